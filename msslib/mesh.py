@@ -8,11 +8,37 @@ Conventions (shared by every module of msslib):
   (``det[p1-p0, p2-p0, p3-p0] > 0``); ``hexahedron`` nodes 0-3 the bottom face counter-clockwise
   seen from above, 4-7 the top face, node ``i + 4`` above node ``i``.
 * ``material`` has shape ``(n_cells,)``: an index into the list of materials of a model.
+
+Contents of this module (all lengths in metres, areas in m^2, volumes in m^3):
+
+* structured generators: :func:`quad_grid`, :func:`triangle_grid_right`,
+  :func:`triangle_grid_equilateral` (with :func:`equilateral_rows`), :func:`hexagon_equilateral`,
+  :func:`hex_grid`, :func:`tet_grid`, :func:`l_block_hex`;
+* unstructured meshes generated with gmsh: :func:`polygon_mesh`, :func:`cylinder_mesh`,
+  :func:`cylinder_with_hole_mesh`, :func:`cone_mesh`, :func:`l_block_tet`.  Element sizes are at
+  most ``h``, refined to about 12 elements per full circle on curved boundaries but not below
+  ``h / 8``; gmsh runs single-threaded with a fixed random ``seed``, so a call is reproducible;
+  the mesh keeps only the nodes its cells use and its simplices are positively oriented;
+* input/output: :func:`read`, :func:`write_vtu`;
+* topology and geometry: :func:`unique_edges`, :func:`face_diagonals`, :func:`inner_diagonals`,
+  :func:`boundary_facets`, :func:`facet_areas`, :func:`cell_measures`, :func:`check_cells`,
+  :func:`orient`, :func:`select_nodes`, :func:`lumped_masses`.
+
+The L-shaped block (:func:`l_block_hex`, :func:`l_block_tet`) of edge ``size`` ``s`` is the cube
+``[0, s]^3`` from which the quadrant ``x > s/2, z > s/2`` is removed: its cross-section in the
+x-z plane is an "L" (three squares of side ``s/2``), extruded over ``0 <= y <= s``.
+Its volume is ``3 s^3 / 4``.
 """
 
 from __future__ import annotations
 
+import os
+import threading
+import uuid
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -56,3 +82,803 @@ class Mesh:
     @property
     def n_cells(self) -> int:
         return len(self.cells)
+
+    @property
+    def nodes_per_cell(self) -> int:
+        return self.cells.shape[1]
+
+
+__all__ = [
+    "CELL_TYPES",
+    "Mesh",
+    "NodePairs",
+    "quad_grid",
+    "triangle_grid_right",
+    "equilateral_rows",
+    "triangle_grid_equilateral",
+    "hexagon_equilateral",
+    "hex_grid",
+    "tet_grid",
+    "l_block_hex",
+    "polygon_mesh",
+    "cylinder_mesh",
+    "cylinder_with_hole_mesh",
+    "cone_mesh",
+    "l_block_tet",
+    "read",
+    "write_vtu",
+    "unique_edges",
+    "face_diagonals",
+    "inner_diagonals",
+    "boundary_facets",
+    "facet_areas",
+    "cell_measures",
+    "check_cells",
+    "orient",
+    "select_nodes",
+    "lumped_masses",
+]
+
+# --------------------------------------------------------------------------------------------
+# local numbering tables (VTK/meshio node order, see the module docstring)
+# --------------------------------------------------------------------------------------------
+
+_LOCAL_EDGES = {
+    "triangle": np.array([[0, 1], [1, 2], [2, 0]]),
+    "quad": np.array([[0, 1], [1, 2], [2, 3], [3, 0]]),
+    "tetra": np.array([[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]]),
+    "hexahedron": np.array(
+        [[0, 1], [1, 2], [2, 3], [3, 0], [4, 5], [5, 6], [6, 7], [7, 4], [0, 4], [1, 5], [2, 6], [3, 7]]
+    ),
+}
+
+# Facets with outward orientation for a positively oriented cell.  In 2D an edge (a, b) is outward
+# oriented when the cell lies on its left, i.e. the outward normal is (dy, -dx).  In 3D the
+# right-hand-rule normal of the facet points out of the cell.
+_LOCAL_FACETS = {
+    "triangle": _LOCAL_EDGES["triangle"],
+    "quad": _LOCAL_EDGES["quad"],
+    "tetra": np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]]),
+    "hexahedron": np.array(
+        [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
+    ),
+}
+
+_HEX_REF = np.array(
+    [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]],
+    dtype=float,
+)
+
+# Corners of the unit cube in hexahedron order: corner c sits at _HEX_REF01[c].
+_HEX_REF01 = (_HEX_REF + 1.0) / 2.0
+
+_AXES = {"x": 0, "y": 1, "z": 2}
+
+
+class NodePairs(NamedTuple):
+    """Unique node pairs (edges or diagonals) and the cells that share each of them.
+
+    ``pairs`` has shape ``(n_pairs, 2)`` with ``pairs[:, 0] < pairs[:, 1]``, rows sorted
+    lexicographically.  The cells sharing pair ``k`` are ``cells[indptr[k]:indptr[k + 1]]``
+    (compressed sparse rows, cell ids ascending).  ``counts`` is the number of such cells: spring
+    constants contributed per cell are summed over them.  Unpacks as ``pairs, indptr, cells``.
+    """
+
+    pairs: np.ndarray
+    indptr: np.ndarray
+    cells: np.ndarray
+
+    @property
+    def counts(self) -> np.ndarray:
+        return np.diff(self.indptr)
+
+    def cells_of(self, k: int) -> np.ndarray:
+        """Ids of the cells sharing pair ``k``."""
+        return self.cells[self.indptr[k] : self.indptr[k + 1]]
+
+
+# --------------------------------------------------------------------------------------------
+# small internal helpers
+# --------------------------------------------------------------------------------------------
+
+
+def _positive_int(name: str, value, minimum: int = 1) -> int:
+    if int(value) != value or value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def _positive_length(name: str, value) -> float:
+    value = float(value)
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} must be a positive length in metres, got {value!r}")
+    return value
+
+
+def _compact(points: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Drop the nodes no cell uses; keeps the relative order of the remaining nodes."""
+    used = np.zeros(len(points), dtype=bool)
+    used[cells.ravel()] = True
+    new_id = np.cumsum(used) - 1
+    return points[used], new_id[cells]
+
+
+def _group_pairs(pairs: np.ndarray, cell_ids: np.ndarray, n_nodes: int) -> NodePairs:
+    """Sort every pair, merge duplicates, and build the pair -> cells CSR table."""
+    pairs = np.sort(pairs, axis=1).astype(np.int64)
+    keys = pairs[:, 0] * np.int64(max(n_nodes, 1)) + pairs[:, 1]
+    unique_keys, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    order = np.argsort(inverse, kind="stable")
+    indptr = np.zeros(len(unique_keys) + 1, dtype=np.int64)
+    np.cumsum(np.bincount(inverse, minlength=len(unique_keys)), out=indptr[1:])
+    return NodePairs(pairs[first], indptr, cell_ids[order].astype(np.int64))
+
+
+def _local_pairs(mesh: Mesh, local: np.ndarray) -> NodePairs:
+    pairs = mesh.cells[:, local].reshape(-1, 2)
+    cell_ids = np.repeat(np.arange(mesh.n_cells, dtype=np.int64), len(local))
+    return _group_pairs(pairs, cell_ids, mesh.n_nodes)
+
+
+def _lattice_triangles(q: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Triangles of a triangular lattice given in axial coordinates.
+
+    Node ``k`` sits at ``a * (q + r / 2, r * sqrt(3) / 2)``.  Every lattice triangle whose three
+    corners are all present is returned, counter-clockwise.
+    """
+    qmin, rmin = q.min(), r.min()
+    span = np.int64(r.max() - rmin + 2)
+    keys = (q - qmin).astype(np.int64) * span + (r - rmin)
+    order = np.argsort(keys)
+    sorted_keys = keys[order]
+
+    def lookup(dq, dr):
+        k = (q + dq - qmin).astype(np.int64) * span + (r + dr - rmin)
+        pos = np.clip(np.searchsorted(sorted_keys, k), 0, len(keys) - 1)
+        found = sorted_keys[pos] == k
+        return np.where(found, order[pos], -1)
+
+    here = np.arange(len(q))
+    # every triangle is anchored at its lowest vertex (the lower-left one for upward triangles)
+    right, up, up_left = lookup(1, 0), lookup(0, 1), lookup(-1, 1)
+    tri_up = np.stack([here, right, up], axis=1)
+    tri_down = np.stack([here, up, up_left], axis=1)
+    tris = np.concatenate([tri_up, tri_down])
+    return tris[(tris >= 0).all(axis=1)]
+
+
+# --------------------------------------------------------------------------------------------
+# structured generators
+# --------------------------------------------------------------------------------------------
+
+
+def quad_grid(lx: float, ly: float, nx: int, ny: int, origin=(0.0, 0.0)) -> Mesh:
+    """Rectangle ``[x0, x0 + lx] x [y0, y0 + ly]`` (metres) meshed with ``nx * ny`` quads.
+
+    Node ``i + (nx + 1) * j`` sits at ``(x0 + i lx / nx, y0 + j ly / ny)``; quads are
+    counter-clockwise, numbered x fastest.  Squares when ``lx / nx == ly / ny``.
+    """
+    lx, ly = _positive_length("lx", lx), _positive_length("ly", ly)
+    nx, ny = _positive_int("nx", nx), _positive_int("ny", ny)
+    x = origin[0] + np.linspace(0.0, lx, nx + 1)
+    y = origin[1] + np.linspace(0.0, ly, ny + 1)
+    xx, yy = np.meshgrid(x, y, indexing="xy")
+    points = np.column_stack([xx.ravel(), yy.ravel()])
+    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="xy")
+    n0 = (i + (nx + 1) * j).ravel()
+    cells = np.column_stack([n0, n0 + 1, n0 + nx + 2, n0 + nx + 1])
+    return Mesh(points, cells, "quad")
+
+
+def triangle_grid_right(lx: float, ly: float, nx: int, ny: int, origin=(0.0, 0.0)) -> Mesh:
+    """Rectangle of :func:`quad_grid` with each ``lx/nx`` by ``ly/ny`` rectangle split in two
+    right triangles along its diagonal from the lower-left to the upper-right corner.
+
+    Same nodes as :func:`quad_grid`; ``2 * nx * ny`` counter-clockwise triangles, the two halves of
+    rectangle ``c`` being cells ``2c`` (lower-right) and ``2c + 1`` (upper-left).
+    """
+    quads = quad_grid(lx, ly, nx, ny, origin)
+    q = quads.cells
+    lower = q[:, [0, 1, 2]]
+    upper = q[:, [0, 2, 3]]
+    cells = np.stack([lower, upper], axis=1).reshape(-1, 3)
+    return Mesh(quads.points, cells, "triangle")
+
+
+def equilateral_rows(width: float, height: float, n: int) -> tuple[int, float]:
+    """Rows of triangles of :func:`triangle_grid_equilateral`: ``(n_rows, used_height)``.
+
+    The edge is ``a = width / n`` and a row of triangles is ``a * sqrt(3) / 2`` high, so
+    ``n_rows = floor(height / (a sqrt(3) / 2))`` (at least 1 is required) and the mesh spans
+    ``used_height = n_rows * a * sqrt(3) / 2 <= height`` metres.
+    """
+    width, height = _positive_length("width", width), _positive_length("height", height)
+    n = _positive_int("n", n)
+    row_height = width / n * np.sqrt(3.0) / 2.0
+    n_rows = int(np.floor(height / row_height * (1.0 + 1e-12)))
+    return n_rows, n_rows * row_height
+
+
+def triangle_grid_equilateral(width: float, height: float, n: int, origin=(0.0, 0.0)) -> Mesh:
+    """Membrane meshed with equilateral triangles of edge ``a = width / n`` (metres).
+
+    Node rows are ``a sqrt(3) / 2`` apart; even rows hold ``n + 1`` nodes at ``x = 0, a, ..., width``,
+    odd rows ``n`` nodes offset by half an edge (``x = a/2, ..., width - a/2``), so every edge of the
+    mesh has length ``a`` and the left and right sides are zig-zags.  As many rows of triangles as
+    fit in ``height`` are used: that number and the height actually covered are reported by
+    :func:`equilateral_rows` (also ``mesh.points[:, 1].max() - origin[1]``).  Each row of
+    triangles holds ``2 n - 1`` counter-clockwise triangles.
+    """
+    n_rows, _ = equilateral_rows(width, height, n)
+    if n_rows < 1:
+        raise ValueError(
+            f"height {height} m is smaller than one row of equilateral triangles "
+            f"({width / n * np.sqrt(3) / 2} m for width {width} m and n = {n})"
+        )
+    a = width / n
+    rows = np.arange(n_rows + 1)
+    counts = np.where(rows % 2 == 0, n + 1, n)
+    r = np.repeat(rows, counts)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    i = np.arange(counts.sum()) - np.repeat(start, counts)
+    q = i - r // 2
+    points = np.column_stack([a * (q + r / 2.0), a * r * np.sqrt(3.0) / 2.0]) + np.asarray(origin, float)
+    return Mesh(points, _lattice_triangles(q, r), "triangle")
+
+
+def hexagon_equilateral(height: float, n_rings: int, center=(0.0, 0.0)) -> Mesh:
+    """Regular hexagon of ``height`` (distance between its flat top and bottom sides, metres)
+    meshed with equilateral triangles, centred on ``center``.
+
+    The circumradius is ``R = height / sqrt(3)`` (corners at ``(+-R, 0)``); the edge of the
+    triangles is ``R / n_rings``.  Node count ``3 n^2 + 3 n + 1`` and ``6 n^2`` counter-clockwise
+    triangles for ``n = n_rings``.
+    """
+    height = _positive_length("height", height)
+    n = _positive_int("n_rings", n_rings)
+    a = height / np.sqrt(3.0) / n
+    q, r = np.meshgrid(np.arange(-n, n + 1), np.arange(-n, n + 1), indexing="ij")
+    q, r = q.ravel(), r.ravel()
+    keep = np.abs(q + r) <= n
+    q, r = q[keep], r[keep]
+    points = np.column_stack([a * (q + r / 2.0), a * r * np.sqrt(3.0) / 2.0]) + np.asarray(center, float)
+    return Mesh(points, _lattice_triangles(q, r), "triangle")
+
+
+def _grid3_points(lx, ly, lz, nx, ny, nz, origin):
+    x = origin[0] + np.linspace(0.0, lx, nx + 1)
+    y = origin[1] + np.linspace(0.0, ly, ny + 1)
+    z = origin[2] + np.linspace(0.0, lz, nz + 1)
+    zz, yy, xx = np.meshgrid(z, y, x, indexing="ij")
+    return np.column_stack([xx.ravel(), yy.ravel(), zz.ravel()])
+
+
+def _grid3_cube_corners(nx, ny, nz):
+    """Node ids of the 8 corners (hexahedron order) of every cube, x fastest; and (i, j, k)."""
+    k, j, i = np.meshgrid(np.arange(nz), np.arange(ny), np.arange(nx), indexing="ij")
+    i, j, k = i.ravel(), j.ravel(), k.ravel()
+    off = _HEX_REF01.astype(np.int64)
+    corners = (i[:, None] + off[:, 0]) + (nx + 1) * ((j[:, None] + off[:, 1]) + (ny + 1) * (k[:, None] + off[:, 2]))
+    return corners, (i, j, k)
+
+
+def hex_grid(lx: float, ly: float, lz: float, nx: int, ny: int, nz: int, origin=(0.0, 0.0, 0.0)) -> Mesh:
+    """Box ``origin + [0, lx] x [0, ly] x [0, lz]`` (metres) meshed with ``nx * ny * nz`` hexahedra.
+
+    Node ``i + (nx + 1) * (j + (ny + 1) * k)`` sits at ``origin + (i lx/nx, j ly/ny, k lz/nz)``;
+    cells numbered x fastest, then y, then z.
+    """
+    lx, ly, lz = (_positive_length(s, v) for s, v in (("lx", lx), ("ly", ly), ("lz", lz)))
+    nx, ny, nz = (_positive_int(s, v) for s, v in (("nx", nx), ("ny", ny), ("nz", nz)))
+    points = _grid3_points(lx, ly, lz, nx, ny, nz, origin)
+    corners, _ = _grid3_cube_corners(nx, ny, nz)
+    return Mesh(points, corners, "hexahedron")
+
+
+# Five tetrahedra of a cube whose corner 0 has even parity: the central tetrahedron joins the even
+# corners 0, 2, 5, 7 and one corner tetrahedron cuts off each odd corner 1, 3, 4, 6.
+_CUBE5_EVEN = np.array([[0, 2, 5, 7], [1, 0, 2, 5], [3, 0, 2, 7], [4, 0, 5, 7], [6, 2, 5, 7]])
+# Mirror image for cubes whose corner 0 has odd parity: central tetrahedron on 1, 3, 4, 6.
+_CUBE5_ODD = np.array([[1, 3, 4, 6], [0, 1, 3, 4], [2, 1, 3, 6], [5, 1, 4, 6], [7, 3, 4, 6]])
+# Kuhn/Freudenthal: the six paths 0 -> 6 along the cube edges, one per ordering of the axes.
+_CUBE6 = np.array([[0, 1, 2, 6], [0, 1, 5, 6], [0, 3, 2, 6], [0, 3, 7, 6], [0, 4, 5, 6], [0, 4, 7, 6]])
+
+
+def tet_grid(lx: float, ly: float, lz: float, nx: int, ny: int, nz: int, scheme: int = 6,
+             origin=(0.0, 0.0, 0.0)) -> Mesh:
+    """Box of :func:`hex_grid` with each cube split into tetrahedra, positively oriented.
+
+    ``scheme=5``: five tetrahedra per cube (one central tetrahedron of a third of the cube's
+    volume and four corner ones); the split alternates with the parity of ``i + j + k`` so that
+    every face diagonal joins two nodes of even global parity and neighbouring faces conform.
+    ``scheme=6``: Kuhn/Freudenthal split, six tetrahedra of equal volume sharing the cube
+    diagonal from its lowest to its highest corner (conforming, translation invariant).
+    Tetrahedra of cube ``c`` are cells ``scheme * c ... scheme * c + scheme - 1``.
+    """
+    if scheme not in (5, 6):
+        raise ValueError(f"scheme must be 5 or 6, got {scheme!r}")
+    hexes = hex_grid(lx, ly, lz, nx, ny, nz, origin)
+    corners = hexes.cells
+    if scheme == 6:
+        tets = corners[:, _CUBE6]
+    else:
+        _, (i, j, k) = _grid3_cube_corners(nx, ny, nz)
+        odd = ((i + j + k) % 2 == 1)[:, None, None]
+        tets = np.where(odd, corners[:, _CUBE5_ODD], corners[:, _CUBE5_EVEN])
+    return orient(Mesh(hexes.points, tets.reshape(-1, 4), "tetra"))
+
+
+def l_block_hex(size: float, n: int, origin=(0.0, 0.0, 0.0)) -> Mesh:
+    """L-shaped block of edge ``size`` (metres) made of cubes of edge ``size / n`` (``n`` even).
+
+    Shape (see the module docstring): the cube ``[0, size]^3`` minus the quadrant
+    ``x > size/2, z > size/2``; an "L" in the x-z plane extruded along y.  ``3 n^3 / 4`` hexahedra.
+    Nodes are those of ``hex_grid(size, size, size, n, n, n)`` that the remaining cubes use, in
+    the same relative order.
+    """
+    size = _positive_length("size", size)
+    n = _positive_int("n", n, minimum=2)
+    if n % 2:
+        raise ValueError(f"n must be even so that the removed quadrant is made of whole cubes, got {n}")
+    full = hex_grid(size, size, size, n, n, n, origin)
+    _, (i, _j, k) = _grid3_cube_corners(n, n, n)
+    keep = ~((i >= n // 2) & (k >= n // 2))
+    points, cells = _compact(full.points, full.cells[keep])
+    return Mesh(points, cells, "hexahedron")
+
+
+# --------------------------------------------------------------------------------------------
+# unstructured meshes with gmsh
+# --------------------------------------------------------------------------------------------
+
+# gmsh keeps global state: one session at a time in this process.
+_GMSH_LOCK = threading.Lock()
+
+
+@contextmanager
+def _gmsh_session(h: float, seed: int, name: str, min_size: float | None = None):
+    """Initialise gmsh with deterministic, quiet options; always finalise it.
+
+    Element sizes: at most ``h``; about 12 elements per full circle of a curved boundary, but
+    not smaller than ``min_size`` (default ``h / 8``, which keeps a cone's apex from being
+    over-refined).
+    """
+    try:
+        import gmsh
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise ImportError("the gmsh Python API is needed for unstructured meshes: pip install gmsh") from exc
+    h = _positive_length("h", h)
+    with _GMSH_LOCK:
+        if gmsh.isInitialized():
+            raise RuntimeError("gmsh is already initialised by other code; finalise it before calling msslib.mesh")
+        # no signal handler (works outside the main thread), no user configuration files
+        gmsh.initialize(readConfigFiles=False, interruptible=False)
+        try:
+            opt = gmsh.option.setNumber
+            opt("General.Terminal", 0)
+            opt("General.Verbosity", 0)
+            opt("General.NumThreads", 1)
+            for d in ("1D", "2D", "3D"):
+                opt(f"Mesh.MaxNumThreads{d}", 1)
+            opt("Mesh.RandomSeed", int(seed))
+            opt("Mesh.Algorithm", 6)  # Frontal-Delaunay
+            opt("Mesh.Algorithm3D", 1)  # Delaunay
+            opt("Mesh.ElementOrder", 1)
+            opt("Mesh.MeshSizeMax", h)
+            opt("Mesh.MeshSizeMin", h / 8 if min_size is None else min(float(min_size), h))
+            opt("Mesh.MeshSizeFromPoints", 0)
+            opt("Mesh.MeshSizeFromCurvature", 12)  # at least ~12 elements per full circle
+            opt("Mesh.MeshSizeExtendFromBoundary", 1)
+            gmsh.model.add(name)
+            yield gmsh
+        finally:
+            gmsh.finalize()
+
+
+def _gmsh_extract(gmsh, dim: int) -> Mesh:
+    """Mesh the synchronised model in ``dim`` dimensions and return it as a positive Mesh."""
+    gmsh.model.mesh.generate(dim)
+    node_tags, coords, _ = gmsh.model.mesh.getNodes()
+    coords = np.asarray(coords, dtype=float).reshape(-1, 3)
+    node_tags = np.asarray(node_tags, dtype=np.int64)
+    etype, cell_type = (2, "triangle") if dim == 2 else (4, "tetra")
+    _, elem_nodes = gmsh.model.mesh.getElementsByType(etype)
+    elem_nodes = np.asarray(elem_nodes, dtype=np.int64).reshape(-1, CELL_TYPES[cell_type][1])
+    if len(elem_nodes) == 0:
+        raise RuntimeError("gmsh produced no elements; is h much larger than the geometry?")
+    index = np.full(node_tags.max() + 1, -1, dtype=np.int64)
+    index[node_tags] = np.arange(len(node_tags))
+    cells = index[elem_nodes]
+    points, cells = _compact(coords[:, :dim], cells)
+    return orient(Mesh(points, cells, cell_type))
+
+
+def polygon_mesh(vertices, h: float, seed: int = 0) -> Mesh:
+    """Simple polygon (vertices ``(n, 2)`` in metres, either orientation, not repeated at the end)
+    meshed with counter-clockwise triangles of size about ``h`` by gmsh.
+
+    ``seed`` fixes gmsh's random generator; gmsh runs single-threaded, so the same call gives the
+    same mesh.
+    """
+    vertices = np.asarray(vertices, dtype=float)
+    if vertices.ndim != 2 or vertices.shape[1] != 2 or len(vertices) < 3:
+        raise ValueError(f"vertices must have shape (n >= 3, 2), got {vertices.shape}")
+    with _gmsh_session(h, seed, "polygon") as gmsh:
+        geo = gmsh.model.geo
+        pts = [geo.addPoint(x, y, 0.0) for x, y in vertices]
+        lines = [geo.addLine(pts[k], pts[(k + 1) % len(pts)]) for k in range(len(pts))]
+        loop = geo.addCurveLoop(lines)
+        geo.addPlaneSurface([loop])
+        geo.synchronize()
+        return _gmsh_extract(gmsh, 2)
+
+
+def _check_cylinder(radius, height):
+    return _positive_length("radius", radius), _positive_length("height", height)
+
+
+def cylinder_mesh(radius: float, height: float, h: float, seed: int = 0) -> Mesh:
+    """Solid cylinder of ``radius`` and ``height`` (metres), axis z, base disc at ``z = 0``,
+    meshed with positively oriented tetrahedra of size about ``h`` (gmsh, deterministic)."""
+    radius, height = _check_cylinder(radius, height)
+    with _gmsh_session(h, seed, "cylinder") as gmsh:
+        gmsh.model.occ.addCylinder(0, 0, 0, 0, 0, height, radius)
+        gmsh.model.occ.synchronize()
+        return _gmsh_extract(gmsh, 3)
+
+
+def cylinder_with_hole_mesh(radius: float, height: float, hole_radius: float, h: float, seed: int = 0) -> Mesh:
+    """Cylinder of :func:`cylinder_mesh` with a spherical cavity of ``hole_radius`` (metres) at its
+    centre ``(0, 0, height / 2)``.  Volume ``pi r^2 height - 4/3 pi hole_radius^3``."""
+    radius, height = _check_cylinder(radius, height)
+    hole_radius = _positive_length("hole_radius", hole_radius)
+    if hole_radius >= min(radius, height / 2):
+        raise ValueError(f"hole_radius {hole_radius} must be smaller than the radius and half the height")
+    with _gmsh_session(h, seed, "cylinder_with_hole", min_size=min(h / 8, np.pi * hole_radius / 6)) as gmsh:
+        occ = gmsh.model.occ
+        cyl = occ.addCylinder(0, 0, 0, 0, 0, height, radius)
+        ball = occ.addSphere(0, 0, height / 2, hole_radius)
+        occ.cut([(3, cyl)], [(3, ball)])
+        occ.synchronize()
+        return _gmsh_extract(gmsh, 3)
+
+
+def cone_mesh(r_bottom: float, r_top: float, height: float, h: float, seed: int = 0) -> Mesh:
+    """Truncated cone, axis z, base disc of radius ``r_bottom`` at ``z = 0``, top disc of radius
+    ``r_top`` (may be 0: a full cone) at ``z = height`` (metres); tetrahedra of size about ``h``.
+    Volume ``pi height (r_b^2 + r_b r_t + r_t^2) / 3``."""
+    r_bottom = _positive_length("r_bottom", r_bottom)
+    height = _positive_length("height", height)
+    r_top = float(r_top)
+    if r_top < 0:
+        raise ValueError(f"r_top must be >= 0, got {r_top}")
+    with _gmsh_session(h, seed, "cone") as gmsh:
+        gmsh.model.occ.addCone(0, 0, 0, 0, 0, height, r_bottom, r_top)
+        gmsh.model.occ.synchronize()
+        return _gmsh_extract(gmsh, 3)
+
+
+def l_block_tet(size: float, h: float, seed: int = 0) -> Mesh:
+    """L-shaped block of :func:`l_block_hex` (cube ``[0, size]^3`` minus ``x > size/2, z > size/2``)
+    meshed with positively oriented tetrahedra of size about ``h`` by gmsh."""
+    size = _positive_length("size", size)
+    with _gmsh_session(h, seed, "l_block") as gmsh:
+        occ = gmsh.model.occ
+        block = occ.addBox(0, 0, 0, size, size, size)
+        notch = occ.addBox(size / 2, 0, size / 2, size / 2, size, size / 2)
+        occ.cut([(3, block)], [(3, notch)])
+        occ.synchronize()
+        return _gmsh_extract(gmsh, 3)
+
+
+# --------------------------------------------------------------------------------------------
+# input / output
+# --------------------------------------------------------------------------------------------
+
+
+def read(path, material_key: str = "material") -> Mesh:
+    """Read any mesh file meshio can read.
+
+    The cells are the blocks of the highest-dimensional supported type (``tetra`` or
+    ``hexahedron`` before ``triangle`` or ``quad``; between two types of the same dimension the
+    one with more cells); blocks of that type are concatenated.  Nodes no chosen cell uses are
+    dropped (the others keep their order).  For 2D cells the z coordinate must be constant and is
+    dropped.  ``cell_data[material_key]`` (integers), when present, becomes ``material``.
+
+    Raises FileNotFoundError for a missing file and ValueError (naming the cell types found) when
+    no supported cell type is present.
+    """
+    import meshio
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"mesh file not found: {path}")
+    m = meshio.read(path)
+    found = [block.type for block in m.cells]
+    supported = [t for t in CELL_TYPES if t in found]
+    if not supported:
+        raise ValueError(
+            f"{path}: no supported cell type; found {sorted(set(found)) or 'no cells'}, supported {sorted(CELL_TYPES)}"
+        )
+
+    def rank(t):
+        return CELL_TYPES[t][0], sum(len(b.data) for b in m.cells if b.type == t)
+
+    cell_type = max(supported, key=rank)
+    dim = CELL_TYPES[cell_type][0]
+    blocks = [k for k, b in enumerate(m.cells) if b.type == cell_type]
+    cells = np.concatenate([m.cells[k].data for k in blocks]).astype(np.int64)
+    material = None
+    if material_key in m.cell_data:
+        values = np.concatenate([np.asarray(m.cell_data[material_key][k]).reshape(len(m.cells[k].data), -1) for k in blocks])
+        if values.shape[1] == 1:
+            material = np.rint(values[:, 0]).astype(np.int64)
+    points = np.asarray(m.points, dtype=float)
+    if points.shape[1] < dim:
+        points = np.pad(points, ((0, 0), (0, dim - points.shape[1])))
+    points, cells = _compact(points, cells)
+    if dim == 2 and points.shape[1] == 3:
+        z = points[:, 2]
+        scale = max(np.ptp(points[:, :2], axis=0).max(initial=0.0), 1e-300)
+        if len(z) and np.ptp(z) > 1e-9 * scale:
+            raise ValueError(f"{path}: {cell_type} cells are not in a plane z = const; cannot make a 2D mesh")
+        points = points[:, :2]
+    return Mesh(points, cells, cell_type, material)
+
+
+def _pad_columns(a: np.ndarray, dim: int) -> np.ndarray:
+    if dim == 2 and a.ndim == 2 and a.shape[1] == 2:
+        return np.pad(a, ((0, 0), (0, 1)))
+    return a
+
+
+def write_vtu(path, mesh: Mesh, point_data: dict | None = None, cell_data: dict | None = None) -> Path:
+    """Write ``mesh`` as a VTK unstructured grid (.vtu) that ParaView opens.
+
+    2D points get ``z = 0``; on a 2D mesh, data arrays of shape ``(n, 2)`` (vectors) are padded
+    to 3 components as well.  ``point_data`` arrays have ``n_nodes`` rows, ``cell_data`` arrays
+    ``n_cells`` rows; ``material`` is always written as cell data.  The file is written to a
+    temporary file in the same directory and moved into place with :func:`os.replace`, so a
+    reader never sees a partial file.  Returns the path.
+    """
+    import meshio
+
+    path = Path(path)
+    point_data = {} if point_data is None else dict(point_data)
+    cell_data = {} if cell_data is None else dict(cell_data)
+    pdata, cdata = {}, {"material": [mesh.material]}
+    for name, values in point_data.items():
+        values = np.asarray(values)
+        if len(values) != mesh.n_nodes:
+            raise ValueError(f"point_data[{name!r}] has {len(values)} rows, the mesh {mesh.n_nodes} nodes")
+        pdata[name] = _pad_columns(values, mesh.dim)
+    for name, values in cell_data.items():
+        values = np.asarray(values)
+        if len(values) != mesh.n_cells:
+            raise ValueError(f"cell_data[{name!r}] has {len(values)} rows, the mesh {mesh.n_cells} cells")
+        cdata[name] = [_pad_columns(values, mesh.dim)]
+    points = _pad_columns(mesh.points, mesh.dim)
+    out = meshio.Mesh(points, [(mesh.cell_type, mesh.cells)], point_data=pdata, cell_data=cdata)
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    try:
+        meshio.write(tmp, out, file_format="vtu")
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+# --------------------------------------------------------------------------------------------
+# topology
+# --------------------------------------------------------------------------------------------
+
+
+def unique_edges(mesh: Mesh) -> NodePairs:
+    """Edges of the mesh: ``(pairs, indptr, cells)``, see :class:`NodePairs`.
+
+    ``pairs`` is ``(n_edges, 2)`` sorted node pairs; ``NodePairs.counts`` is the number of cells
+    sharing each edge (1 or 2 for a quad/hexahedron boundary/interior edge in 2D, up to 4 around
+    an interior edge of a hexahedron grid, any number for tetrahedra).
+    """
+    return _local_pairs(mesh, _LOCAL_EDGES[mesh.cell_type])
+
+
+_FACE_DIAGONALS = {
+    "quad": np.array([[0, 2], [1, 3]]),
+    "hexahedron": _LOCAL_FACETS["hexahedron"][:, [[0, 2], [1, 3]]].reshape(-1, 2),
+}
+_INNER_DIAGONALS = np.array([[0, 6], [1, 7], [2, 4], [3, 5]])
+
+
+def face_diagonals(mesh: Mesh) -> NodePairs:
+    """Diagonals of the faces of hexahedra (12 per cell; of the cell itself for quads, 2 per cell).
+
+    A diagonal of a face shared by two hexahedra appears once with ``counts == 2``.
+    """
+    if mesh.cell_type not in _FACE_DIAGONALS:
+        raise ValueError(f"face diagonals need hexahedron or quad cells, got {mesh.cell_type}")
+    return _local_pairs(mesh, _FACE_DIAGONALS[mesh.cell_type])
+
+
+def inner_diagonals(mesh: Mesh) -> NodePairs:
+    """The four space diagonals (0-6, 1-7, 2-4, 3-5) of each hexahedron; counts are 1."""
+    if mesh.cell_type != "hexahedron":
+        raise ValueError(f"inner diagonals need hexahedron cells, got {mesh.cell_type}")
+    return _local_pairs(mesh, _INNER_DIAGONALS)
+
+
+def _facet_table(mesh: Mesh):
+    local = _LOCAL_FACETS[mesh.cell_type]
+    facets = mesh.cells[:, local].reshape(-1, local.shape[1])
+    keys = np.sort(facets, axis=1)
+    _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    return facets, counts[inverse.ravel()]
+
+
+def boundary_facets(mesh: Mesh) -> np.ndarray:
+    """Facets belonging to exactly one cell, outward oriented.
+
+    2D: ``(n, 2)`` edges with the mesh on their left (counter-clockwise around the outer boundary;
+    outward normal ``(dy, -dx)``).  3D: ``(n, 3)`` triangles (tetra) or ``(n, 4)`` quads
+    (hexahedron) whose right-hand-rule normal points out of the mesh.  Assumes positively oriented
+    cells (see :func:`orient`).  Facets are listed cell by cell in local facet order.
+    """
+    facets, counts = _facet_table(mesh)
+    return facets[counts == 1]
+
+
+def facet_areas(mesh: Mesh, facets: np.ndarray) -> np.ndarray:
+    """Length (2D, metres) or area (3D, m^2) of each facet of ``facets`` (node ids).
+
+    Quads use the area of the bilinear surface they span (2 x 2 Gauss quadrature; exact for
+    planar quads).
+    """
+    facets = np.asarray(facets, dtype=np.int64)
+    x = mesh.points[facets]
+    if facets.shape[1] == 2:
+        return np.linalg.norm(x[:, 1] - x[:, 0], axis=1)
+    if facets.shape[1] == 3:
+        return 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
+    if facets.shape[1] == 4:
+        g = np.array([-1.0, 1.0]) / np.sqrt(3.0)
+        area = np.zeros(len(facets))
+        for u in g:
+            for v in g:
+                # bilinear map on [-1, 1]^2, corners counter-clockwise
+                du = 0.25 * ((x[:, 1] - x[:, 0]) * (1 - v) + (x[:, 2] - x[:, 3]) * (1 + v))
+                dv = 0.25 * ((x[:, 3] - x[:, 0]) * (1 - u) + (x[:, 2] - x[:, 1]) * (1 + u))
+                area += np.linalg.norm(np.cross(du, dv), axis=1)
+        return area
+    raise ValueError(f"facets must have 2, 3 or 4 nodes, got {facets.shape[1]}")
+
+
+# --------------------------------------------------------------------------------------------
+# geometry and checks
+# --------------------------------------------------------------------------------------------
+
+
+def _hex_volumes(x: np.ndarray) -> np.ndarray:
+    """Exact volume of trilinear hexahedra (det J is of degree <= 2 per variable: 2^3 Gauss)."""
+    g = np.array([-1.0, 1.0]) / np.sqrt(3.0)
+    gp = np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T  # (8, 3)
+    s = _HEX_REF  # (8 nodes, 3)
+    # dN[g, a, d] = d N_a / d xi_d at Gauss point g
+    f = 1.0 + gp[:, None, :] * s[None, :, :]  # (8 gp, 8 nodes, 3)
+    dn = np.empty((len(gp), 8, 3))
+    dn[..., 0] = s[:, 0] * f[..., 1] * f[..., 2]
+    dn[..., 1] = s[:, 1] * f[..., 0] * f[..., 2]
+    dn[..., 2] = s[:, 2] * f[..., 0] * f[..., 1]
+    dn /= 8.0
+    jac = np.einsum("cai,gad->cgid", x, dn)  # (cells, gp, 3, 3)
+    return np.linalg.det(jac).sum(axis=1)
+
+
+def cell_measures(mesh: Mesh) -> np.ndarray:
+    """Signed area (2D, m^2) or volume (3D, m^3) of each cell; positive for the conventional
+    orientation.
+
+    Triangles and tetrahedra: exact.  Quads: exact area of the bilinear quad (shoelace formula).
+    Hexahedra: exact volume of the trilinear hexahedron (2 x 2 x 2 Gauss quadrature of det J).
+    """
+    x = mesh.points[mesh.cells]
+    t = mesh.cell_type
+    if t == "triangle":
+        a, b = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
+        return 0.5 * (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+    if t == "quad":
+        d1, d2 = x[:, 2] - x[:, 0], x[:, 3] - x[:, 1]
+        return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+    if t == "tetra":
+        return np.linalg.det(x[:, 1:] - x[:, :1]) / 6.0
+    return _hex_volumes(x)
+
+
+def check_cells(mesh: Mesh, rtol: float = 1e-12, max_report: int = 5) -> np.ndarray:
+    """Raise ValueError if a cell is inverted (negative measure) or degenerate
+    (``|measure| <= rtol * mean |measure|``); otherwise return the measures.
+
+    The message names the first ``max_report`` offending cell indices with their measure.
+    """
+    measures = cell_measures(mesh)
+    if measures.size == 0:
+        return measures
+    mean = np.abs(measures).mean()
+    degenerate = np.abs(measures) <= rtol * mean
+    inverted = (measures < 0) & ~degenerate
+    problems = []
+    for label, mask in (("inverted", inverted), ("degenerate", degenerate)):
+        bad = np.flatnonzero(mask)
+        if len(bad):
+            shown = ", ".join(f"cell {i} (measure {measures[i]:.3e})" for i in bad[:max_report])
+            more = f" and {len(bad) - max_report} more" if len(bad) > max_report else ""
+            problems.append(f"{len(bad)} {label} {mesh.cell_type} cell(s): {shown}{more}")
+    if problems:
+        raise ValueError("; ".join(problems) + f" (mean |measure| {mean:.3e})")
+    return measures
+
+
+_FLIP = {
+    "triangle": np.array([0, 2, 1]),
+    "quad": np.array([0, 3, 2, 1]),
+    "tetra": np.array([0, 2, 1, 3]),
+    "hexahedron": np.array([4, 5, 6, 7, 0, 1, 2, 3]),
+}
+
+
+def orient(mesh: Mesh) -> Mesh:
+    """Return a mesh whose cells with negative measure are flipped: triangles and tetrahedra swap
+    nodes 1 and 2, quads reverse their order, hexahedra swap their bottom and top faces."""
+    flip = cell_measures(mesh) < 0
+    if not flip.any():
+        return mesh
+    cells = mesh.cells.copy()
+    cells[flip] = cells[flip][:, _FLIP[mesh.cell_type]]
+    return Mesh(mesh.points, cells, mesh.cell_type, mesh.material)
+
+
+def select_nodes(mesh: Mesh, box=None, plane=None, tol: float = 1e-9) -> np.ndarray:
+    """Sorted ids of the nodes inside ``box`` and on ``plane`` (both optional; both -> intersection).
+
+    ``box = ((xmin, ymin[, zmin]), (xmax, ymax[, zmax]))`` in metres, any bound may be None
+    (unbounded), and either corner may be None.  ``plane = (axis, value)`` with axis "x", "y",
+    "z" or 0, 1, 2, e.g. ``("z", 0.0)``.  Bounds are widened by ``tol`` metres.  With neither,
+    every node is selected.  Raises ValueError if nothing is selected.
+    """
+    x = mesh.points
+    keep = np.ones(len(x), dtype=bool)
+    if box is not None:
+        lower, upper = box
+        for bounds, sign in ((lower, 1.0), (upper, -1.0)):
+            if bounds is None:
+                continue
+            if len(bounds) != mesh.dim:
+                raise ValueError(f"box corners need {mesh.dim} coordinates, got {bounds!r}")
+            for d, b in enumerate(bounds):
+                if b is not None:
+                    keep &= sign * (x[:, d] - b) >= -tol
+    if plane is not None:
+        axis, value = plane
+        d = _AXES.get(axis, axis) if isinstance(axis, str) else int(axis)
+        if not isinstance(d, int) or not 0 <= d < mesh.dim:
+            raise ValueError(f"plane axis {axis!r} is not an axis of a {mesh.dim}D mesh")
+        keep &= np.abs(x[:, d] - value) <= tol
+    ids = np.flatnonzero(keep)
+    if len(ids) == 0:
+        raise ValueError(f"no node selected by box={box!r}, plane={plane!r} (tol={tol})")
+    return ids
+
+
+def lumped_masses(mesh: Mesh, density, thickness: float = 1.0) -> np.ndarray:
+    """Lumped nodal masses (kg): each cell's mass split equally among its nodes.
+
+    ``density`` in kg/m^3, a scalar or one value per cell.  For 2D meshes the cell mass is
+    ``density * area * thickness`` (thickness in metres); for 3D meshes ``density * volume``
+    and ``thickness`` must be left at 1.
+    """
+    density = np.broadcast_to(np.asarray(density, dtype=float), (mesh.n_cells,))
+    if mesh.dim == 3 and thickness != 1.0:
+        raise ValueError("thickness applies to 2D meshes only")
+    cell_mass = density * np.abs(cell_measures(mesh)) * (thickness if mesh.dim == 2 else 1.0)
+    per_node = np.repeat(cell_mass / mesh.nodes_per_cell, mesh.nodes_per_cell)
+    return np.bincount(mesh.cells.ravel(), weights=per_node, minlength=mesh.n_nodes)

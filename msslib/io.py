@@ -1,0 +1,502 @@
+"""NetCDF results: one schema for every simulation (mass-spring system or FEM reference).
+
+Results are :class:`xarray.Dataset` objects built by :func:`make_dataset`, written atomically by
+:func:`write_result` (engine ``netcdf4``) and read back fully into memory by :func:`read_result`.
+:func:`mesh_from_result` rebuilds the :class:`~msslib.mesh.Mesh`.
+
+Schema ``msslib-result-1.0`` (the value of the global attribute ``Conventions``)
+==================================================================================
+
+Dimensions
+----------
+
+============== ===============================================================================
+dimension      meaning
+============== ===============================================================================
+``node``       mesh nodes, in the order of ``Mesh.points``
+``axis``       spatial axes; coordinate variable ``axis`` holds ``"x", "y"`` (2D) or
+               ``"x", "y", "z"`` (3D)
+``cell``       mesh cells, in the order of ``Mesh.cells``
+``cell_node``  nodes of one cell (3 triangle, 4 quad, 4 tetra, 8 hexahedron)
+``spring``     springs of a mass-spring system (optional)
+``spring_end`` the two end nodes of a spring (length 2; optional, with ``spring``)
+``time``       stored states of a dynamic run; coordinate variable ``time`` [s] (optional)
+``step``       stored states of a quasi-static / iterative run when there is no physical time;
+               coordinate variable ``step`` [1] (optional; used only if ``time`` is not)
+============== ===============================================================================
+
+Variables (every variable, coordinates included, has the attributes ``units`` and ``long_name``;
+``1`` is the unit of dimensionless quantities and indices)
+
+====================================================== ===== ==========================================
+variable                                               units content
+====================================================== ===== ==========================================
+``axis(axis)``                                         1     axis names (string coordinate)
+``rest_position(node, axis)``                          m     node positions of the undeformed mesh
+``displacement(node, axis)``                           m     displacement of the final state
+``cells(cell, cell_node)``                             1     int64 connectivity, 0-based node indices,
+                                                             node order of :mod:`msslib.mesh`;
+                                                             attribute ``cell_type`` (``triangle``,
+                                                             ``quad``, ``tetra``, ``hexahedron``)
+``material(cell)``                                     1     int64 index into the arrays ``E``/``nu``
+``springs(spring, spring_end)``                        1     int64 end nodes of every spring (optional)
+``spring_constant(spring)``                            N/m   spring stiffness (optional)
+``rest_length(spring)``                                m     spring rest length (optional)
+``reaction_force(node, axis)``                         N     reaction force at the nodes (optional)
+``fixed(node, axis)``                                  1     Dirichlet mask: ``bool`` in memory, stored
+                                                             as ``int8`` 0/1 with attribute
+                                                             ``dtype = "bool"`` (xarray decodes it back
+                                                             to ``bool``) (optional)
+``time(time)``                                         s     time of the stored states (optional)
+``step(step)`` or ``step(time)``                       1     iteration / load-step number (optional)
+``displacement_history(time|step, node, axis)``        m     displacement of every stored state
+                                                             (optional)
+``velocity_history(time|step, node, axis)``            m/s   velocity of every stored state (optional)
+====================================================== ===== ==========================================
+
+Further variables may be added with ``extra_vars``; they must carry ``units`` and ``long_name`` too.
+
+Global attributes
+-----------------
+
+==================== ==========================================================================
+attribute            content
+==================== ==========================================================================
+``Conventions``      ``"msslib-result-1.0"`` (:data:`SCHEMA_VERSION`)
+``model``            model name, e.g. ``"fem_linear"``, ``"lloyd_tetrahedron"``
+``E``                Young's modulus [Pa]; a number, or a 1-D array indexed by ``material``
+``nu``               Poisson's ratio [1]; a number, or a 1-D array indexed by ``material``
+``scene``            the scene text or name (``""`` if none; a mapping is stored as JSON)
+``msslib_version``   :data:`msslib.__version__`
+``git_commit``       ``git rev-parse HEAD`` run in the package's directory, with suffix
+                     ``"+dirty"`` when tracked files have uncommitted changes (untracked files are
+                     ignored, as by ``git describe --dirty``); ``"unknown"`` when unavailable
+``created``          creation time, UTC, ISO 8601 (``YYYY-MM-DDTHH:MM:SS+00:00``)
+``python_version``   :func:`platform.python_version`
+``numpy_version``    :data:`numpy.__version__`
+``wall_time_s``      wall time of the run [s]; NaN when not given
+``solver_*``         solver statistics, flattened: ``{"newton": {"iterations": 3}}`` becomes
+                     ``solver_newton_iterations = 3``
+==================== ==========================================================================
+
+Attribute values are restricted to what netCDF stores: strings, numbers and 1-D numeric arrays.
+Booleans become the integers 0/1, ``None`` becomes the string ``"None"``, and anything else
+(lists of strings, nested lists, empty lists) becomes its JSON text. A length-1 array attribute reads
+back as a scalar (a netCDF property). Further global attributes may be added with ``extra_attrs``
+(they must not collide with the attributes above).
+"""
+
+from __future__ import annotations
+
+import errno
+import json
+import math
+import os
+import platform
+import secrets
+import subprocess
+from collections.abc import Mapping
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from . import __version__
+from .mesh import CELL_TYPES, Mesh
+
+__all__ = [
+    "SCHEMA_VERSION",
+    "git_commit",
+    "make_dataset",
+    "write_result",
+    "read_result",
+    "mesh_from_result",
+]
+
+SCHEMA_VERSION = "msslib-result-1.0"
+AXIS_NAMES = ("x", "y", "z")
+ENGINE = "netcdf4"
+#: Variables that must be finite for :func:`write_result` to accept a dataset.
+FINITE_VARIABLES = ("rest_position", "displacement", "displacement_history", "velocity_history")
+#: Global attributes set by :func:`make_dataset` (``solver_*`` apart).
+SCHEMA_ATTRS = (
+    "Conventions", "model", "E", "nu", "scene", "msslib_version", "git_commit", "created",
+    "python_version", "numpy_version", "wall_time_s",
+)
+
+
+# --------------------------------------------------------------------------------------------------
+# provenance and attribute sanitising
+
+
+def git_commit(directory: str | os.PathLike | None = None, *, timeout: float = 10.0) -> str:
+    """Commit of the git work tree holding ``directory`` (default: this package's directory).
+
+    Returns the full hash, with ``"+dirty"`` appended when tracked files differ from the commit, or
+    ``"unknown"`` when git is missing, the directory is not in a work tree, or git fails. Only
+    read-only git commands are run, and ``--no-optional-locks`` keeps ``git status`` from taking the
+    index lock (so concurrent git operations in the same tree are not disturbed).
+    """
+    cwd = Path(__file__).resolve().parent if directory is None else Path(directory)
+
+    def run(*args: str) -> str:
+        return subprocess.run(
+            ["git", "--no-optional-locks", *args], cwd=cwd, capture_output=True, text=True,
+            timeout=timeout, check=True,
+        ).stdout.strip()
+
+    try:
+        commit = run("rev-parse", "--verify", "HEAD")
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    if not commit:
+        return "unknown"
+    try:
+        dirty = bool(run("status", "--porcelain", "--untracked-files=no"))
+    except (OSError, subprocess.SubprocessError):
+        return commit
+    return commit + "+dirty" if dirty else commit
+
+
+def _attr_value(value):
+    """Convert ``value`` to something netCDF can store as an attribute (see the module docstring)."""
+    if value is None:
+        return "None"
+    if isinstance(value, (bool, np.bool_)):
+        return int(value)
+    if isinstance(value, (str, int, float, np.integer, np.floating)):
+        return value
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    if isinstance(value, (list, tuple, np.ndarray)):
+        arr = np.asarray(value) if not isinstance(value, np.ndarray) else value
+        if arr.ndim == 0:
+            return _attr_value(arr.item())
+        if arr.ndim == 1 and arr.size and arr.dtype.kind in "biuf":
+            return arr.astype(np.int8) if arr.dtype.kind == "b" else arr
+    try:
+        return json.dumps(value, default=_json_default, sort_keys=True)
+    except (TypeError, ValueError):
+        return str(value)
+
+
+def _json_default(obj):
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return str(obj)
+
+
+def _flatten(stats: Mapping, prefix: str) -> dict:
+    """Flatten a nested mapping into ``{prefix_key_subkey: netCDF attribute value}``."""
+    out = {}
+    for key, value in stats.items():
+        name = f"{prefix}_{key}"
+        if isinstance(value, Mapping):
+            out.update(_flatten(value, name))
+        else:
+            out[name] = _attr_value(value)
+    return out
+
+
+def _moduli_attr(value, name: str):
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim > 1 or arr.size == 0:
+        raise ValueError(f"{name} must be a number or a non-empty 1-D array, got shape {arr.shape}")
+    return float(arr) if arr.ndim == 0 else arr
+
+
+# --------------------------------------------------------------------------------------------------
+# building a dataset
+
+
+def _array(value, shape, name, dtype=float):
+    arr = np.asarray(value, dtype=dtype)
+    if arr.shape != tuple(shape):
+        raise ValueError(f"{name} must have shape {tuple(shape)}, got {arr.shape}")
+    return arr
+
+
+def _var(dims, data, units, long_name, **attrs):
+    return xr.Variable(dims, data, attrs={"units": units, "long_name": long_name, **attrs})
+
+
+def make_dataset(
+    mesh: Mesh,
+    displacement,
+    *,
+    model: str,
+    E,
+    nu,
+    scene=None,
+    springs=None,
+    spring_constant=None,
+    rest_length=None,
+    reaction=None,
+    fixed=None,
+    history: Mapping | None = None,
+    solver_stats: Mapping | None = None,
+    wall_time: float | None = None,
+    extra_vars: Mapping | None = None,
+    extra_attrs: Mapping | None = None,
+) -> xr.Dataset:
+    """Build a result dataset following the schema of this module's docstring.
+
+    Parameters
+    ----------
+    mesh : the undeformed mesh (``rest_position``, ``cells``, ``material``).
+    displacement : ``(n_nodes, dim)`` displacement of the final state [m].
+    model : model name (global attribute ``model``).
+    E, nu : Young's modulus [Pa] and Poisson's ratio, numbers or 1-D arrays indexed by
+        ``mesh.material``.
+    scene : scene text or name (a mapping is stored as JSON); ``None`` stores ``""``.
+    springs : ``(n_springs, 2)`` node indices; ``spring_constant`` [N/m] and ``rest_length`` [m]
+        are ``(n_springs,)`` and need ``springs``.
+    reaction : ``(n_nodes, dim)`` reaction forces [N].
+    fixed : ``(n_nodes, dim)`` bool mask of constrained components, or ``(n_nodes,)`` for nodes
+        constrained along every axis.
+    history : mapping with ``"time"`` [s] (``(n_t,)``) and/or ``"step"`` (``(n_t,)`` ints), and
+        ``"displacement"`` [m] and/or ``"velocity"`` [m/s] of shape ``(n_t, n_nodes, dim)``. The
+        states run along ``time`` if given, else along ``step``; with both, ``step`` is a variable
+        along ``time``.
+    solver_stats : mapping (possibly nested) stored as ``solver_*`` global attributes.
+    wall_time : wall time of the run [s] (``wall_time_s``; NaN if ``None``).
+    extra_vars : mapping name -> :class:`xarray.DataArray`/:class:`xarray.Variable` or
+        ``(dims, data, attrs)`` tuple; each needs ``units`` and ``long_name`` attributes.
+    extra_attrs : further global attributes (sanitised like ``solver_*``).
+    """
+    if not isinstance(mesh, Mesh):
+        raise TypeError(f"mesh must be a msslib.mesh.Mesh, got {type(mesh).__name__}")
+    if not isinstance(model, str) or not model:
+        raise ValueError("model must be a non-empty string")
+    n, dim = mesh.n_nodes, mesh.dim
+    axes = list(AXIS_NAMES[:dim])
+
+    E_attr, nu_attr = _moduli_attr(E, "E"), _moduli_attr(nu, "nu")
+    n_mat = int(mesh.material.max()) + 1 if mesh.n_cells else 0
+    for name, value in (("E", E_attr), ("nu", nu_attr)):
+        if isinstance(value, np.ndarray) and len(value) < n_mat:
+            raise ValueError(f"{name} has {len(value)} entries but mesh.material refers to {n_mat} materials")
+
+    variables = {
+        "rest_position": _var(("node", "axis"), mesh.points.copy(), "m", "node position of the undeformed mesh"),
+        "displacement": _var(("node", "axis"), _array(displacement, (n, dim), "displacement"), "m",
+                             "node displacement of the final state"),
+        "cells": _var(("cell", "cell_node"), mesh.cells.copy(), "1", "cell connectivity (0-based node indices)",
+                      cell_type=mesh.cell_type),
+        "material": _var(("cell",), mesh.material.copy(), "1", "material index of the cell"),
+    }
+
+    if springs is None:
+        if spring_constant is not None or rest_length is not None:
+            raise ValueError("spring_constant and rest_length need springs")
+    else:
+        springs = np.asarray(springs)
+        if springs.ndim != 2 or springs.shape[1] != 2:
+            raise ValueError(f"springs must have shape (n_springs, 2), got {springs.shape}")
+        if springs.dtype.kind not in "iu" and not (springs.size == 0 or np.array_equal(springs, np.round(springs))):
+            raise ValueError("springs must hold integer node indices")
+        springs = springs.astype(np.int64)
+        if springs.size and (springs.min() < 0 or springs.max() >= n):
+            raise ValueError("springs refer to nodes that do not exist")
+        m = len(springs)
+        variables["springs"] = _var(("spring", "spring_end"), springs, "1", "end nodes of the spring")
+        if spring_constant is not None:
+            variables["spring_constant"] = _var(("spring",), _array(spring_constant, (m,), "spring_constant"),
+                                                "N/m", "spring constant")
+        if rest_length is not None:
+            variables["rest_length"] = _var(("spring",), _array(rest_length, (m,), "rest_length"), "m",
+                                            "spring rest length")
+
+    if reaction is not None:
+        variables["reaction_force"] = _var(("node", "axis"), _array(reaction, (n, dim), "reaction"), "N",
+                                           "reaction force at the node")
+    if fixed is not None:
+        fixed = np.asarray(fixed, dtype=bool)
+        if fixed.shape == (n,):
+            fixed = np.repeat(fixed[:, None], dim, axis=1)
+        fixed = _array(fixed, (n, dim), "fixed", dtype=bool)
+        variables["fixed"] = _var(("node", "axis"), fixed, "1", "displacement component prescribed (Dirichlet)")
+
+    coords = {"axis": _var(("axis",), np.array(axes, dtype=object), "1", "spatial axis")}
+    if history is not None:
+        coords_h, vars_h = _history(history, n, dim)
+        coords.update(coords_h)
+        variables.update(vars_h)
+
+    for name, value in (extra_vars or {}).items():
+        if name in variables or name in coords:
+            raise ValueError(f"extra variable {name!r} collides with a schema variable")
+        if isinstance(value, tuple):
+            value = xr.Variable(*value)
+        elif isinstance(value, xr.DataArray):
+            value = value.variable
+        elif not isinstance(value, xr.Variable):
+            raise TypeError(f"extra variable {name!r} must be a DataArray, Variable or (dims, data, attrs) tuple")
+        missing = [a for a in ("units", "long_name") if a not in value.attrs]
+        if missing:
+            raise ValueError(f"extra variable {name!r} lacks the attribute(s) {missing}")
+        variables[name] = value
+
+    if isinstance(scene, Mapping):
+        scene = json.dumps(scene, default=_json_default, sort_keys=True)
+    attrs = {
+        "Conventions": SCHEMA_VERSION,
+        "model": model,
+        "E": E_attr,
+        "nu": nu_attr,
+        "scene": "" if scene is None else str(scene),
+        "msslib_version": __version__,
+        "git_commit": git_commit(),
+        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "python_version": platform.python_version(),
+        "numpy_version": np.__version__,
+        "wall_time_s": math.nan if wall_time is None else float(wall_time),
+    }
+    if solver_stats is not None:
+        attrs.update(_flatten(solver_stats, "solver"))
+    for key, value in (extra_attrs or {}).items():
+        if key in attrs:
+            raise ValueError(f"extra attribute {key!r} collides with a schema attribute")
+        attrs[key] = _attr_value(value)
+
+    for name, var in variables.items():
+        var.attrs = {k: _attr_value(v) for k, v in var.attrs.items()}
+    return xr.Dataset(variables, coords=coords, attrs=attrs)
+
+
+def _history(history: Mapping, n: int, dim: int):
+    unknown = set(history) - {"time", "step", "displacement", "velocity"}
+    if unknown:
+        raise ValueError(f"unknown history keys {sorted(unknown)}; expected time, step, displacement, velocity")
+    if "time" not in history and "step" not in history:
+        raise ValueError("history needs a 'time' or a 'step' array")
+    if "displacement" not in history and "velocity" not in history:
+        raise ValueError("history needs a 'displacement' or a 'velocity' array")
+    tdim = "time" if "time" in history else "step"
+    n_t = len(np.atleast_1d(history[tdim]))
+    coords, variables = {}, {}
+    if "time" in history:
+        coords["time"] = _var(("time",), _array(history["time"], (n_t,), "history['time']"), "s", "time")
+    if "step" in history:
+        step = np.asarray(history["step"])
+        if step.shape != (n_t,) or (step.size and not np.array_equal(step, np.round(step))):
+            raise ValueError(f"history['step'] must be {n_t} integers")
+        coords["step"] = _var((tdim,), step.astype(np.int64), "1", "step number")
+    if "displacement" in history:
+        variables["displacement_history"] = _var(
+            (tdim, "node", "axis"), _array(history["displacement"], (n_t, n, dim), "history['displacement']"),
+            "m", "node displacement of every stored state")
+    if "velocity" in history:
+        variables["velocity_history"] = _var(
+            (tdim, "node", "axis"), _array(history["velocity"], (n_t, n, dim), "history['velocity']"),
+            "m/s", "node velocity of every stored state")
+    return coords, variables
+
+
+# --------------------------------------------------------------------------------------------------
+# writing and reading
+
+
+def _encoding(ds: xr.Dataset) -> dict:
+    """No fill values (results are complete); zlib for numeric arrays."""
+    enc = {}
+    for name, var in ds.variables.items():
+        e = {"_FillValue": None}
+        if var.dtype.kind in "biuf" and var.ndim >= 1 and var.size:
+            e.update(zlib=True, complevel=4)
+        enc[name] = e
+    return enc
+
+
+def write_result(path: str | os.PathLike, ds: xr.Dataset) -> Path:
+    """Write ``ds`` to ``path`` (NetCDF-4, engine netcdf4) atomically and return the path.
+
+    The dataset is written to a hidden temporary file in the target directory, flushed to disk
+    (``fsync``) and renamed over ``path`` with :func:`os.replace`, so readers never see a partial
+    file. On any error the temporary file is removed and the error re-raised; ``path`` is left
+    untouched (an older file there survives).
+
+    Raises
+    ------
+    ValueError
+        if a variable of :data:`FINITE_VARIABLES` holds NaN or infinity (nothing is written).
+    OSError
+        (``FileNotFoundError``, ``NotADirectoryError``, ``PermissionError``, ...) naming ``path``
+        when the target directory does not exist or is not writable.
+    """
+    path = Path(path)
+    for name in FINITE_VARIABLES:
+        if name in ds.variables:
+            values = np.asarray(ds[name].values)
+            if values.dtype.kind in "fc" and not np.isfinite(values).all():
+                bad = int(np.count_nonzero(~np.isfinite(values)))
+                raise ValueError(f"refusing to write {path}: variable {name!r} has {bad} non-finite value(s)")
+
+    directory = path.parent
+    if not directory.is_dir():
+        code = errno.ENOTDIR if directory.exists() else errno.ENOENT
+        raise (NotADirectoryError if code == errno.ENOTDIR else FileNotFoundError)(
+            code, f"cannot write result, directory {str(directory)!r} does not exist", str(path))
+    tmp = directory / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # mode honours the umask
+    except OSError as exc:
+        raise type(exc)(exc.errno, f"cannot write result, no temporary file in {str(directory)!r}: {exc.strerror}",
+                        str(path)) from exc
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, mode="w", format="NETCDF4", engine=ENGINE, encoding=_encoding(ds))
+        fd = os.open(tmp, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    try:  # make the rename durable; not possible on every platform
+        dfd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return path
+    try:
+        os.fsync(dfd)
+    except OSError:
+        pass
+    finally:
+        os.close(dfd)
+    return path
+
+
+def read_result(path: str | os.PathLike) -> xr.Dataset:
+    """Read a result file fully into memory and close it.
+
+    ``fixed`` comes back as ``bool``; ``time`` stays plain seconds (no timedelta decoding).
+    """
+    return xr.load_dataset(path, engine=ENGINE, decode_timedelta=False)
+
+
+def mesh_from_result(ds: xr.Dataset, *, deformed: bool = False) -> Mesh:
+    """The :class:`~msslib.mesh.Mesh` of a result (its rest configuration; ``deformed=True`` adds
+    ``displacement`` to the node positions)."""
+    for name in ("rest_position", "cells", "material"):
+        if name not in ds.variables:
+            raise ValueError(f"dataset has no variable {name!r}; not a {SCHEMA_VERSION} result")
+    cell_type = ds["cells"].attrs.get("cell_type")
+    if cell_type not in CELL_TYPES:
+        raise ValueError(f"variable 'cells' has no valid cell_type attribute (got {cell_type!r})")
+    points = ds["rest_position"].transpose("node", "axis").values
+    if deformed:
+        points = points + ds["displacement"].transpose("node", "axis").values
+    return Mesh(
+        points=np.array(points, dtype=float),
+        cells=np.array(ds["cells"].transpose("cell", "cell_node").values, dtype=np.int64),
+        cell_type=str(cell_type),
+        material=np.array(ds["material"].values, dtype=np.int64),
+    )
