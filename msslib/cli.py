@@ -1,0 +1,172 @@
+"""Command line of msslib: ``python -m msslib COMMAND ...`` (also the ``msslib`` console script).
+
+Commands
+--------
+``run SCENE.yaml --out OUT.nc [--vtu OUT.vtu] [--quiet]``
+    Validate, build and solve a scene (:mod:`msslib.scene`) and write the result atomically as
+    NetCDF (:func:`msslib.io.write_result`); with ``--vtu`` (or ``output: {vtu: ...}`` in the scene)
+    also a VTU file for ParaView.  Output directories are checked before the run; on any failure no
+    output file is left behind.  A progress bar is drawn on stderr for runs longer than half a
+    second unless ``--quiet``.
+``validate SCENE.yaml``
+    Check the scene and build its mesh, boundary conditions, loads and model without solving.
+
+Exit codes: 0 success, 1 bad input or a failed solve (a one-line ``msslib: error: ...`` message on
+stderr, no traceback), 2 bad command-line usage (argparse).
+
+Adding a command: write ``_add_NAME(subparsers)`` that creates its subparser and sets
+``func=_cmd_NAME`` with :meth:`argparse.ArgumentParser.set_defaults`, where ``_cmd_NAME(args) ->
+int``, and append it to :data:`COMMANDS`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+__all__ = ["main", "build_parser", "COMMANDS"]
+
+
+class CommandError(Exception):
+    """A user-facing error reported as one line with exit code 1."""
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__
+
+
+def _check_writable(path: Path, what: str) -> None:
+    """Fail early (before a long run) when ``path`` cannot be written."""
+    if path.is_dir():
+        raise CommandError(f"{what} {str(path)!r} is a directory")
+    directory = path.parent
+    if not directory.exists():
+        raise CommandError(f"cannot write {what} {str(path)!r}: directory {str(directory)!r} does not exist")
+    if not directory.is_dir():
+        raise CommandError(f"cannot write {what} {str(path)!r}: {str(directory)!r} is not a directory")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise CommandError(f"cannot write {what} {str(path)!r}: directory {str(directory)!r} is not writable")
+
+
+def _vtu_path(scene, out: Path, cli_vtu: str | None) -> Path | None:
+    if cli_vtu:
+        return Path(cli_vtu)
+    vtu = scene.output.get("vtu", False)
+    if vtu is True:
+        return out.with_suffix(".vtu")
+    if isinstance(vtu, str):
+        return out.parent / vtu
+    return None
+
+
+def _write_vtu(path: Path, ds) -> None:
+    import numpy as np
+
+    from msslib.io import mesh_from_result
+    from msslib.mesh import write_vtu
+
+    mesh = mesh_from_result(ds)
+    point_data = {"displacement": ds["displacement"].transpose("node", "axis").values}
+    if "reaction_force" in ds:
+        point_data["reaction_force"] = ds["reaction_force"].transpose("node", "axis").values
+    if "fixed" in ds:
+        point_data["fixed"] = np.asarray(ds["fixed"].transpose("node", "axis").values, dtype=np.int8)
+    write_vtu(path, mesh, point_data=point_data)
+
+
+# --------------------------------------------------------------------------------------------
+# commands
+# --------------------------------------------------------------------------------------------
+
+
+def _add_run(subparsers) -> None:
+    p = subparsers.add_parser("run", help="run a scene and write its result (NetCDF, optionally VTU)",
+                              description="Run a scene and write its result atomically.")
+    p.add_argument("scene", help="scene file (YAML)")
+    p.add_argument("--out", "-o", required=True, help="result file (NetCDF, .nc)")
+    p.add_argument("--vtu", help="also write the final state as a VTU file (ParaView)")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary line")
+    p.set_defaults(func=_cmd_run)
+
+
+def _cmd_run(args) -> int:
+    from msslib.io import write_result
+    from msslib.scene import load_scene, run_scene
+
+    scene = load_scene(args.scene)
+    out = Path(args.out)
+    vtu = _vtu_path(scene, out, args.vtu)
+    _check_writable(out, "output file")
+    if vtu is not None:
+        _check_writable(vtu, "VTU file")
+        if vtu.resolve() == out.resolve():
+            raise CommandError(f"the VTU file and the output file are the same: {str(out)!r}")
+    ds = run_scene(scene, progress=not args.quiet)
+    existed = out.exists()
+    write_result(out, ds)
+    if vtu is not None:
+        try:
+            _write_vtu(vtu, ds)
+        except BaseException:
+            if not existed:  # no half-finished set of outputs
+                try:
+                    out.unlink()
+                except OSError:
+                    pass
+            raise
+    if not args.quiet:
+        extra = f" and {vtu}" if vtu is not None else ""
+        umax = float(abs(ds["displacement"]).max())
+        print(f"{scene.name}: {ds.attrs['model']}, {ds.sizes['node']} nodes, max |u_i| {umax:.4g} m, "
+              f"{ds.attrs['wall_time_s']:.2f} s -> {out}{extra}", file=sys.stderr)
+    return 0
+
+
+def _add_validate(subparsers) -> None:
+    p = subparsers.add_parser("validate", help="check a scene without solving it",
+                              description="Check a scene: keys, values, mesh, selections, model.")
+    p.add_argument("scene", help="scene file (YAML)")
+    p.set_defaults(func=_cmd_validate)
+
+
+def _cmd_validate(args) -> int:
+    from msslib.scene import load_scene, prepare
+
+    scene = load_scene(args.scene)
+    setup = prepare(scene)
+    mesh = setup.mesh
+    kind = scene.solver["type"]
+    print(f"{args.scene}: ok ({scene.name}: {scene.model}, {kind}; {mesh.n_nodes} nodes, {mesh.n_cells} "
+          f"{mesh.cell_type} cells, {int(setup.fixed.sum())} fixed dofs)")
+    return 0
+
+
+#: subparser builders, in the order of the help text
+COMMANDS = [_add_run, _add_validate]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="msslib", description="Mass-spring systems and their FEM references.")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for add in COMMANDS:
+        add(subparsers)
+    return parser
+
+
+def main(argv=None) -> int:
+    """Entry point; returns the exit code (0 ok, 1 error, 2 usage)."""
+    from msslib.solvers import ConvergenceError, DivergenceError
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (CommandError, ValueError, OSError, ConvergenceError, DivergenceError) as exc:
+        print(f"msslib: error: {_one_line(exc)}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("msslib: interrupted", file=sys.stderr)
+        return 130

@@ -1,0 +1,1 @@
+"""Code generated from ``derivations/`` by ``python -m derivations.codegen``; do not edit."""

@@ -1,0 +1,39 @@
+# Generated from derivations/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: 3597d5a059c93696bc9581e9fae8c7f93e3fcc41302685a9e960a2728531da43
+# body-sha256: a35ff5265d287f0040075799752d846c04cfcc02c51cc80aa3045cf95055a64d
+"""Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.).
+
+Generated from derivations/cube_baudet.py by `python -m derivations.codegen`; do not edit.
+"""
+
+from numpy import sqrt  # noqa: F401
+
+
+OUTPUTS = {'baudet_cube': ('k_edge', 'k_diagonal', 'correction_factor'), 'baudet_cube_published': ('k_edge', 'k_diagonal', 'correction_factor')}
+
+
+def baudet_cube(E, nu, a):
+    """Per-element constants of a cube of edge a: edge springs (sum over the cubes sharing the edge), inner diagonals, and the factor c of the correction force F_perp = c F_i applied, as a total per face, on each face orthogonal to the elongation force F_i (Baudet eqs. 7-8).
+
+    Returns (k_edge, k_diagonal, correction_factor).
+    """
+    _c0 = E*a/(nu + 1)
+    return (
+        (1/8)*_c0*(4*nu + 1),
+        (3/8)*_c0,
+        1/2 - 2*nu,
+    )
+
+
+def baudet_cube_published(E, nu, a):
+    """Baudet et al.'s eqs. 7-8 as printed (correction factor -(4 nu - 1)/16).
+
+    Returns (k_edge, k_diagonal, correction_factor).
+    """
+    _c0 = 4*nu
+    _c1 = E*a/(nu + 1)
+    return (
+        (1/8)*_c1*(_c0 + 1),
+        (3/8)*_c1,
+        1/16 - 1/16*_c0,
+    )

@@ -1,0 +1,42 @@
+# Generated from derivations/cube_golec.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: 0b41ded46007ecbef2b028a8e9b1e1d57dfba8f870247caa80bbf9ca165c579a
+# body-sha256: 27a48c1508e2c336a6de6ee220c683003e0ac46e9e9f1ac653a3e8238d975b82
+"""Cube with edge, face and inner springs and volume correction (Golec et al.).
+
+Generated from derivations/cube_golec.py by `python -m derivations.codegen`; do not edit.
+"""
+
+from numpy import sqrt  # noqa: F401
+
+
+OUTPUTS = {'golec_cube': ('k_edge', 'k_face', 'k_inner', 'kappa'), 'golec_cube_published': ('k_edge', 'k_face', 'k_inner', 'kappa')}
+
+
+def golec_cube(E, nu, a, A):
+    """Per-element constants of a cube of edge a (sum the edge springs over the up to 4 cubes sharing an edge, face diagonals over the up to 2 cubes sharing a face) and kappa [Pa] of the volume energy kappa/(2 V0) (V - V0)^2. The lattice reproduces the isotropic (lambda, mu) exactly.
+
+    Returns (k_edge, k_face, k_inner, kappa).
+    """
+    _c0 = 2*A
+    _c1 = E*a/(_c0*nu + _c0 + 3*nu + 3)
+    _c2 = (3/4)*_c1
+    return (
+        (1/8)*_c1*(4*A + 3),
+        _c2,
+        A*_c2,
+        -1/2*E*(4*nu - 1)/(2*nu**2 + nu - 1),
+    )
+
+
+def golec_cube_published(E, nu, a, A):
+    """Golec et al.'s constants as printed (k_edge and k_face are the assembled values of an interior spring).
+
+    Returns (k_edge, k_face, k_inner, kappa).
+    """
+    _c0 = (6/5)*E*a/(4*A + 3)
+    return (
+        _c0*((8/3)*A + 1),
+        _c0,
+        A*_c0,
+        -1/2*E*(4*nu - 1)/((nu + 1)*(2*nu - 1)),
+    )

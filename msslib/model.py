@@ -1,0 +1,479 @@
+"""Mass-spring models: a mesh, force terms and boundary conditions behind the solver protocol.
+
+:class:`Model` sums the terms of :mod:`msslib.terms` and implements the problem protocol of
+:mod:`msslib.solvers` (``n_dof``, ``force``, ``stiffness``, ``energy``, ``free``, ``mass``,
+``symmetric``, ``apply_prescribed``, ``damping``, ``dim``), plus ``x0`` and :meth:`Model.reaction`.
+
+The builders turn a mesh and its materials into spring terms whose constants come from
+:mod:`msslib.parameters` (per element, then summed over the elements sharing a node pair):
+
+* :func:`assemble_springs` — generic: per (pair, cell) constant, summed per pair;
+* :func:`lloyd_triangle_springs`, :func:`van_gelder_springs` (triangles, plane stress, thickness t);
+* :func:`lloyd_square_springs` (quads; prestrained edges and diagonals);
+* :func:`lloyd_tet_springs` (tetrahedra, optionally with Lloyd's volume term);
+* :func:`baudet_cube_springs`, :func:`baudet_correction` (cubes);
+* :func:`golec_cube_springs` (cubes: springs plus the volume correction).
+
+``materials`` is a list of ``(E, nu)`` pairs (Pa, -) indexed by ``mesh.material``.  Every builder
+first runs :func:`msslib.mesh.check_cells` (ValueError on inverted or degenerate cells) and
+returns a list of terms, to be combined with loads into a :class:`Model`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from msslib import mesh as _mesh
+from msslib.generated import kernels as _K
+from msslib.terms import (
+    BaudetCorrection,
+    ExternalForce,
+    HexVolume,
+    Springs,
+    Term,
+    TetVolume,
+    sum_external_forces,
+)
+
+__all__ = [
+    "Model",
+    "material_arrays",
+    "assemble_springs",
+    "lloyd_triangle_springs",
+    "van_gelder_springs",
+    "lloyd_square_springs",
+    "lloyd_tet_springs",
+    "baudet_cube_springs",
+    "baudet_correction",
+    "golec_cube_springs",
+]
+
+
+# --------------------------------------------------------------------------------------------
+# the model
+# --------------------------------------------------------------------------------------------
+
+
+class Model:
+    """A mass-spring system on ``mesh`` made of ``terms`` (see :mod:`msslib.terms`).
+
+    Parameters
+    ----------
+    mesh : :class:`msslib.mesh.Mesh`; its points are the rest positions ``x0``.
+    terms : iterable of terms (internal ones, external loads, corrections).
+    fixed : bool ``(n_nodes, dim)`` (or ``(n_dof,)``) mask of the constrained dofs; default none.
+    prescribed : ``(n_nodes, dim)`` displacements (m) imposed on the fixed dofs at load 1; at
+        load factor ``load`` the fixed dofs sit at ``x0 + load * prescribed``.  Default zero.
+    masses : ``(n_nodes,)`` node masses (kg); default the lumped masses of unit density (and unit
+        thickness in 2D), :func:`msslib.mesh.lumped_masses`.
+    damping : default damping of :func:`msslib.solvers.integrate` (scalar alpha or (alpha, beta)).
+
+    Force convention: ``force(x, load) = -sum_t s_t grad_t(x)`` with ``s_t = load`` for the terms
+    that scale with the load (external loads, Baudet's correction) and 1 otherwise;
+    ``stiffness = -d force / dx = sum_t s_t H_t`` assembled in a CSR matrix whose sparsity
+    pattern (union of the terms' patterns, all dofs) is built once: each call only refills its data.
+    """
+
+    def __init__(self, mesh, terms, *, fixed=None, prescribed=None, masses=None, damping=0.0):
+        self.mesh = mesh
+        self.dim = mesh.dim
+        self.n_nodes = mesh.n_nodes
+        self.n_dof = mesh.n_nodes * mesh.dim
+        self.x0 = mesh.points.ravel().copy()
+        self.terms = [t for t in terms]
+        for t in self.terms:
+            if not isinstance(t, Term):
+                raise TypeError(f"not a term: {t!r}")
+            if t.max_node() >= self.n_nodes:
+                raise ValueError(f"{type(t).__name__} refers to node {t.max_node()}, the mesh has {self.n_nodes}")
+            if t.dim != self.dim and (isinstance(t, ExternalForce) or t.max_node() >= 0):
+                raise ValueError(f"{type(t).__name__} is {t.dim}D, the mesh {self.dim}D")
+        self.conservative = all(t.conservative for t in self.terms)
+        self.symmetric = all(t.symmetric for t in self.terms)
+        self.damping = damping
+
+        if fixed is None:
+            fixed = np.zeros(self.n_dof, dtype=bool)
+        fixed = np.asarray(fixed, dtype=bool)
+        if fixed.size != self.n_dof:
+            raise ValueError(f"fixed must have shape ({self.n_nodes}, {self.dim}), got {fixed.shape}")
+        self.fixed = fixed.ravel().copy()
+        self.free = ~self.fixed
+        if prescribed is None:
+            prescribed = np.zeros(self.n_dof)
+        prescribed = np.asarray(prescribed, dtype=float)
+        if prescribed.size != self.n_dof:
+            raise ValueError(f"prescribed must have shape ({self.n_nodes}, {self.dim}), got {prescribed.shape}")
+        prescribed = prescribed.ravel().copy()
+        if np.any(prescribed[self.free] != 0):
+            raise ValueError("prescribed displacements given on free dofs; mark them in `fixed`")
+        self.prescribed = prescribed
+
+        if masses is None:
+            masses = _mesh.lumped_masses(mesh, 1.0)
+        masses = np.asarray(masses, dtype=float)
+        if masses.shape != (self.n_nodes,):
+            raise ValueError(f"masses must have shape ({self.n_nodes},), got {masses.shape}")
+        self.node_masses = masses
+        self.mass = np.repeat(masses, self.dim)
+
+        self._build_pattern()
+
+    # ---- sparsity pattern ------------------------------------------------------------------
+
+    def _build_pattern(self):
+        parts = [(t, *t.hessian_pattern()) for t in self.terms]
+        self._hessian_terms = [(t, r, c) for t, r, c in parts if len(r)]
+        n = self.n_dof
+        if self._hessian_terms:
+            rows = np.concatenate([r for _, r, _ in self._hessian_terms])
+            cols = np.concatenate([c for _, _, c in self._hessian_terms])
+        else:
+            rows = cols = np.zeros(0, dtype=np.int64)
+        # the diagonal is always present, so that constrained rows can be edited without changing
+        # the pattern
+        diag = np.arange(n, dtype=np.int64)
+        keys = np.concatenate([rows * n + cols, diag * n + diag])
+        unique, inverse = np.unique(keys, return_inverse=True)
+        self._indices = (unique % n).astype(np.int32 if n < 2**31 else np.int64)
+        urows = unique // n
+        self._indptr = np.zeros(n + 1, dtype=self._indices.dtype)
+        np.cumsum(np.bincount(urows, minlength=n), out=self._indptr[1:])
+        self._nnz = len(unique)
+        self._scatter = []
+        start = 0
+        for t, r, _ in self._hessian_terms:
+            self._scatter.append(inverse[start:start + len(r)])
+            start += len(r)
+
+    @property
+    def nnz(self) -> int:
+        """Number of stored entries of the stiffness pattern."""
+        return self._nnz
+
+    # ---- protocol ------------------------------------------------------------------------
+
+    def _scale(self, term, load):
+        return load if term.scales_with_load else 1.0
+
+    def force(self, x, load: float = 1.0) -> np.ndarray:
+        """Total nodal force ``(n_dof,)``: internal plus ``load`` times the external forces."""
+        x = np.asarray(x, dtype=float).ravel()
+        g = np.zeros(self.n_dof)
+        for t in self.terms:
+            s = self._scale(t, load)
+            if s != 0.0:
+                g += s * t.gradient(x)
+        return -g
+
+    def internal_force(self, x) -> np.ndarray:
+        """Force of the terms that do not scale with the load (springs, volume terms)."""
+        return self.force(x, 0.0)
+
+    def external_force(self, load: float = 1.0) -> np.ndarray:
+        """Load-proportional force at ``x0`` (dead loads plus load-dependent corrections)."""
+        return self.force(self.x0, load) - self.force(self.x0, 0.0)
+
+    def stiffness(self, x, load: float = 1.0) -> sp.csr_matrix:
+        """Tangent stiffness ``-d force / dx`` (CSR, fixed pattern incl. the full diagonal)."""
+        x = np.asarray(x, dtype=float).ravel()
+        data = np.zeros(self._nnz)
+        for (t, _, _), scatter in zip(self._hessian_terms, self._scatter):
+            s = self._scale(t, load)
+            if s != 0.0:
+                data += np.bincount(scatter, weights=t.hessian_values(x), minlength=self._nnz) * s
+        K = sp.csr_matrix((data, self._indices.copy(), self._indptr.copy()), shape=(self.n_dof, self.n_dof))
+        K.has_sorted_indices = True
+        return K
+
+    def energy(self, x, load: float = 1.0):
+        """Total potential energy (J), or None when a term is non-conservative."""
+        if not self.conservative:
+            return None
+        x = np.asarray(x, dtype=float).ravel()
+        return float(sum(self._scale(t, load) * t.energy(x) for t in self.terms))
+
+    def apply_prescribed(self, x, load: float = 1.0) -> np.ndarray:
+        """Copy of ``x`` with the fixed dofs at ``x0 + load * prescribed``."""
+        x = np.array(x, dtype=float).ravel()
+        x[self.fixed] = self.x0[self.fixed] + load * self.prescribed[self.fixed]
+        return x
+
+    def reaction(self, x, load: float = 1.0) -> np.ndarray:
+        """Support reactions ``(n_nodes, dim)`` (N), zero on free dofs.
+
+        On a fixed dof the reaction is minus the total force the terms apply there (internal force
+        plus any load on that node), i.e. what the support must supply.  At equilibrium
+        (free residual zero) the reactions plus the applied loads sum to zero.
+        """
+        r = np.where(self.fixed, -self.force(x, load), 0.0)
+        return r.reshape(self.n_nodes, self.dim)
+
+
+# --------------------------------------------------------------------------------------------
+# helpers for the builders
+# --------------------------------------------------------------------------------------------
+
+
+def _parameters():
+    from msslib import parameters  # written by the lead; imported lazily
+
+    return parameters
+
+
+def material_arrays(mesh, materials) -> tuple[np.ndarray, np.ndarray]:
+    """``(E, nu)`` per cell from ``materials`` (list of ``(E, nu)``) and ``mesh.material``."""
+    materials = [tuple(m) for m in materials]
+    if not materials:
+        raise ValueError("materials is empty")
+    if any(len(m) != 2 for m in materials):
+        raise ValueError("materials must be a list of (E, nu) pairs")
+    if mesh.n_cells and (mesh.material.min() < 0 or mesh.material.max() >= len(materials)):
+        raise ValueError(f"mesh.material refers to materials up to {mesh.material.max()}, only {len(materials)} given")
+    table = np.asarray(materials, dtype=float)
+    return table[mesh.material, 0], table[mesh.material, 1]
+
+
+def _field(result, name):
+    """Field ``name`` of a parameters result (a dataclass), or the result itself if it is a number."""
+    if hasattr(result, name):
+        return getattr(result, name)
+    if np.ndim(result) == 0 and not hasattr(result, "__dataclass_fields__"):
+        return result
+    raise AttributeError(f"{type(result).__name__} has no field {name!r}")
+
+
+def _per_cell(fn, fields, *args):
+    """Call a parameters function on per-cell arrays; returns one float array per field.
+
+    Tries one vectorised call; if the function only takes scalars, calls it cell by cell
+    (genuine errors, e.g. an invalid nu, are then raised by the scalar call)."""
+    arrays = [np.asarray(a, dtype=float) for a in args]
+    m = max((a.size for a in arrays if a.ndim), default=1)
+    arrays = [np.broadcast_to(a, (m,)) for a in arrays]
+    try:
+        res = fn(*arrays)
+        out = [np.broadcast_to(np.asarray(_field(res, f), dtype=float), (m,)).copy() for f in fields]
+        return out
+    except (TypeError, ValueError, AttributeError):
+        pass
+    out = [np.empty(m) for _ in fields]
+    cache = {}
+    for i in range(m):
+        key = tuple(float(a[i]) for a in arrays)
+        if key not in cache:
+            res = fn(*key)
+            cache[key] = [float(_field(res, f)) for f in fields]
+        for o, v in zip(out, cache[key]):
+            o[i] = v
+    return out
+
+
+def _pairs_of(mesh, pair_kind):
+    if isinstance(pair_kind, _mesh.NodePairs):
+        return pair_kind
+    table = {
+        "edges": _mesh.unique_edges,
+        "face_diagonals": _mesh.face_diagonals,
+        "inner_diagonals": _mesh.inner_diagonals,
+    }
+    if pair_kind not in table:
+        raise ValueError(f"pair_kind must be one of {sorted(table)} or a NodePairs, got {pair_kind!r}")
+    return table[pair_kind](mesh)
+
+
+def _combine(pairs: _mesh.NodePairs, k_inc, rest_inc):
+    """Sum per-incidence constants per pair; the rest length is the k-weighted mean (exact: the sum
+    of springs on one pair equals one spring of that constant and rest length, up to a constant)."""
+    n_pairs = len(pairs.pairs)
+    owner = np.repeat(np.arange(n_pairs), pairs.counts)
+    k = np.bincount(owner, weights=k_inc, minlength=n_pairs)
+    if rest_inc is None:
+        return k, None
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rest = np.bincount(owner, weights=k_inc * rest_inc, minlength=n_pairs) / k
+    return k, rest
+
+
+def _springs_from(mesh, pairs, k, rest):
+    length = np.linalg.norm(mesh.points[pairs.pairs[:, 1]] - mesh.points[pairs.pairs[:, 0]], axis=1)
+    return Springs(pairs.pairs, k, length if rest is None else rest, mesh.dim)
+
+
+def assemble_springs(mesh, pair_kind, k_per_cell_fn) -> Springs:
+    """Springs on the node pairs of ``mesh`` with constants summed over the cells sharing a pair.
+
+    ``pair_kind``: ``"edges"``, ``"face_diagonals"``, ``"inner_diagonals"`` or a
+    :class:`msslib.mesh.NodePairs`.  ``k_per_cell_fn(cell_ids, node_pairs)`` receives, for every
+    (pair, cell) incidence, the cell id (m,) and the node pair (m, 2), and returns the constant
+    contributed by that cell (m,), or a tuple ``(k, rest_length)``.  The spring of a pair gets
+    ``k = sum`` of its contributions and the rest length: the distance of its nodes, or with
+    explicit rest lengths their k-weighted mean.  Raises ValueError (from :class:`Springs`) if a
+    summed constant is not positive.
+    """
+    pairs = _pairs_of(mesh, pair_kind)
+    node_pairs = np.repeat(pairs.pairs, pairs.counts, axis=0)
+    res = k_per_cell_fn(pairs.cells, node_pairs)
+    if isinstance(res, tuple):
+        k_inc, rest_inc = (np.broadcast_to(np.asarray(v, dtype=float), (len(node_pairs),)) for v in res)
+    else:
+        k_inc, rest_inc = np.broadcast_to(np.asarray(res, dtype=float), (len(node_pairs),)), None
+    k, rest = _combine(pairs, k_inc, rest_inc)
+    return _springs_from(mesh, pairs, k, rest)
+
+
+def _merge_springs(springs: list[Springs]) -> Springs:
+    """One Springs term from several on disjoint pair sets (e.g. edges and diagonals)."""
+    return Springs(np.concatenate([s.pairs for s in springs]), np.concatenate([s.k for s in springs]),
+                   np.concatenate([s.rest_length for s in springs]), springs[0].dim)
+
+
+def _require(mesh, cell_type):
+    if mesh.cell_type != cell_type:
+        raise ValueError(f"this model needs {cell_type} cells, got {mesh.cell_type}")
+    return _mesh.check_cells(mesh)
+
+
+def _pair_lengths(mesh, node_pairs):
+    return np.linalg.norm(mesh.points[node_pairs[:, 1]] - mesh.points[node_pairs[:, 0]], axis=1)
+
+
+def _cube_edges(mesh, rtol=1e-6):
+    """Edge length ``a`` per hexahedron; ValueError unless every cell is a cube (within rtol)."""
+    x = mesh.points[mesh.cells]
+    edges = _mesh._LOCAL_EDGES["hexahedron"]
+    lengths = np.linalg.norm(x[:, edges[:, 1]] - x[:, edges[:, 0]], axis=2)  # (m, 12)
+    a = lengths.mean(axis=1)
+    diag = np.linalg.norm(x[:, [6, 7, 4, 5]] - x[:, [0, 1, 2, 3]], axis=2)
+    bad = np.flatnonzero((np.abs(lengths - a[:, None]).max(axis=1) > rtol * a)
+                         | (np.abs(diag - np.sqrt(3.0) * a[:, None]).max(axis=1) > rtol * a))
+    if len(bad):
+        shown = ", ".join(f"cell {i} (edges {lengths[i].min():.4g}..{lengths[i].max():.4g} m)" for i in bad[:5])
+        raise ValueError(f"{len(bad)} hexahedra are not cubes (rtol {rtol}): {shown}")
+    return a
+
+
+# --------------------------------------------------------------------------------------------
+# builders
+# --------------------------------------------------------------------------------------------
+
+
+def lloyd_triangle_springs(mesh, materials, t: float) -> list[Term]:
+    """Lloyd et al.'s springs on the edges of a triangle mesh (plane stress, thickness ``t`` m):
+    per triangle ``parameters.lloyd_triangle(E, t).k`` on each of its edges, summed over the
+    triangles sharing an edge; rest lengths are the mesh distances."""
+    _require(mesh, "triangle")
+    E, _ = material_arrays(mesh, materials)
+    (k,) = _per_cell(_parameters().lloyd_triangle, ("k",), E, t)
+    return [assemble_springs(mesh, "edges", lambda cells, _p: k[cells])]
+
+
+def van_gelder_springs(mesh, materials, t: float) -> list[Term]:
+    """Van Gelder's springs: per triangle ``parameters.van_gelder_triangle(E, t, A_e, l).k`` on each
+    edge of length ``l`` (``A_e`` the triangle's area), summed over the adjacent triangles."""
+    area = _require(mesh, "triangle")
+    E, _ = material_arrays(mesh, materials)
+    fn = _parameters().van_gelder_triangle
+
+    def k_fn(cells, node_pairs):
+        (k,) = _per_cell(fn, ("k",), E[cells], t, area[cells], _pair_lengths(mesh, node_pairs))
+        return k
+
+    return [assemble_springs(mesh, "edges", k_fn)]
+
+
+def lloyd_square_springs(mesh, materials, t: float) -> list[Term]:
+    """Lloyd et al.'s springs on a mesh of squares (quads): per element ``k_edge`` on its four
+    edges and ``k_diagonal`` on both diagonals (``parameters.lloyd_square(E, t)``), summed over
+    the elements sharing them; rest lengths are ``rest_factor_edge`` and ``rest_factor_diagonal``
+    times the mesh distances (prestrained springs)."""
+    _require(mesh, "quad")
+    E, _ = material_arrays(mesh, materials)
+    k_e, k_d, f_e, f_d = _per_cell(_parameters().lloyd_square,
+                                   ("k_edge", "k_diagonal", "rest_factor_edge", "rest_factor_diagonal"), E, t)
+    edges = assemble_springs(mesh, "edges", lambda c, p: (k_e[c], f_e[c] * _pair_lengths(mesh, p)))
+    diags = assemble_springs(mesh, "face_diagonals", lambda c, p: (k_d[c], f_d[c] * _pair_lengths(mesh, p)))
+    return [_merge_springs([edges, diags])]
+
+
+def _tet_rest_volumes(mesh):
+    p = mesh.points[mesh.cells]  # (m, 4, 3)
+    return np.asarray(_K.tet_signed_volume(*[p[:, a, d] for a in range(4) for d in range(3)]), dtype=float)
+
+
+def lloyd_tet_springs(mesh, materials, volume: bool = False) -> list[Term]:
+    """Lloyd et al.'s springs on the edges of a tetrahedral mesh.
+
+    Each tetrahedron of volume ``V`` is treated as a regular one of the same volume, edge
+    ``l_hat = (6 sqrt(2) V)^(1/3)``; its constant ``parameters.lloyd_tetrahedron(E, l_hat).k`` is
+    added to each of its edges.  With ``volume=True`` the constants come from
+    ``parameters.lloyd_tetrahedron_volume(E, l_hat, nu)`` (``k``, ``k_volume``) and a
+    :class:`TetVolume` term with ``k_v = k_volume`` and ``V0 = V`` is added.
+    """
+    V = _require(mesh, "tetra")
+    E, nu = material_arrays(mesh, materials)
+    l_hat = np.cbrt(6.0 * np.sqrt(2.0) * V)
+    P = _parameters()
+    if volume:
+        k, k_vol = _per_cell(P.lloyd_tetrahedron_volume, ("k", "k_volume"), E, l_hat, nu)
+    else:
+        (k,) = _per_cell(P.lloyd_tetrahedron, ("k",), E, l_hat)
+    terms: list[Term] = [assemble_springs(mesh, "edges", lambda c, _p: k[c])]
+    if volume:
+        terms.append(TetVolume(mesh.cells, k_vol, _tet_rest_volumes(mesh)))
+    return terms
+
+
+def baudet_cube_springs(mesh, materials) -> list[Term]:
+    """Baudet et al.'s springs on a mesh of cubes: per cube ``k_edge`` on its 12 edges (summed over
+    the cubes sharing an edge) and ``k_diagonal`` on its 4 inner diagonals
+    (``parameters.baudet_cube(E, nu, a)``, ``a`` the cube's edge).  Add :func:`baudet_correction`
+    for the Poisson effect under load."""
+    _require(mesh, "hexahedron")
+    a = _cube_edges(mesh)
+    E, nu = material_arrays(mesh, materials)
+    k_e, k_d = _per_cell(_parameters().baudet_cube, ("k_edge", "k_diagonal"), E, nu, a)
+    edges = assemble_springs(mesh, "edges", lambda c, _p: k_e[c])
+    inner = assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_d[c])
+    return [_merge_springs([edges, inner])]
+
+
+def baudet_correction(mesh, materials, loads) -> BaudetCorrection:
+    """:class:`msslib.terms.BaudetCorrection` for a mesh of cubes with the per-cube factor
+    ``parameters.baudet_cube(E, nu, a).correction_factor``; ``loads`` (n, 3) nodal surface forces
+    at unit load, or a list of terms whose external forces are summed (leave gravity out)."""
+    _require(mesh, "hexahedron")
+    a = _cube_edges(mesh)
+    E, nu = material_arrays(mesh, materials)
+    (c,) = _per_cell(_parameters().baudet_cube, ("correction_factor",), E, nu, a)
+    if not isinstance(loads, np.ndarray):
+        try:
+            loads = np.asarray(loads, dtype=float)
+        except (TypeError, ValueError):
+            loads = sum_external_forces(loads, mesh.n_nodes, 3)
+    return BaudetCorrection(mesh, loads, c)
+
+
+def _hex_rest_volumes(mesh):
+    p = mesh.points[mesh.cells]  # (m, 8, 3)
+    return np.asarray(_K.hex_averaged_volume(*[p[:, a, d] for a in range(8) for d in range(3)]), dtype=float)
+
+
+def golec_cube_springs(mesh, materials, A) -> list[Term]:
+    """Golec et al.'s cube model: per cube ``parameters.golec_cube(E, nu, a, A)`` gives ``k_edge``
+    (12 edges), ``k_face`` (12 face diagonals) and ``k_inner`` (4 inner diagonals), each summed over
+    the cubes sharing the pair, and ``kappa`` for a :class:`HexVolume` term per cube with ``V0``
+    the averaged-edge volume at rest.  ``A`` (a scalar or one value per cell) is passed through to
+    ``golec_cube``."""
+    _require(mesh, "hexahedron")
+    a = _cube_edges(mesh)
+    E, nu = material_arrays(mesh, materials)
+    k_e, k_f, k_i, kappa = _per_cell(_parameters().golec_cube, ("k_edge", "k_face", "k_inner", "kappa"),
+                                     E, nu, a, A)
+    springs = _merge_springs([
+        assemble_springs(mesh, "edges", lambda c, _p: k_e[c]),
+        assemble_springs(mesh, "face_diagonals", lambda c, _p: k_f[c]),
+        assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_i[c]),
+    ])
+    return [springs, HexVolume(mesh.cells, kappa, _hex_rest_volumes(mesh))]

@@ -1,0 +1,1199 @@
+"""Declarative scenes: a YAML file that describes one simulation, from the mesh to the output.
+
+:func:`load_scene` reads and validates a scene (a YAML file or an equivalent ``dict``) into a
+:class:`Scene`; :func:`prepare` builds its mesh, boundary conditions, loads and model;
+:func:`run_scene` solves it and returns an :class:`xarray.Dataset` in the schema of
+:mod:`msslib.io`.  The command line (``python -m msslib run SCENE.yaml --out OUT.nc``) wraps them.
+
+Syntax reference
+================
+
+Units are SI throughout: metres, pascals, newtons, kilograms, seconds.  Numbers may be written
+``1.0e6`` or ``1e6`` (plain YAML reads the latter as a string; scenes accept both).  Every mapping
+is checked for unknown keys: a typo is an error naming its full path, e.g.
+``scene.loads[1].tractoin: unknown key; expected one of select, traction, type``.
+
+.. code-block:: yaml
+
+    name: golec_compression            # optional; default: the file name without suffix
+    description: Golec cube, 10 % compression          # optional, free text
+    geometry:                          # exactly one of `generator` or `file`
+      generator: hex_grid              # a generator of msslib.mesh
+      args: {lx: 0.1, ly: 0.1, lz: 0.1, nx: 4, ny: 4, nz: 4}
+      # file: meshes/part.vtu          # or any file meshio reads, relative to the scene file
+    materials:                         # material i applies to the cells with material index i
+      - {E: 1.0e6, nu: 0.3, density: 1000.0}
+    regions:                           # optional; later entries win
+      - {box: [[0.05, null, null], [null, null, null]], material: 1}
+    thickness: 0.01                    # 2D meshes only (default 1.0)
+    model: golec_cube                  # or a mapping, see "model" below
+    boundary:
+      - {select: {plane: [z, 0.0]}, fix: [z]}
+      - {select: {plane: [z, 0.1]}, fix: [z], displacement: [null, null, -0.01]}
+    loads:
+      - {type: gravity, g: [0.0, 0.0, -9.81]}
+    solver: {type: static, load_steps: 5, tol: 1.0e-8}
+    output: {vtu: true}
+
+``geometry``
+    ``generator`` names one of :data:`GENERATORS` (``quad_grid``, ``triangle_grid_equilateral``,
+    ``hexagon_equilateral``, ``triangle_grid_right``, ``hex_grid``, ``tet_grid``,
+    ``l_block_hex``, ``polygon_mesh``, ``cylinder_mesh``, ``cylinder_with_hole_mesh``,
+    ``cone_mesh``, ``l_block_tet``) and ``args`` its keyword arguments (see :mod:`msslib.mesh`;
+    unknown or missing arguments are errors).  ``file`` is a mesh file read by
+    :func:`msslib.mesh.read`, relative to the directory of the scene file (or of ``base_dir`` for a
+    scene given as a dict); an integer cell data array ``material`` becomes the material index.
+``materials``
+    A non-empty list of ``{E, nu, density}``: Young's modulus ``E > 0`` (Pa), Poisson's ratio
+    ``-1 < nu < 0.5`` and the density (kg/m^3, > 0).  ``density`` may be omitted unless the scene
+    has gravity or is dynamic.  Note that the triangle and square MSS models are exact only for
+    ``nu = 1/3``, Lloyd's tetrahedron without volume term for ``nu = 1/4``.
+``regions``
+    Optional list of ``{box: [[xmin, ymin(, zmin)], [xmax, ymax(, zmax)]], material: i}``: cells
+    whose centroid lies in the box (``null`` bounds are unbounded) get material ``i``.
+``thickness``
+    Membrane thickness (m) of a 2D mesh (plane stress); an error for 3D meshes.
+``model``
+    A name, or a mapping ``{type: NAME, ...options}``.  FEM references (scikit-fem):
+    ``fem_linear`` (small strain), ``fem_svk`` (St Venant-Kirchhoff), ``fem_neohookean``; option
+    ``plane: stress | strain`` for 2D (default ``stress``).  Mass-spring models with their mesh:
+
+    ============================ ============ =========================================
+    model                        cells        terms (default: all of them)
+    ============================ ============ =========================================
+    ``lloyd_triangle``           triangle     ``springs``
+    ``van_gelder``               triangle     ``springs``
+    ``lloyd_square``             quad         ``springs``
+    ``lloyd_tetrahedron``        tetra        ``springs``
+    ``lloyd_tetrahedron_volume`` tetra        ``springs``, ``volume``
+    ``baudet_cube``              hexahedron   ``springs``, ``correction``
+    ``golec_cube``               hexahedron   ``springs``, ``volume``
+    ============================ ============ =========================================
+
+    Options: ``published: true`` uses the formulas as printed in the papers (see
+    :mod:`msslib.parameters`; models without a separate printed variant ignore it), ``A``
+    (``golec_cube`` only, default 1.0) the ratio ``k_inner / k_face``, and ``terms`` the list of
+    internal force terms to build — only those listed are built, e.g.
+    ``{type: golec_cube, terms: [springs]}`` is a classical MSS without Golec's volume term.
+    Baudet's ``correction`` is computed from the traction and nodal-force loads (not gravity); it
+    is non-conservative, so the static solver's line search works on the residual norm.
+``boundary``
+    List of ``{select: SELECTION, fix: [x, y(, z)] | all, displacement: [...]}``.  ``fix``
+    (default ``all``) lists the constrained axes of the selected nodes; ``displacement`` (optional)
+    gives one value per axis (m), ``null`` or 0 for the axes not fixed.  A dof fixed twice with two
+    different displacements is an error.  Static solves ramp prescribed displacements with the
+    load factor; dynamic runs apply them at ``t = 0`` and hold them.
+``SELECTION``
+    ``all``, or a mapping with ``plane: [axis, value]`` (axis ``x``, ``y`` or ``z``) and/or
+    ``box: [[xmin, ...], [xmax, ...]]`` (``null`` = unbounded, either corner may be ``null``);
+    with both, the intersection.  ``tol`` (m) widens the bounds; default ``1e-8`` times the
+    diagonal of the mesh's bounding box.  Selecting no node is an error.
+``loads``
+    List of load entries, all proportional to the load factor of the static solver:
+
+    * ``{type: gravity, g: [0, 0, -9.81]}`` — weight of the lumped node masses (m/s^2);
+    * ``{type: traction, select: SELECTION, traction: [tx, ty(, tz)]}`` — a dead traction (Pa) on
+      the boundary facets whose nodes are all selected (consistent nodal forces; in 2D per unit
+      area of the edge times ``thickness``);
+    * ``{type: nodal_force, select: SELECTION, total: [Fx, Fy(, Fz)]}`` — a total force (N) split
+      equally over the selected nodes.
+``solver``
+    ``{type: static, load_steps: 1, tol: 1.0e-8, max_iter: 50}`` (default; load-stepped Newton
+    of :func:`msslib.solvers.static_solve` for MSS, :func:`msslib.fem.solve_nonlinear` for the
+    non-linear FEM; ``fem_linear`` ignores them), or ``{type: dynamic, method:
+    symplectic_euler | velocity_verlet | implicit_euler, dt: 1.0e-4, t_end: 0.1, damping: 0.0,
+    save_every: 1}`` (MSS only, :func:`msslib.solvers.integrate` from rest; ``damping`` is a
+    mass-proportional ``alpha`` (1/s) or a Rayleigh pair ``[alpha, beta]``).
+``output``
+    ``{vtu: false, history: true}``: ``vtu: true`` also writes a VTU file next to the NetCDF result
+    (same name, suffix ``.vtu``), a string names that file (relative to the result's directory);
+    ``history: false`` drops the stored states of a dynamic run.
+
+Result
+------
+:func:`run_scene` returns :func:`msslib.io.make_dataset`'s dataset: rest positions, final
+displacement, reactions, fixed mask, springs with constants and rest lengths (MSS), the history
+(time, displacement, velocity, kinetic energy) of dynamic runs, solver statistics (``solver_*``),
+wall time, the scene text, the model name, ``E`` and ``nu`` (one value per material), plus the
+attributes ``scene_name``, ``scene_description``, ``density`` and ``thickness``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import inspect
+import math
+import sys
+import time
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+import yaml
+
+from msslib import mesh as _mesh
+
+__all__ = [
+    "GENERATORS",
+    "MSS_MODELS",
+    "FEM_MODELS",
+    "MODELS",
+    "Material",
+    "Scene",
+    "Setup",
+    "TextProgress",
+    "load_scene",
+    "prepare",
+    "run_scene",
+]
+
+GENERATORS = {
+    "quad_grid": 2, "triangle_grid_equilateral": 2, "hexagon_equilateral": 2, "triangle_grid_right": 2,
+    "polygon_mesh": 2, "hex_grid": 3, "tet_grid": 3, "l_block_hex": 3, "cylinder_mesh": 3,
+    "cylinder_with_hole_mesh": 3, "cone_mesh": 3, "l_block_tet": 3,
+}
+"""Mesh generators of :mod:`msslib.mesh` a scene may name, with their dimension."""
+
+#: MSS model name -> (cell type, internal terms it can build)
+MSS_MODELS = {
+    "lloyd_triangle": ("triangle", ("springs",)),
+    "van_gelder": ("triangle", ("springs",)),
+    "lloyd_square": ("quad", ("springs",)),
+    "lloyd_tetrahedron": ("tetra", ("springs",)),
+    "lloyd_tetrahedron_volume": ("tetra", ("springs", "volume")),
+    "baudet_cube": ("hexahedron", ("springs", "correction")),
+    "golec_cube": ("hexahedron", ("springs", "volume")),
+}
+#: FEM model name -> material law of :func:`msslib.fem.solve_nonlinear` (None: linear)
+FEM_MODELS = {"fem_linear": None, "fem_svk": "svk", "fem_neohookean": "neohookean"}
+MODELS = tuple(FEM_MODELS) + tuple(MSS_MODELS)
+
+LOAD_TYPES = ("gravity", "nodal_force", "traction")
+SOLVER_TYPES = ("static", "dynamic")
+METHODS = ("symplectic_euler", "velocity_verlet", "implicit_euler")
+AXES = ("x", "y", "z")
+
+_TOP_KEYS = ("name", "description", "geometry", "materials", "regions", "thickness", "model", "boundary",
+             "loads", "solver", "output")
+
+
+# --------------------------------------------------------------------------------------------
+# data classes
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Material:
+    """An isotropic material: ``E`` (Pa), ``nu`` and ``density`` (kg/m^3, None if not given)."""
+
+    E: float
+    nu: float
+    density: float | None = None
+
+
+@dataclass
+class Scene:
+    """A validated scene (see the module docstring for the syntax).
+
+    ``geometry`` is ``{"generator": name, "args": {...}}`` or ``{"file": Path}`` (absolute);
+    ``model_options`` holds ``published`` (bool), ``A`` (float), ``terms`` (tuple of names) and
+    ``plane``; ``boundary``, ``loads``, ``solver`` and ``output`` are normalised mappings.
+    ``text`` is the scene source (YAML), ``path`` its file (None for a dict).
+    """
+
+    name: str
+    description: str
+    geometry: dict
+    materials: list[Material]
+    model: str
+    model_options: dict = field(default_factory=dict)
+    regions: list[dict] = field(default_factory=list)
+    thickness: float | None = None
+    boundary: list[dict] = field(default_factory=list)
+    loads: list[dict] = field(default_factory=list)
+    solver: dict = field(default_factory=dict)
+    output: dict = field(default_factory=dict)
+    text: str = ""
+    path: Path | None = None
+
+    @property
+    def is_fem(self) -> bool:
+        return self.model in FEM_MODELS
+
+    @property
+    def is_dynamic(self) -> bool:
+        return self.solver.get("type") == "dynamic"
+
+
+@dataclass
+class Setup:
+    """What :func:`prepare` builds from a scene: mesh, boundary conditions, loads and model.
+
+    ``fixed`` (n, dim) bool and ``prescribed`` (n, dim) m; ``surface_forces`` (n, dim) N, the
+    traction and nodal-force loads; ``gravity`` (dim,) m/s^2 or None; ``cell_density`` (n_cells,)
+    (NaN where not given); ``masses`` (n,) kg lumped node masses (None without densities);
+    ``model`` the :class:`msslib.model.Model` of an MSS scene (None for FEM).
+    """
+
+    scene: Scene
+    mesh: _mesh.Mesh
+    fixed: np.ndarray
+    prescribed: np.ndarray
+    surface_forces: np.ndarray
+    gravity: np.ndarray | None
+    cell_density: np.ndarray
+    masses: np.ndarray | None
+    model: Any = None
+
+    @property
+    def thickness(self) -> float:
+        return 1.0 if self.mesh.dim == 3 else float(self.scene.thickness or 1.0)
+
+
+# --------------------------------------------------------------------------------------------
+# YAML loading (duplicate keys are errors)
+# --------------------------------------------------------------------------------------------
+
+
+class _StrictLoader(yaml.SafeLoader):
+    """SafeLoader that rejects duplicate keys in a mapping."""
+
+
+def _construct_mapping(loader, node, deep=False):
+    seen = {}
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            raise yaml.constructor.ConstructorError(
+                "while constructing a mapping", node.start_mark, f"found duplicate key {key!r}", key_node.start_mark)
+        seen[key] = True
+    return yaml.SafeLoader.construct_mapping(loader, node, deep=deep)
+
+
+_StrictLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+
+
+def _parse_yaml(text: str, source: str):
+    try:
+        return yaml.load(text, Loader=_StrictLoader)  # noqa: S506 - a SafeLoader subclass
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        where = f", line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        what = " ".join(str(x) for x in (exc.context, exc.problem) if x)
+        raise ValueError(f"{source}{where}: invalid YAML: {what}") from None
+    except yaml.YAMLError as exc:
+        detail = " ".join(str(exc).split())
+        raise ValueError(f"{source}: invalid YAML: {detail}") from None
+
+
+# --------------------------------------------------------------------------------------------
+# validation helpers: every error names the key path
+# --------------------------------------------------------------------------------------------
+
+
+def _fail(path: str, message: str):
+    raise ValueError(f"{path}: {message}")
+
+
+def _mapping(path, value, allowed, required=()):
+    if not isinstance(value, Mapping):
+        _fail(path, f"expected a mapping with keys {', '.join(sorted(allowed))}, got {value!r}")
+    for key in value:
+        if key not in allowed:
+            hint = difflib.get_close_matches(str(key), list(allowed), n=1)
+            did = f" (did you mean {hint[0]!r}?)" if hint else ""
+            _fail(f"{path}.{key}", f"unknown key; expected one of {', '.join(sorted(allowed))}{did}")
+    for key in required:
+        if key not in value:
+            _fail(f"{path}.{key}", "required key missing")
+    return value
+
+
+def _show(value) -> str:
+    """A value as the user wrote it (numbers written as strings such as 1e6 without quotes)."""
+    if isinstance(value, str):
+        try:
+            float(value)
+            return value
+        except ValueError:
+            return repr(value)
+    return repr(value)
+
+
+def _number(path, value, *, low=None, high=None, low_open=True, high_open=True, what="a number"):
+    if isinstance(value, bool) or value is None:
+        _fail(path, f"expected {what}, got {value!r}")
+    if isinstance(value, str):
+        try:
+            number = float(value)
+        except ValueError:
+            _fail(path, f"expected {what}, got {value!r}")
+    elif isinstance(value, (int, float, np.integer, np.floating)):
+        number = float(value)
+    else:
+        _fail(path, f"expected {what}, got {value!r}")
+    if not math.isfinite(number):
+        _fail(path, f"expected a finite number, got {_show(value)}")
+    if low is not None and (number <= low if low_open else number < low):
+        _fail(path, f"must be {'>' if low_open else '>='} {low:g}, got {_show(value)}")
+    if high is not None and (number >= high if high_open else number > high):
+        _fail(path, f"must be {'<' if high_open else '<='} {high:g}, got {_show(value)}")
+    return number
+
+
+def _integer(path, value, minimum=1):
+    number = _number(path, value, what="an integer")
+    if number != int(number) or number < minimum:
+        _fail(path, f"must be an integer >= {minimum}, got {_show(value)}")
+    return int(number)
+
+
+def _boolean(path, value):
+    if not isinstance(value, bool):
+        _fail(path, f"expected true or false, got {value!r}")
+    return value
+
+
+def _string(path, value):
+    if not isinstance(value, str):
+        _fail(path, f"expected a string, got {value!r}")
+    return value
+
+
+def _choice(path, value, choices, what):
+    if not isinstance(value, str) or value not in choices:
+        hint = difflib.get_close_matches(str(value), list(choices), n=1)
+        did = f" (did you mean {hint[0]!r}?)" if hint else ""
+        _fail(path, f"unknown {what} {value!r}; expected one of {', '.join(choices)}{did}")
+    return value
+
+
+def _vector(path, value, *, allow_null=False, length=None):
+    if not isinstance(value, (list, tuple)) or not value:
+        _fail(path, f"expected a list of numbers, got {value!r}")
+    if length is not None and len(value) != length:
+        _fail(path, f"expected {length} values, got {len(value)}: {value!r}")
+    if len(value) not in (2, 3):
+        _fail(path, f"expected 2 or 3 values (one per axis), got {len(value)}: {value!r}")
+    out = []
+    for i, v in enumerate(value):
+        if v is None and allow_null:
+            out.append(None)
+        else:
+            out.append(_number(f"{path}[{i}]", v))
+    return out
+
+
+def _list(path, value):
+    if value is None:
+        return []
+    if not isinstance(value, list):
+        _fail(path, f"expected a list, got {value!r}")
+    return value
+
+
+def _box(path, value):
+    if not isinstance(value, (list, tuple)) or len(value) != 2:
+        _fail(path, f"expected [[min...], [max...]] (null for unbounded), got {value!r}")
+    corners = []
+    for i, corner in enumerate(value):
+        corners.append(None if corner is None else _vector(f"{path}[{i}]", corner, allow_null=True))
+    if corners[0] is not None and corners[1] is not None and len(corners[0]) != len(corners[1]):
+        _fail(path, f"both corners need the same number of coordinates, got {value!r}")
+    return corners
+
+
+def _selection(path, value):
+    if value == "all":
+        return {"all": True}
+    if not isinstance(value, Mapping):
+        _fail(path, f"expected 'all' or a mapping with plane and/or box, got {value!r}")
+    _mapping(path, value, ("plane", "box", "tol"))
+    if "plane" not in value and "box" not in value:
+        _fail(path, "give plane and/or box (or write select: all)")
+    out = {}
+    if "plane" in value:
+        plane = value["plane"]
+        if not isinstance(plane, (list, tuple)) or len(plane) != 2:
+            _fail(f"{path}.plane", f"expected [axis, value] such as [z, 0.0], got {plane!r}")
+        axis = plane[0]
+        if axis in (0, 1, 2) and not isinstance(axis, bool):
+            axis = AXES[axis]
+        _choice(f"{path}.plane[0]", axis, AXES, "axis")
+        out["plane"] = (axis, _number(f"{path}.plane[1]", plane[1]))
+    if "box" in value:
+        out["box"] = _box(f"{path}.box", value["box"])
+    if "tol" in value:
+        out["tol"] = _number(f"{path}.tol", value["tol"], low=0.0)
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# load_scene
+# --------------------------------------------------------------------------------------------
+
+
+def _generator_function(name):
+    return getattr(_mesh, name)
+
+
+def _geometry(path, value, base_dir: Path):
+    _mapping(path, value, ("generator", "args", "file"))
+    has_gen, has_file = "generator" in value, "file" in value
+    if has_gen == has_file:
+        _fail(path, "give exactly one of 'generator' (with 'args') or 'file'")
+    if has_file:
+        if "args" in value:
+            _fail(f"{path}.args", "only used with 'generator'")
+        file_value = _string(f"{path}.file", value["file"])
+        file_path = Path(file_value)
+        if not file_path.is_absolute():
+            file_path = base_dir / file_path
+        if not file_path.is_file():
+            raise FileNotFoundError(f"{path}.file: mesh file not found: {file_value!r} (looked for {file_path})")
+        return {"file": file_path}
+    name = _choice(f"{path}.generator", value["generator"], tuple(GENERATORS), "generator")
+    args = value.get("args") or {}
+    if not isinstance(args, Mapping):
+        _fail(f"{path}.args", f"expected a mapping of keyword arguments of {name}, got {args!r}")
+    sig = inspect.signature(_generator_function(name))
+    params = [p for p in sig.parameters]
+    converted = {}
+    for key, v in args.items():
+        if key not in params:
+            hint = difflib.get_close_matches(str(key), params, n=1)
+            did = f" (did you mean {hint[0]!r}?)" if hint else ""
+            _fail(f"{path}.args.{key}", f"unknown argument of {name}; expected one of {', '.join(params)}{did}")
+        converted[key] = _generator_arg(f"{path}.args.{key}", v)
+    missing = [p.name for p in sig.parameters.values() if p.default is inspect.Parameter.empty and p.name not in args]
+    if missing:
+        _fail(f"{path}.args", f"{name} needs the argument(s) {', '.join(missing)}")
+    return {"generator": name, "args": converted}
+
+
+def _generator_arg(path, value):
+    """Numbers (also written as strings like '1e-2') and nested lists of them."""
+    if isinstance(value, (list, tuple)):
+        return tuple(_generator_arg(f"{path}[{i}]", v) for i, v in enumerate(value))
+    if isinstance(value, bool):
+        _fail(path, f"expected a number, got {value!r}")
+    if isinstance(value, int):
+        return value
+    return _number(path, value)
+
+
+def _materials(path, value):
+    if not isinstance(value, list) or not value:
+        _fail(path, f"expected a non-empty list of {{E, nu, density}}, got {value!r}")
+    out = []
+    for i, m in enumerate(value):
+        p = f"{path}[{i}]"
+        _mapping(p, m, ("E", "nu", "density"), required=("E", "nu"))
+        E = _number(f"{p}.E", m["E"], low=0.0)
+        nu = _number(f"{p}.nu", m["nu"], low=-1.0, high=0.5)
+        density = None if m.get("density") is None else _number(f"{p}.density", m["density"], low=0.0)
+        out.append(Material(E, nu, density))
+    return out
+
+
+def _regions(path, value, n_materials):
+    out = []
+    for i, r in enumerate(_list(path, value)):
+        p = f"{path}[{i}]"
+        _mapping(p, r, ("box", "material"), required=("box", "material"))
+        material = _integer(f"{p}.material", r["material"], minimum=0)
+        if material >= n_materials:
+            _fail(f"{p}.material", f"material index {material} does not exist ({n_materials} material(s) given)")
+        out.append({"box": _box(f"{p}.box", r["box"]), "material": material})
+    return out
+
+
+def _model(path, value):
+    type_path = f"{path}.type"
+    if isinstance(value, str):
+        value, type_path = {"type": value}, path
+    if not isinstance(value, Mapping):
+        _fail(path, f"expected a model name or a mapping with 'type', got {value!r}")
+    _mapping(path, value, ("type", "published", "A", "terms", "plane"), required=("type",))
+    name = _choice(type_path, value["type"], MODELS, "model")
+    opts = {"published": False, "A": None, "terms": None, "plane": "stress"}
+    if "published" in value:
+        opts["published"] = _boolean(f"{path}.published", value["published"])
+    if "A" in value:
+        if name != "golec_cube":
+            _fail(f"{path}.A", f"only golec_cube takes A, not {name}")
+        opts["A"] = _number(f"{path}.A", value["A"], low=0.0)
+    if name == "golec_cube" and opts["A"] is None:
+        opts["A"] = 1.0
+    if "terms" in value:
+        if name in FEM_MODELS:
+            _fail(f"{path}.terms", f"only MSS models have terms, not {name}")
+        available = MSS_MODELS[name][1]
+        terms = value["terms"]
+        if not isinstance(terms, list) or not terms:
+            _fail(f"{path}.terms", f"expected a non-empty list from {', '.join(available)}, got {terms!r}")
+        for i, t in enumerate(terms):
+            _choice(f"{path}.terms[{i}]", t, available, f"term of {name}")
+        if len(set(terms)) != len(terms):
+            _fail(f"{path}.terms", f"a term is listed twice: {terms!r}")
+        opts["terms"] = tuple(terms)
+    elif name in MSS_MODELS:
+        opts["terms"] = MSS_MODELS[name][1]
+    if "plane" in value:
+        if name not in FEM_MODELS:
+            _fail(f"{path}.plane", f"MSS models are plane stress; plane applies to the FEM models only, not {name}")
+        opts["plane"] = _choice(f"{path}.plane", value["plane"], ("stress", "strain"), "plane")
+    return name, opts
+
+
+def _boundary(path, value):
+    out = []
+    for i, b in enumerate(_list(path, value)):
+        p = f"{path}[{i}]"
+        _mapping(p, b, ("select", "fix", "displacement"), required=("select",))
+        sel = _selection(f"{p}.select", b["select"])
+        fix = b.get("fix", "all")
+        if fix == "all":
+            axes = None
+        else:
+            if isinstance(fix, str):
+                fix = [fix]
+            if not isinstance(fix, list) or not fix:
+                _fail(f"{p}.fix", f"expected 'all' or a list of axes such as [x, z], got {fix!r}")
+            axes = []
+            for j, a in enumerate(fix):
+                _choice(f"{p}.fix[{j}]", a, AXES, "axis")
+                if a in axes:
+                    _fail(f"{p}.fix", f"axis {a!r} listed twice")
+                axes.append(a)
+        disp = None
+        if b.get("displacement") is not None:
+            disp = _vector(f"{p}.displacement", b["displacement"], allow_null=True)
+            for j, d in enumerate(disp):
+                if axes is not None and AXES[j] not in axes and d not in (None, 0.0):
+                    _fail(f"{p}.displacement[{j}]", f"displacement {d!r} given on axis {AXES[j]!r}, which is not fixed "
+                          f"(fix: {axes})")
+        out.append({"select": sel, "fix": axes, "displacement": disp})
+    return out
+
+
+_LOAD_KEYS = {"gravity": ("type", "g"), "traction": ("type", "select", "traction"),
+              "nodal_force": ("type", "select", "total")}
+
+
+def _loads(path, value):
+    out = []
+    for i, load in enumerate(_list(path, value)):
+        p = f"{path}[{i}]"
+        if not isinstance(load, Mapping):
+            _fail(p, f"expected a mapping with 'type' ({', '.join(LOAD_TYPES)}), got {load!r}")
+        if "type" not in load:
+            _fail(f"{p}.type", f"required key missing; one of {', '.join(LOAD_TYPES)}")
+        kind = _choice(f"{p}.type", load["type"], LOAD_TYPES, "load type")
+        keys = _LOAD_KEYS[kind]
+        _mapping(p, load, keys, required=keys)
+        entry = {"type": kind}
+        if kind == "gravity":
+            entry["g"] = _vector(f"{p}.g", load["g"])
+        else:
+            entry["select"] = _selection(f"{p}.select", load["select"])
+            key = keys[2]
+            entry[key] = _vector(f"{p}.{key}", load[key])
+        out.append(entry)
+    return out
+
+
+def _solver(path, value, model):
+    value = {"type": "static"} if value is None else value
+    if not isinstance(value, Mapping):
+        _fail(path, f"expected a mapping with 'type' (static or dynamic), got {value!r}")
+    kind = _choice(f"{path}.type", value.get("type", "static"), SOLVER_TYPES, "solver type")
+    if kind == "static":
+        _mapping(path, value, ("type", "load_steps", "tol", "max_iter"))
+        return {
+            "type": "static",
+            "load_steps": _integer(f"{path}.load_steps", value.get("load_steps", 1)),
+            "tol": _number(f"{path}.tol", value.get("tol", 1e-8), low=0.0),
+            "max_iter": _integer(f"{path}.max_iter", value.get("max_iter", 50 if model in MSS_MODELS else 30)),
+        }
+    _mapping(path, value, ("type", "method", "dt", "t_end", "damping", "save_every"), required=("dt", "t_end"))
+    if model in FEM_MODELS:
+        _fail(f"{path}.type", f"dynamic runs need an MSS model; {model} is static only")
+    damping = value.get("damping", 0.0)
+    if isinstance(damping, (list, tuple)):
+        if len(damping) != 2:
+            _fail(f"{path}.damping", f"expected alpha or [alpha, beta], got {damping!r}")
+        damping = tuple(_number(f"{path}.damping[{j}]", d, low=0.0, low_open=False) for j, d in enumerate(damping))
+    else:
+        damping = _number(f"{path}.damping", damping, low=0.0, low_open=False)
+    return {
+        "type": "dynamic",
+        "method": _choice(f"{path}.method", value.get("method", "symplectic_euler"), METHODS, "method"),
+        "dt": _number(f"{path}.dt", value["dt"], low=0.0),
+        "t_end": _number(f"{path}.t_end", value["t_end"], low=0.0),
+        "damping": damping,
+        "save_every": _integer(f"{path}.save_every", value.get("save_every", 1)),
+    }
+
+
+def _output(path, value):
+    value = {} if value is None else value
+    _mapping(path, value, ("vtu", "history"))
+    vtu = value.get("vtu", False)
+    if not isinstance(vtu, (bool, str)) or vtu == "":
+        _fail(f"{path}.vtu", f"expected true, false or a file name, got {vtu!r}")
+    return {"vtu": vtu, "history": _boolean(f"{path}.history", value.get("history", True))}
+
+
+def load_scene(source, *, base_dir=None) -> Scene:
+    """Read and validate a scene: a path to a YAML file or a ``dict`` with the same structure
+    (a :class:`Scene` is returned unchanged).
+
+    Relative mesh files are resolved against the scene file's directory (``base_dir``, default
+    the current directory, for a dict).  Raises ValueError naming the key path and the value for
+    unknown keys and bad values, FileNotFoundError for a missing scene or mesh file.
+    """
+    if isinstance(source, Scene):
+        return source
+    if isinstance(source, Mapping):
+        raw = source
+        path = None
+        text = yaml.safe_dump(_plain(raw), sort_keys=False)
+        base = Path(base_dir) if base_dir is not None else Path.cwd()
+    else:
+        path = Path(source)
+        if not path.is_file():
+            raise FileNotFoundError(f"scene file not found: {str(source)!r}")
+        text = path.read_text(encoding="utf-8")
+        raw = _parse_yaml(text, str(source))
+        base = Path(base_dir) if base_dir is not None else path.resolve().parent
+    root = "scene"
+    if not isinstance(raw, Mapping):
+        _fail(root, f"expected a mapping of {', '.join(_TOP_KEYS)}, got {type(raw).__name__}")
+    _mapping(root, raw, _TOP_KEYS, required=("geometry", "materials", "model"))
+
+    name = raw.get("name")
+    name = _string(f"{root}.name", name) if name is not None else (path.stem if path else "scene")
+    description = raw.get("description")
+    description = "" if description is None else _string(f"{root}.description", description)
+    geometry = _geometry(f"{root}.geometry", raw["geometry"], base)
+    materials = _materials(f"{root}.materials", raw["materials"])
+    regions = _regions(f"{root}.regions", raw.get("regions"), len(materials))
+    thickness = None
+    if raw.get("thickness") is not None:
+        thickness = _number(f"{root}.thickness", raw["thickness"], low=0.0)
+        if geometry.get("generator") and GENERATORS[geometry["generator"]] == 3:
+            _fail(f"{root}.thickness", f"applies to 2D meshes only; {geometry['generator']} is 3D")
+    model, options = _model(f"{root}.model", raw["model"])
+    if "generator" in geometry and model in MSS_MODELS:
+        dim = GENERATORS[geometry["generator"]]
+        if (MSS_MODELS[model][0] in ("triangle", "quad")) != (dim == 2):
+            _fail(f"{root}.model", f"{model} needs {MSS_MODELS[model][0]} cells, "
+                  f"the generator {geometry['generator']} makes a {dim}D mesh")
+    boundary = _boundary(f"{root}.boundary", raw.get("boundary"))
+    loads = _loads(f"{root}.loads", raw.get("loads"))
+    solver = _solver(f"{root}.solver", raw.get("solver"), model)
+    output = _output(f"{root}.output", raw.get("output"))
+    needs_density = solver["type"] == "dynamic" or any(l["type"] == "gravity" for l in loads)
+    if needs_density:
+        for i, m in enumerate(materials):
+            if m.density is None:
+                why = "dynamic runs" if solver["type"] == "dynamic" else "gravity loads"
+                _fail(f"{root}.materials[{i}].density", f"required for {why}")
+    return Scene(name=name, description=description, geometry=geometry, materials=materials, model=model,
+                 model_options=options, regions=regions, thickness=thickness, boundary=boundary, loads=loads,
+                 solver=solver, output=output, text=text, path=path)
+
+
+def _plain(value):
+    """A dict/list tree of plain Python values (for YAML dumping)."""
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    return value
+
+
+# --------------------------------------------------------------------------------------------
+# prepare: mesh, boundary conditions, loads, model
+# --------------------------------------------------------------------------------------------
+
+
+def _build_mesh(scene: Scene) -> _mesh.Mesh:
+    geo = scene.geometry
+    if "file" in geo:
+        try:
+            mesh = _mesh.read(geo["file"])
+        except ValueError as exc:
+            _fail("scene.geometry.file", str(exc))
+        mesh = _mesh.orient(mesh)
+    else:
+        fn = _generator_function(geo["generator"])
+        try:
+            mesh = fn(**geo["args"])
+        except (ValueError, TypeError) as exc:
+            _fail("scene.geometry", f"{geo['generator']}: {exc}")
+    if scene.thickness is not None and mesh.dim == 3:
+        _fail("scene.thickness", "applies to 2D meshes only; the mesh is 3D")
+    material = mesh.material.copy()
+    if scene.regions:
+        centroids = mesh.points[mesh.cells].mean(axis=1)
+        for i, region in enumerate(scene.regions):
+            inside = _in_box(f"scene.regions[{i}].box", centroids, region["box"], mesh.dim, 1e-12)
+            material[inside] = region["material"]
+    if mesh.n_cells and material.max() >= len(scene.materials):
+        _fail("scene.materials", f"the mesh uses material index {int(material.max())}, "
+              f"only {len(scene.materials)} material(s) given")
+    if mesh.n_cells and material.min() < 0:
+        _fail("scene.geometry", f"the mesh has a negative material index {int(material.min())}")
+    return _mesh.Mesh(mesh.points, mesh.cells, mesh.cell_type, material)
+
+
+def _in_box(path, x, box, dim, tol):
+    keep = np.ones(len(x), dtype=bool)
+    for corner, sign in zip(box, (1.0, -1.0)):
+        if corner is None:
+            continue
+        if len(corner) != dim:
+            _fail(path, f"box corners need {dim} coordinates on a {dim}D mesh, got {list(corner)!r}")
+        for d, b in enumerate(corner):
+            if b is not None:
+                keep &= sign * (x[:, d] - b) >= -tol
+    return keep
+
+
+def _select(path, mesh, sel, default_tol):
+    if sel.get("all"):
+        return np.arange(mesh.n_nodes)
+    tol = sel.get("tol", default_tol)
+    if "plane" in sel and AXES.index(sel["plane"][0]) >= mesh.dim:
+        _fail(f"{path}.plane", f"axis {sel['plane'][0]!r} does not exist on a {mesh.dim}D mesh")
+    if "box" in sel:
+        for i, corner in enumerate(sel["box"]):
+            if corner is not None and len(corner) != mesh.dim:
+                _fail(f"{path}.box[{i}]", f"needs {mesh.dim} coordinates on a {mesh.dim}D mesh, got {corner!r}")
+    try:
+        return _mesh.select_nodes(mesh, box=sel.get("box"), plane=sel.get("plane"), tol=tol)
+    except ValueError:
+        shown = {k: v for k, v in sel.items()}
+        lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
+        _fail(path, f"selects no node: {shown} (tol {tol:.3g} m; the mesh spans {np.round(lo, 6).tolist()} to "
+              f"{np.round(hi, 6).tolist()})")
+
+
+def _check_dim(path, vec, dim):
+    if len(vec) != dim:
+        _fail(path, f"expected {dim} values on a {dim}D mesh, got {len(vec)}: {vec!r}")
+    return np.asarray(vec, dtype=float)
+
+
+def prepare(scene: Scene) -> Setup:
+    """Build the mesh, boundary conditions, loads and (for MSS) the model of a scene.
+
+    Does not solve; :func:`run_scene` calls it, the ``validate`` command too.  Errors that need
+    the mesh (a selection matching no node, a vector of the wrong length, a model whose cell type
+    does not fit the mesh) are ValueErrors naming the key path.
+    """
+    mesh = _build_mesh(scene)
+    n, dim = mesh.n_nodes, mesh.dim
+    size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if n else 1.0
+    default_tol = max(1e-8 * size, 1e-15)
+
+    fixed = np.zeros((n, dim), dtype=bool)
+    prescribed = np.zeros((n, dim))
+    owner = np.full((n, dim), -1)
+    for i, b in enumerate(scene.boundary):
+        p = f"scene.boundary[{i}]"
+        nodes = _select(f"{p}.select", mesh, b["select"], default_tol)
+        axes = list(range(dim)) if b["fix"] is None else [AXES.index(a) for a in b["fix"]]
+        for a in axes:
+            if a >= dim:
+                _fail(f"{p}.fix", f"axis {AXES[a]!r} does not exist on a {dim}D mesh")
+        disp = np.zeros(dim)
+        if b["displacement"] is not None:
+            if len(b["displacement"]) != dim:
+                _fail(f"{p}.displacement", f"expected {dim} values on a {dim}D mesh, got {b['displacement']!r}")
+            disp = np.array([0.0 if v is None else v for v in b["displacement"]])
+        for a in axes:
+            clash = (owner[nodes, a] >= 0) & (prescribed[nodes, a] != disp[a])
+            if clash.any():
+                j = int(owner[nodes, a][clash][0])
+                _fail(f"{p}.displacement", f"node {int(nodes[clash][0])} axis {AXES[a]} is already fixed by "
+                      f"scene.boundary[{j}] with displacement {prescribed[nodes[clash][0], a]!r}, here {disp[a]!r}")
+            fixed[nodes, a] = True
+            prescribed[nodes, a] = disp[a]
+            owner[nodes, a] = i
+
+    thickness = 1.0 if dim == 3 else float(scene.thickness or 1.0)
+    dens = np.array([np.nan if m.density is None else m.density for m in scene.materials])
+    cell_density = dens[mesh.material]
+    masses = None
+    if mesh.n_cells and np.all(np.isfinite(cell_density)):
+        masses = _mesh.lumped_masses(mesh, cell_density, thickness) if dim == 2 else _mesh.lumped_masses(mesh, cell_density)
+
+    surface = np.zeros((n, dim))
+    gravity = None
+    facets = None
+    for i, load in enumerate(scene.loads):
+        p = f"scene.loads[{i}]"
+        if load["type"] == "gravity":
+            g = _check_dim(f"{p}.g", load["g"], dim)
+            gravity = g if gravity is None else gravity + g
+        elif load["type"] == "nodal_force":
+            total = _check_dim(f"{p}.total", load["total"], dim)
+            nodes = _select(f"{p}.select", mesh, load["select"], default_tol)
+            surface[nodes] += total / len(nodes)
+        else:
+            from msslib.terms import Traction
+
+            traction = _check_dim(f"{p}.traction", load["traction"], dim)
+            nodes = _select(f"{p}.select", mesh, load["select"], default_tol)
+            if facets is None:
+                facets = _mesh.boundary_facets(mesh)
+            selected = np.zeros(n, dtype=bool)
+            selected[nodes] = True
+            on = selected[facets].all(axis=1)
+            if not on.any():
+                _fail(f"{p}.select", f"no boundary facet has all its nodes selected ({len(nodes)} node(s) selected)")
+            surface += Traction(mesh, facets[on], traction, thickness if dim == 2 else 1.0).nodal
+
+    setup = Setup(scene=scene, mesh=mesh, fixed=fixed, prescribed=prescribed, surface_forces=surface,
+                  gravity=gravity, cell_density=cell_density, masses=masses)
+    if scene.is_fem:
+        try:
+            _mesh.check_cells(mesh)
+        except ValueError as exc:
+            _fail("scene.geometry", str(exc))
+    else:
+        setup.model = _build_model(setup)
+    return setup
+
+
+# --------------------------------------------------------------------------------------------
+# MSS model
+# --------------------------------------------------------------------------------------------
+
+
+def _accepts(fn, name):
+    try:
+        return name in inspect.signature(fn).parameters
+    except (TypeError, ValueError):
+        return False
+
+
+def _published_terms(name, mesh, materials, opts):
+    """Spring/volume terms with the papers' printed constants (``published: true``)."""
+    from functools import partial
+
+    from msslib import model as M
+    from msslib import parameters as P
+    from msslib.terms import HexVolume, TetVolume
+
+    if name == "baudet_cube":
+        M._require(mesh, "hexahedron")
+        a = M._cube_edges(mesh)
+        E, nu = M.material_arrays(mesh, materials)
+        k_e, k_d = M._per_cell(partial(P.baudet_cube, published=True), ("k_edge", "k_diagonal"), E, nu, a)
+        return [M._merge_springs([M.assemble_springs(mesh, "edges", lambda c, _p: k_e[c]),
+                                  M.assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_d[c])])]
+    if name == "golec_cube":
+        M._require(mesh, "hexahedron")
+        a = M._cube_edges(mesh)
+        E, nu = M.material_arrays(mesh, materials)
+        k_e, k_f, k_i, kappa = M._per_cell(partial(P.golec_cube, published=True),
+                                           ("k_edge", "k_face", "k_inner", "kappa"), E, nu, a, opts["A"])
+        springs = M._merge_springs([
+            M.assemble_springs(mesh, "edges", lambda c, _p: k_e[c]),
+            M.assemble_springs(mesh, "face_diagonals", lambda c, _p: k_f[c]),
+            M.assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_i[c]),
+        ])
+        return [springs, HexVolume(mesh.cells, kappa, M._hex_rest_volumes(mesh))]
+    if name == "lloyd_tetrahedron_volume":
+        V = M._require(mesh, "tetra")
+        E, nu = M.material_arrays(mesh, materials)
+        l_hat = np.cbrt(6.0 * np.sqrt(2.0) * V)
+        k, k_vol = M._per_cell(partial(P.lloyd_tetrahedron_volume, published=True), ("k", "k_volume"), E, l_hat, nu)
+        return [M.assemble_springs(mesh, "edges", lambda c, _p: k[c]),
+                TetVolume(mesh.cells, k_vol, M._tet_rest_volumes(mesh))]
+    raise AssertionError(name)
+
+
+def _internal_terms(name, mesh, materials, opts, thickness):
+    from msslib import model as M
+
+    published = opts["published"] and name in ("baudet_cube", "golec_cube", "lloyd_tetrahedron_volume")
+    builder = {
+        "lloyd_triangle": lambda: M.lloyd_triangle_springs(mesh, materials, thickness),
+        "van_gelder": lambda: M.van_gelder_springs(mesh, materials, thickness),
+        "lloyd_square": lambda: M.lloyd_square_springs(mesh, materials, thickness),
+        "lloyd_tetrahedron": lambda: M.lloyd_tet_springs(mesh, materials, volume=False),
+        "lloyd_tetrahedron_volume": lambda: M.lloyd_tet_springs(mesh, materials, volume=True),
+        "baudet_cube": lambda: M.baudet_cube_springs(mesh, materials),
+        "golec_cube": lambda: M.golec_cube_springs(mesh, materials, A=opts["A"]),
+    }[name]
+    if published:
+        fn = {"baudet_cube": M.baudet_cube_springs, "golec_cube": M.golec_cube_springs,
+              "lloyd_tetrahedron_volume": M.lloyd_tet_springs}[name]
+        if _accepts(fn, "published"):  # the builders may grow the option themselves
+            extra = {"golec_cube": {"A": opts["A"]}, "lloyd_tetrahedron_volume": {"volume": True}}.get(name, {})
+            return fn(mesh, materials, published=True, **extra)
+        return _published_terms(name, mesh, materials, opts)
+    return builder()
+
+
+def _build_model(setup: Setup):
+    from msslib.model import Model, baudet_correction
+    from msslib.terms import Gravity, HexVolume, NodalForces, Springs, TetVolume
+
+    scene, mesh = setup.scene, setup.mesh
+    name, opts = scene.model, scene.model_options
+    cell_type = MSS_MODELS[name][0]
+    if mesh.cell_type != cell_type:
+        _fail("scene.model", f"{name} needs {cell_type} cells, the mesh has {mesh.cell_type} cells")
+    materials = [(m.E, m.nu) for m in scene.materials]
+    wanted = set(opts["terms"])
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            internal = []
+            if wanted & {"springs", "volume"}:
+                for t in _internal_terms(name, mesh, materials, opts, setup.thickness):
+                    kind = "springs" if isinstance(t, Springs) else "volume" if isinstance(t, (TetVolume, HexVolume)) else None
+                    if kind in wanted:
+                        internal.append(t)
+            if "correction" in wanted:
+                internal.append(baudet_correction(mesh, materials, setup.surface_forces))
+    except ValueError as exc:
+        _fail("scene.model", f"{name}: {exc}")
+    terms = list(internal)
+    if np.any(setup.surface_forces != 0):
+        terms.append(NodalForces(setup.surface_forces))
+    if setup.gravity is not None:
+        terms.append(Gravity(setup.masses, setup.gravity))
+    damping = scene.solver.get("damping", 0.0) if scene.is_dynamic else 0.0
+    return Model(mesh, terms, fixed=setup.fixed, prescribed=setup.prescribed, masses=setup.masses, damping=damping)
+
+
+# --------------------------------------------------------------------------------------------
+# progress
+# --------------------------------------------------------------------------------------------
+
+
+class TextProgress:
+    """A one-line text progress bar on ``stream`` (default stderr), ``callable(fraction, text)``.
+
+    Nothing is shown during the first ``delay`` seconds (short runs stay quiet); then the line is
+    redrawn at most every ``interval`` seconds.  :meth:`close` ends the line.
+    """
+
+    def __init__(self, label: str = "", stream=None, width: int = 30, delay: float = 0.5, interval: float = 0.1):
+        self.label = label
+        self.stream = stream
+        self.width = width
+        self.delay = delay
+        self.interval = interval
+        self.start = time.perf_counter()
+        self.last = -math.inf
+        self.shown = False
+        self.fraction = 0.0
+        self.text = ""
+
+    def __call__(self, fraction: float, text: str = "") -> None:
+        self.fraction = min(max(float(fraction), 0.0), 1.0)
+        self.text = text
+        now = time.perf_counter()
+        interval = self.interval if self._tty() else max(self.interval, 5.0)
+        if now - self.start < self.delay or now - self.last < interval:
+            return
+        self.last = now
+        self._draw(now)
+
+    def _stream(self):
+        return self.stream if self.stream is not None else sys.stderr
+
+    def _tty(self) -> bool:
+        try:
+            return bool(self._stream().isatty())
+        except (AttributeError, ValueError):
+            return False
+
+    def _draw(self, now):
+        stream = self._stream()
+        filled = int(round(self.fraction * self.width))
+        bar = "#" * filled + "." * (self.width - filled)
+        line = f"{self.label} [{bar}] {100 * self.fraction:5.1f}% {self.text} ({now - self.start:.1f} s)"
+        if self._tty():
+            stream.write("\r" + line.ljust(99))
+        else:  # a log file: whole lines, no carriage returns
+            stream.write(line + "\n")
+        stream.flush()
+        self.shown = True
+
+    def close(self, fraction: float | None = None) -> None:
+        if self.shown:
+            if fraction is not None:
+                self.fraction = fraction
+            self._draw(time.perf_counter())
+            if self._tty():
+                self._stream().write("\n")
+                self._stream().flush()
+            self.shown = False
+
+
+# --------------------------------------------------------------------------------------------
+# run
+# --------------------------------------------------------------------------------------------
+
+
+def _moduli(scene):
+    E = [m.E for m in scene.materials]
+    nu = [m.nu for m in scene.materials]
+    if len(E) == 1:
+        return E[0], nu[0]
+    return np.array(E), np.array(nu)
+
+
+def _solve_fem(setup: Setup, report):
+    from msslib import fem
+    from msslib.solvers import ConvergenceError
+
+    scene, mesh = setup.scene, setup.mesh
+    E = [m.E for m in scene.materials]
+    nu = [m.nu for m in scene.materials]
+    body = None
+    if setup.gravity is not None:
+        body = setup.cell_density[:, None] * setup.gravity[None, :]
+    kw = dict(fixed=setup.fixed, prescribed=setup.prescribed, nodal_forces=setup.surface_forces, body_force=body)
+    if mesh.dim == 2:
+        kw.update(thickness=setup.thickness, plane=scene.model_options["plane"])
+    law = FEM_MODELS[scene.model]
+    if law is None:
+        res = fem.solve_linear(mesh, E, nu, **kw)
+    else:
+        s = scene.solver
+        try:
+            res = fem.solve_nonlinear(mesh, E, nu, law=law, steps=s["load_steps"], tol=s["tol"], max_iter=s["max_iter"],
+                                      progress=lambda k, n: report(k / n, f"load step {k}/{n}"), **kw)
+        except RuntimeError as exc:
+            raise ConvergenceError(f"{scene.model}: {exc}") from None
+    stats = {"type": "static", **res.stats}
+    return {"displacement": res.displacement, "reaction": res.reaction, "stats": stats,
+            "extra_attrs": {"strain_energy": res.strain_energy}}
+
+
+def _solve_mss_static(setup: Setup, report):
+    from msslib.solvers import static_solve
+
+    model, s = setup.model, setup.scene.solver
+
+    def cb(info):
+        report(info["load"], f"load {info['load']:.3g} it {info['iteration']} |r| {info['residual']:.2e}")
+
+    res = static_solve(model, model.x0, load_steps=s["load_steps"], tol=s["tol"], max_iter=s["max_iter"], progress=cb)
+    u = (res.x - model.x0).reshape(-1, model.dim)
+    stats = {
+        "type": "static", "load_steps": s["load_steps"], "tol": s["tol"], "n_load_steps": res.n_load_steps,
+        "n_cuts": res.n_cuts, "iterations": res.iterations, "total_iterations": res.total_iterations,
+        "final_residual": res.residuals[-1][-1] if res.residuals and res.residuals[-1] else 0.0,
+        "force_scale": res.force_scale, "line_search_merit": res.line_search_merit, "wall_time": res.wall_time,
+        "messages": res.messages,
+    }
+    energy = model.energy(res.x, 1.0)
+    extra = {"potential_energy": "None" if energy is None else energy}
+    return {"displacement": u, "reaction": model.reaction(res.x, 1.0), "stats": stats, "extra_attrs": extra}
+
+
+def _solve_mss_dynamic(setup: Setup, report):
+    from msslib.solvers import integrate
+
+    model, s = setup.model, setup.scene.solver
+    x_start = model.apply_prescribed(model.x0, 1.0)
+
+    def cb(info):
+        n = max(info["n_steps"], 1)
+        report(info["step"] / n, f"t = {info['t']:.4g} s")
+
+    res = integrate(model, x_start, np.zeros(model.n_dof), dt=s["dt"], t_end=s["t_end"], method=s["method"],
+                    damping=s["damping"], save_every=s["save_every"], progress=cb)
+    n, dim = model.n_nodes, model.dim
+    u = (res.x_final - model.x0).reshape(n, dim)
+    out = {"displacement": u, "reaction": model.reaction(res.x_final, 1.0),
+           "stats": {"type": "dynamic", **res.stats}, "extra_attrs": {}}
+    if setup.scene.output["history"]:
+        n_t = len(res.t)
+        out["history"] = {"time": res.t, "displacement": (res.x - model.x0).reshape(n_t, n, dim),
+                          "velocity": res.v.reshape(n_t, n, dim)}
+        extra = {"kinetic_energy": (("time",), res.kinetic_energy, {"units": "J", "long_name": "kinetic energy"})}
+        if res.potential_energy is not None:
+            extra["potential_energy"] = (("time",), res.potential_energy,
+                                         {"units": "J", "long_name": "potential energy (internal minus load work)"})
+        out["extra_vars"] = extra
+    return out
+
+
+def run_scene(scene, progress=True):
+    """Build and solve a scene (a :class:`Scene`, a path or a dict) and return its result dataset.
+
+    ``progress``: True draws a text progress bar on stderr for runs longer than half a second,
+    False/None is silent, a callable receives ``(fraction, text)``.  Raises ValueError /
+    FileNotFoundError for bad scenes, :class:`msslib.solvers.ConvergenceError` when a static solve
+    fails and :class:`msslib.solvers.DivergenceError` when a dynamic run blows up.
+    """
+    from msslib.io import make_dataset
+
+    scene = load_scene(scene)
+    t0 = time.perf_counter()
+    bar = None
+    if progress is True:
+        bar = TextProgress(label=scene.name)
+        report: Callable = bar
+    elif callable(progress):
+        report = progress
+    else:
+        def report(_fraction, _text=""):
+            return None
+    try:
+        setup = prepare(scene)
+        if scene.is_fem:
+            out = _solve_fem(setup, report)
+        elif scene.is_dynamic:
+            out = _solve_mss_dynamic(setup, report)
+        else:
+            out = _solve_mss_static(setup, report)
+    finally:
+        if bar is not None:
+            bar.close()
+    wall = time.perf_counter() - t0
+
+    springs = k = rest = None
+    if setup.model is not None:
+        from msslib.terms import Springs
+
+        sp = [t for t in setup.model.terms if isinstance(t, Springs)]
+        if sp:
+            springs = np.concatenate([t.pairs for t in sp])
+            k = np.concatenate([t.k for t in sp])
+            rest = np.concatenate([t.rest_length for t in sp])
+    E, nu = _moduli(scene)
+    dens = [np.nan if m.density is None else m.density for m in scene.materials]
+    attrs = {"scene_name": scene.name, "scene_description": scene.description,
+             "density": dens[0] if len(dens) == 1 else np.array(dens),
+             "thickness": setup.thickness if setup.mesh.dim == 2 else "None",
+             "model_published": scene.model_options.get("published", False),
+             "model_terms": list(scene.model_options["terms"]) if scene.model_options.get("terms") else "None",
+             **out.get("extra_attrs", {})}
+    if scene.model_options.get("A") is not None:
+        attrs["model_A"] = scene.model_options["A"]
+    return make_dataset(
+        setup.mesh, out["displacement"], model=scene.model, E=E, nu=nu, scene=scene.text,
+        springs=springs, spring_constant=k, rest_length=rest, reaction=out["reaction"], fixed=setup.fixed,
+        history=out.get("history"), solver_stats=out["stats"], wall_time=wall, extra_vars=out.get("extra_vars"),
+        extra_attrs=attrs,
+    )

@@ -1,0 +1,860 @@
+"""Generic static and dynamic solvers for discrete mechanical systems (mass-spring networks, FEM).
+
+The solvers know nothing about springs or elements: they talk to a *problem* object through the
+duck-typed protocol below. Any object providing these attributes works.
+
+Problem protocol
+----------------
+``n_dof`` : int
+    Number of degrees of freedom. The state ``x`` is a flat float array of node positions,
+    ``n_nodes * dim`` long, interleaved by node (``x[dim * i + a]`` is coordinate ``a`` of node ``i``).
+``force(x, load=1.0)`` -> ndarray ``(n_dof,)``
+    Total force on every dof: internal forces plus ``load`` times the external forces. Internal
+    forces may contain non-conservative terms that depend on ``load`` (follower or circulatory
+    forces), so the result depends on ``load`` and not only on ``x``.
+``stiffness(x, load=1.0)`` -> scipy.sparse matrix ``(n_dof, n_dof)``
+    Tangent stiffness ``K = -d force / d x`` at the same load. May be non-symmetric.
+``energy(x, load=1.0)`` -> float or None
+    Total potential energy (internal energy minus ``load`` times the work of the external forces),
+    so that ``force = -grad energy``. Return ``None`` when the system is not conservative; the
+    line search then works on the residual norm instead of the energy.
+``free`` : bool ndarray ``(n_dof,)``
+    Mask of the unconstrained dofs. Constrained dofs keep the value they have in ``x``.
+``symmetric`` : bool, optional (default True)
+    False when ``stiffness`` is non-symmetric; the iterative (CG) linear solver is then never used.
+``apply_prescribed(x, load)`` -> ndarray, optional
+    Returns a copy of ``x`` whose constrained dofs are set to their prescribed value at load
+    factor ``load`` (prescribed motions scaled by the load). Without it, constrained dofs simply
+    keep their value from ``x0``. Only :func:`static_solve` uses it.
+``mass`` : ndarray ``(n_dof,)``
+    Lumped masses (one value per dof; repeat a node's mass for each of its coordinates). Only the
+    dynamics needs it.
+``damping`` : float or (alpha, beta), optional
+    Default damping for :func:`integrate`: a scalar is a mass-proportional coefficient ``alpha``;
+    a pair is Rayleigh damping ``C = alpha * M + beta * K``.
+``dim`` : int, optional
+    Spatial dimension, used only to measure the bounding box in the divergence check.
+
+Static solution
+---------------
+:func:`static_solve` runs Newton's method with the analytic stiffness on the free dofs, with a
+backtracking line search, and increases the load factor from 0 to 1 in ``load_steps`` equal steps,
+halving a step (up to ``max_cuts`` times) whenever its Newton iteration fails.
+
+Convergence criterion. With ``r = force(x, load)[free]``, a load step has converged when::
+
+    ||r||_2 <= tol * F_ref
+
+where ``F_ref`` is computed once, at the start:
+
+1. ``force_scale`` if the caller passes it; otherwise
+2. ``||f_ext[free]||_2`` with ``f_ext = force(x0, 1) - force(x0, 0)`` (the load-proportional
+   force at the initial state, i.e. the external load), if it is larger than the smallest normal
+   float (``numpy.finfo(float).tiny``); otherwise (pure displacement control)
+3. ``||force(apply_prescribed(x0, 1), 1)||_2`` over *all* dofs (reactions included), if nonzero;
+4. else 1.0 (an absolute criterion).
+
+The same absolute threshold ``tol * F_ref`` is used at every load level.
+
+Dynamics
+--------
+:func:`integrate` advances ``M dv/dt = force(x, load) - C v`` with symplectic Euler, velocity
+Verlet or implicit Euler. Constrained dofs keep their initial position and have zero velocity.
+After every step the state is checked: a non-finite value, or a displacement
+``max |x - x0|`` beyond ``blowup * size`` (``size`` the bounding-box diagonal of ``x0``),
+raises :class:`DivergenceError`. :func:`explicit_stability_limit` estimates the critical time
+step ``2 / omega_max`` of the explicit schemes.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+__all__ = [
+    "ConvergenceError",
+    "DivergenceError",
+    "StaticResult",
+    "DynamicResult",
+    "static_solve",
+    "integrate",
+    "explicit_stability_limit",
+]
+
+TINY = np.finfo(float).tiny
+ITERATIVE_THRESHOLD = 20_000  # free dofs above which "auto" uses preconditioned CG for SPD systems
+
+
+class ConvergenceError(RuntimeError):
+    """Newton's method failed (static load step or implicit time step).
+
+    Attributes ``load_step``, ``load``, ``iteration``, ``residual`` (absolute free-dof residual
+    norm), ``x_last`` (the last converged state, finite) and, for dynamics, ``step`` and ``time``.
+    """
+
+    def __init__(self, message, *, load_step=None, load=None, iteration=None, residual=None,
+                 x_last=None, step=None, time=None):
+        super().__init__(message)
+        self.load_step = load_step
+        self.load = load
+        self.iteration = iteration
+        self.residual = residual
+        self.x_last = x_last
+        self.step = step
+        self.time = time
+
+
+class DivergenceError(RuntimeError):
+    """A time integration blew up.
+
+    Attributes ``step`` (index of the offending step, 1-based), ``time``, ``quantity``
+    (``"position"``, ``"velocity"`` or ``"displacement"``), ``dof``, ``value`` and the last
+    finite state ``x_last``, ``v_last`` (the state before the offending step).
+    """
+
+    def __init__(self, message, *, step, time, quantity, dof, value, x_last=None, v_last=None):
+        super().__init__(message)
+        self.step = step
+        self.time = time
+        self.quantity = quantity
+        self.dof = dof
+        self.value = value
+        self.x_last = x_last
+        self.v_last = v_last
+
+
+@dataclass
+class StaticResult:
+    """Outcome of :func:`static_solve`.
+
+    ``converged`` is always True in a returned result (failures raise :class:`ConvergenceError`).
+    ``iterations[i]``, ``residuals[i]`` and ``loads[i]`` belong to the i-th *accepted* load step;
+    ``residuals[i]`` lists the absolute free-dof residual norms, starting with the one of the
+    initial guess of that step. ``force_scale`` is ``F_ref`` of the convergence criterion.
+    """
+
+    x: np.ndarray
+    converged: bool
+    iterations: list[int]
+    residuals: list[list[float]]
+    loads: list[float]
+    wall_time: float
+    n_load_steps: int
+    n_cuts: int
+    force_scale: float
+    line_search_merit: str
+    messages: list[str] = field(default_factory=list)
+
+    @property
+    def total_iterations(self) -> int:
+        return int(sum(self.iterations))
+
+
+@dataclass
+class DynamicResult:
+    """Outcome of :func:`integrate`.
+
+    ``t`` has shape ``(n_saved,)``; ``x`` and ``v`` have shape ``(n_saved, n_dof)``. The initial
+    state and the final state are always saved. ``kinetic_energy`` is saved alongside;
+    ``potential_energy`` too when ``problem.energy`` is not None (else it is None).
+    ``stats`` holds ``n_steps``, ``dt``, ``method``, ``n_force_evals``, ``n_newton_iterations``,
+    ``n_linear_solves``, ``wall_time`` and ``damping`` (alpha, beta).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    x_final: np.ndarray
+    v_final: np.ndarray
+    kinetic_energy: np.ndarray
+    potential_energy: np.ndarray | None
+    stats: dict
+
+
+# --------------------------------------------------------------------------------------------
+# helpers
+# --------------------------------------------------------------------------------------------
+
+class _NewtonFailure(Exception):
+    """Internal: a Newton iteration could not proceed (reason in the message)."""
+
+
+def _free_mask(problem) -> np.ndarray:
+    n = int(problem.n_dof)
+    free = getattr(problem, "free", None)
+    if free is None:
+        return np.ones(n, dtype=bool)
+    free = np.asarray(free, dtype=bool)
+    if free.shape != (n,):
+        raise ValueError(f"problem.free must have shape ({n},), got {free.shape}")
+    return free
+
+
+def _with_prescribed(problem, x, load):
+    fn = getattr(problem, "apply_prescribed", None)
+    if fn is None:
+        return x
+    return np.array(fn(np.array(x, dtype=float), load), dtype=float)
+
+
+def _energy_or_none(problem, x, load):
+    fn = getattr(problem, "energy", None)
+    if fn is None:
+        return None
+    e = fn(x, load)
+    return None if e is None else float(e)
+
+
+def _is_conservative(problem, x, load) -> bool:
+    return _energy_or_none(problem, x, load) is not None
+
+
+def _submatrix(K, free):
+    K = sp.csr_matrix(K)
+    if free.all():
+        return K
+    idx = np.flatnonzero(free)
+    return K[idx][:, idx]
+
+
+def _cg(A, b, M, rtol, maxiter):
+    try:
+        return spla.cg(A, b, rtol=rtol, atol=0.0, M=M, maxiter=maxiter)
+    except TypeError:  # scipy < 1.12 spells it tol
+        return spla.cg(A, b, tol=rtol, atol=0.0, M=M, maxiter=maxiter)
+
+
+_IC0_KERNELS = None
+
+
+def _ic0_kernels():
+    """Compile (lazily, with numba when available) the IC(0) factorisation and triangular solves."""
+    global _IC0_KERNELS
+    if _IC0_KERNELS is not None:
+        return _IC0_KERNELS
+
+    def factor(indptr, indices, data, n):
+        # In place on the lower triangle (CSR, sorted indices, diagonal last in each row).
+        # Returns -1 on success or the row index where a non-positive pivot appeared.
+        for i in range(n):
+            a, b = indptr[i], indptr[i + 1]
+            for p in range(a, b - 1):
+                k = indices[p]
+                s = data[p]
+                # dot product of rows i and k over columns j < k
+                q, r = a, indptr[k]
+                rend = indptr[k + 1] - 1
+                while q < p and r < rend:
+                    jq, jr = indices[q], indices[r]
+                    if jq == jr:
+                        s -= data[q] * data[r]
+                        q += 1
+                        r += 1
+                    elif jq < jr:
+                        q += 1
+                    else:
+                        r += 1
+                data[p] = s / data[indptr[k + 1] - 1]
+            d = data[b - 1]
+            for p in range(a, b - 1):
+                d -= data[p] * data[p]
+            if not d > 0.0:
+                return i
+            data[b - 1] = np.sqrt(d)
+        return -1
+
+    def solve(indptr, indices, data, n, rhs):
+        y = rhs.copy()
+        for i in range(n):  # L y = rhs
+            a, b = indptr[i], indptr[i + 1]
+            s = y[i]
+            for p in range(a, b - 1):
+                s -= data[p] * y[indices[p]]
+            y[i] = s / data[b - 1]
+        for i in range(n - 1, -1, -1):  # L^T z = y
+            a, b = indptr[i], indptr[i + 1]
+            y[i] /= data[b - 1]
+            zi = y[i]
+            for p in range(a, b - 1):
+                y[indices[p]] -= data[p] * zi
+        return y
+
+    try:
+        import numba
+
+        factor = numba.njit(cache=False)(factor)
+        solve = numba.njit(cache=False)(solve)
+    except ImportError:  # pure Python: correct, but slow
+        pass
+    _IC0_KERNELS = (factor, solve)
+    return _IC0_KERNELS
+
+
+def _ic0_preconditioner(A):
+    """Incomplete Cholesky IC(0) of an SPD matrix as a LinearOperator; on breakdown the diagonal
+    is shifted, ``A + shift * diag(A)``, with the shift grown until the factorisation succeeds."""
+    factor, solve = _ic0_kernels()
+    A = sp.csr_matrix(A)
+    lower = sp.tril(A, format="csr")
+    lower.sum_duplicates()
+    lower.sort_indices()
+    n = A.shape[0]
+    diag = A.diagonal()
+    if np.any(diag <= 0):
+        raise ValueError("IC(0) needs a positive diagonal")
+    indptr = lower.indptr.astype(np.int64)
+    indices = lower.indices.astype(np.int64)
+    if np.any(indices[indptr[1:] - 1] != np.arange(n)):
+        raise ValueError("IC(0) needs a structurally nonzero diagonal")
+    shift = 0.0
+    for _ in range(12):
+        data = lower.data.astype(float).copy()
+        data[indptr[1:] - 1] += shift * diag
+        if factor(indptr, indices, data, n) < 0:
+            return spla.LinearOperator(A.shape, matvec=lambda b: solve(indptr, indices, data, n, np.asarray(b, dtype=float).ravel()),
+                                       dtype=float)
+        shift = 1e-3 if shift == 0.0 else 4.0 * shift
+    raise ValueError("IC(0) broke down even with a diagonal shift")
+
+
+def _preconditioner(A):
+    try:
+        import pyamg  # optional
+
+        return pyamg.smoothed_aggregation_solver(sp.csr_matrix(A)).aspreconditioner(cycle="V")
+    except ImportError:
+        return _ic0_preconditioner(A)
+
+
+def _linear_solve(A, b, method, symmetric, messages):
+    """Solve ``A x = b``; raise _NewtonFailure when the matrix is singular or the solve fails."""
+    if callable(method):
+        x = np.asarray(method(A, b), dtype=float)
+        if not np.all(np.isfinite(x)):
+            raise _NewtonFailure("user linear solver returned non-finite values")
+        return x
+    if method not in ("auto", "direct", "cg"):
+        raise ValueError(f"linear_solver must be 'auto', 'direct', 'cg' or a callable, got {method!r}")
+    n = A.shape[0]
+    use_cg = method == "cg" or (method == "auto" and symmetric and n > ITERATIVE_THRESHOLD)
+    if use_cg:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                M = _preconditioner(A)
+                x, info = _cg(A, b, M, rtol=1e-10, maxiter=max(1000, int(20 * np.sqrt(n))))
+            if info == 0 and np.all(np.isfinite(x)):
+                return x
+            messages.append(f"CG did not converge (info={info}); falling back to sparse LU")
+        except (RuntimeError, ValueError, ArithmeticError) as exc:
+            messages.append(f"preconditioned CG failed ({exc}); falling back to sparse LU")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            x = spla.splu(sp.csc_matrix(A)).solve(np.asarray(b, dtype=float))
+    except RuntimeError as exc:  # "Factor is exactly singular"
+        raise _NewtonFailure(f"singular stiffness matrix ({exc})") from None
+    if not np.all(np.isfinite(x)):
+        raise _NewtonFailure("linear solve produced non-finite values (singular stiffness?)")
+    return x
+
+
+def _force_scale(problem, x0, free):
+    with np.errstate(all="ignore"):
+        f_ext = np.asarray(problem.force(x0, 1.0), dtype=float) - np.asarray(problem.force(x0, 0.0), dtype=float)
+    s = float(np.linalg.norm(f_ext[free]))
+    if np.isfinite(s) and s > TINY:
+        return s
+    xp = _with_prescribed(problem, x0, 1.0)
+    with np.errstate(all="ignore"):
+        s = float(np.linalg.norm(np.asarray(problem.force(xp, 1.0), dtype=float)))
+    if np.isfinite(s) and s > TINY:
+        return s
+    return 1.0
+
+
+# --------------------------------------------------------------------------------------------
+# statics
+# --------------------------------------------------------------------------------------------
+
+_ARMIJO_C = 1e-4
+_MAX_BACKTRACKS = 20
+
+
+def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy):
+    """Backtracking (halving) line search. Returns (x_new, r_new, rnorm_new, e_new, alpha)."""
+    slope = -float(r @ dx)  # d/dalpha energy(x + alpha dx) at alpha = 0 (grad energy = -force)
+    energy_merit = use_energy and e0 is not None and slope < 0.0
+    alpha = 1.0
+    for _ in range(_MAX_BACKTRACKS + 1):
+        xt = x.copy()
+        xt[free] += alpha * dx
+        with np.errstate(all="ignore"):
+            rt = np.asarray(problem.force(xt, load), dtype=float)[free]
+        rtn = float(np.linalg.norm(rt))
+        if np.isfinite(rtn):
+            if energy_merit:
+                et = _energy_or_none(problem, xt, load)
+                if et is not None and np.isfinite(et):
+                    if et <= e0 + _ARMIJO_C * alpha * slope:
+                        return xt, rt, rtn, et, alpha
+                    # energy differences drowned in round-off: judge by the residual instead
+                    noise = 64 * np.finfo(float).eps * (abs(e0) + abs(et))
+                    if abs(et - e0) <= noise and rtn < rnorm:
+                        return xt, rt, rtn, et, alpha
+            else:
+                # merit 0.5 ||r||^2, whose slope along the exact Newton direction is -||r||^2
+                if rtn**2 <= (1.0 - 2.0 * _ARMIJO_C * alpha) * rnorm**2:
+                    et = _energy_or_none(problem, xt, load) if use_energy else None
+                    return xt, rt, rtn, et, alpha
+        alpha *= 0.5
+    raise _NewtonFailure(f"line search failed (no sufficient decrease down to step length {2 * alpha:.1e})")
+
+
+def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_solver,
+            symmetric, use_energy, messages, progress, step_index):
+    """Newton iteration at a fixed load. Returns (x, iterations, residual history).
+
+    Raises _NewtonFailure with attributes ``iteration`` and ``residual`` on failure."""
+    with np.errstate(all="ignore"):
+        r = np.asarray(problem.force(x, load), dtype=float)[free]
+    rnorm = float(np.linalg.norm(r))
+    history = [rnorm]
+    e = _energy_or_none(problem, x, load) if (line_search and use_energy) else None
+    it = 0
+
+    def fail(reason):
+        exc = _NewtonFailure(reason)
+        exc.iteration = it
+        exc.residual = rnorm
+        return exc
+
+    if not np.isfinite(rnorm):
+        raise fail("non-finite force at the initial guess")
+    while rnorm > threshold:
+        if it >= max_iter:
+            raise fail(f"no convergence in {max_iter} iterations")
+        it += 1
+        with np.errstate(all="ignore"):
+            K = _submatrix(problem.stiffness(x, load), free)
+        try:
+            dx = _linear_solve(K, r, linear_solver, symmetric, messages)
+        except _NewtonFailure as exc:
+            raise fail(str(exc)) from None
+        if line_search:
+            try:
+                x, r, rnorm, e, _ = _line_search(problem, x, dx, free, load, r, rnorm, e, use_energy)
+            except _NewtonFailure as exc:
+                raise fail(str(exc)) from None
+        else:
+            x = x.copy()
+            x[free] += dx
+            with np.errstate(all="ignore"):
+                r = np.asarray(problem.force(x, load), dtype=float)[free]
+            rnorm = float(np.linalg.norm(r))
+            if not np.isfinite(rnorm):
+                raise fail("non-finite force after a full Newton step")
+        history.append(rnorm)
+        if progress is not None:
+            progress({"load_step": step_index, "load": load, "iteration": it, "residual": rnorm,
+                      "threshold": threshold})
+    return x, it, history
+
+
+def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_iter: int = 50,
+                 line_search: bool = True, linear_solver="auto", progress: Callable | None = None,
+                 max_cuts: int = 10, force_scale: float | None = None) -> StaticResult:
+    """Equilibrium ``force(x, 1) = 0`` on the free dofs by load-stepped Newton.
+
+    Parameters
+    ----------
+    problem : see the module docstring for the protocol.
+    x0 : initial positions ``(n_dof,)`` (constrained dofs hold their values, or are set by
+        ``problem.apply_prescribed(x, load)`` at every load level).
+    load_steps : number of equal load increments from 0 to 1.
+    tol : relative tolerance; converged when ``||force[free]||_2 <= tol * F_ref`` (module docstring).
+    max_iter : Newton iterations allowed per load step before the step counts as failed.
+    line_search : backtracking with the Armijo condition on the energy when ``problem.energy``
+        returns a number and the Newton direction descends it, otherwise on ``||force[free]||^2``.
+    linear_solver : ``"auto"`` (sparse LU; preconditioned CG — pyamg if installed, else incomplete Cholesky IC(0) — for
+        symmetric systems with more than 20 000 free dofs, falling back to LU), ``"direct"``,
+        ``"cg"``, or a callable ``(K_free, rhs) -> dx``.
+    progress : optional callable receiving a dict ``{load_step, load, iteration, residual,
+        threshold}`` after each Newton iteration.
+    max_cuts : how many times a failing load increment may be halved (in total, for one step).
+    force_scale : overrides ``F_ref`` of the convergence criterion.
+
+    Raises
+    ------
+    ConvergenceError when a load increment still fails after ``max_cuts`` halvings.
+    """
+    t_start = time.perf_counter()
+    if load_steps < 1:
+        raise ValueError("load_steps must be >= 1")
+    free = _free_mask(problem)
+    x = np.array(x0, dtype=float).reshape(-1)
+    if x.shape != (int(problem.n_dof),):
+        raise ValueError(f"x0 must have {problem.n_dof} entries, got {x.shape}")
+    if not np.all(np.isfinite(x)):
+        raise ValueError("x0 contains non-finite values")
+    symmetric = bool(getattr(problem, "symmetric", True))
+    use_energy = line_search and _is_conservative(problem, x, 1.0)
+    merit = "none" if not line_search else ("energy" if use_energy else "residual")
+    scale = float(force_scale) if force_scale is not None else _force_scale(problem, x, free)
+    threshold = tol * scale
+    messages: list[str] = []
+
+    iterations: list[int] = []
+    residuals: list[list[float]] = []
+    loads: list[float] = []
+    nominal = 1.0 / load_steps
+    lam = 0.0
+    dlam = nominal
+    n_cuts = 0
+    cuts_this_step = 0
+    while lam < 1.0 - 1e-14:
+        target = min(1.0, lam + dlam)
+        if 1.0 - target < 1e-12:
+            target = 1.0
+        step_index = len(loads) + 1  # the load step being attempted (1-based, accepted steps + 1)
+        guess = _with_prescribed(problem, x, target)
+        try:
+            x_new, it, hist = _newton(problem, guess, free, target, threshold, max_iter, line_search,
+                                      linear_solver, symmetric, use_energy, messages, progress, step_index)
+        except _NewtonFailure as exc:
+            if cuts_this_step >= max_cuts:
+                raise ConvergenceError(
+                    f"static_solve did not converge: load step {step_index}, load factor {target:.6g} "
+                    f"(last converged load factor {lam:.6g}, increment {target - lam:.3g} after "
+                    f"{cuts_this_step} halvings), iteration {exc.iteration}, residual {exc.residual:.3e} "
+                    f"(threshold {threshold:.3e} = tol {tol:.1e} x F_ref {scale:.3e}): {exc}",
+                    load_step=step_index, load=target, iteration=exc.iteration, residual=exc.residual,
+                    x_last=x.copy(),
+                ) from None
+            dlam = 0.5 * (target - lam)
+            cuts_this_step += 1
+            n_cuts += 1
+            messages.append(f"load step {step_index} to load {target:.6g} failed at iteration "
+                            f"{exc.iteration} ({exc}); halving the increment to {dlam:.3g}")
+            continue
+        x = x_new
+        lam = target
+        iterations.append(it)
+        residuals.append(hist)
+        loads.append(lam)
+        if cuts_this_step:  # grow back towards the nominal increment
+            dlam = min(nominal, 2.0 * dlam)
+        cuts_this_step = 0
+
+    return StaticResult(
+        x=x, converged=True, iterations=iterations, residuals=residuals, loads=loads,
+        wall_time=time.perf_counter() - t_start, n_load_steps=len(loads), n_cuts=n_cuts,
+        force_scale=scale, line_search_merit=merit, messages=messages,
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# dynamics
+# --------------------------------------------------------------------------------------------
+
+def _mass_vector(problem):
+    m = np.asarray(getattr(problem, "mass"), dtype=float).reshape(-1)
+    if m.shape != (int(problem.n_dof),):
+        raise ValueError(f"problem.mass must have shape ({problem.n_dof},), got {m.shape}")
+    return m
+
+
+def explicit_stability_limit(problem, x, load: float = 1.0) -> float:
+    """Critical time step ``2 / omega_max`` of the explicit schemes at state ``x``.
+
+    ``omega_max^2`` is the largest eigenvalue of ``M^-1 K`` on the free dofs, computed as the
+    largest eigenvalue of ``M^-1/2 K M^-1/2`` (dense for up to 400 free dofs, else ARPACK
+    ``eigsh``/``eigs``, with power iteration as a fallback). For a non-symmetric ``K`` the largest
+    eigenvalue modulus is used. Returns ``inf`` when no eigenvalue is positive.
+    """
+    free = _free_mask(problem)
+    m = _mass_vector(problem)[free]
+    if np.any(m <= 0):
+        raise ValueError("masses of free dofs must be positive")
+    K = _submatrix(problem.stiffness(np.asarray(x, dtype=float), load), free)
+    d = sp.diags(1.0 / np.sqrt(m))
+    A = sp.csr_matrix(d @ K @ d)
+    symmetric = bool(getattr(problem, "symmetric", True))
+    n = A.shape[0]
+    if n == 0:
+        return float("inf")
+    if n <= 400:
+        dense = A.toarray()
+        lam = np.linalg.eigvalsh(0.5 * (dense + dense.T)).max() if symmetric else np.abs(np.linalg.eigvals(dense)).max()
+    else:
+        try:
+            if symmetric:
+                lam = float(spla.eigsh(A, k=1, which="LA", return_eigenvectors=False, tol=1e-6)[0])
+            else:
+                lam = float(np.abs(spla.eigs(A, k=1, which="LM", return_eigenvectors=False, tol=1e-6)[0]))
+        except (spla.ArpackNoConvergence, spla.ArpackError):
+            rng = np.random.default_rng(0)
+            v = rng.standard_normal(n)
+            v /= np.linalg.norm(v)
+            lam = 0.0
+            for _ in range(500):
+                w = A @ v
+                lam_new = float(np.linalg.norm(w))
+                if lam_new == 0.0:
+                    break
+                v = w / lam_new
+                if abs(lam_new - lam) <= 1e-8 * lam_new:
+                    lam = lam_new
+                    break
+                lam = lam_new
+    lam = float(lam)
+    return 2.0 / np.sqrt(lam) if lam > 0 else float("inf")
+
+
+def _resolve_damping(problem, damping):
+    if damping is None:
+        damping = getattr(problem, "damping", None)
+    if damping is None:
+        return 0.0, 0.0
+    if np.ndim(damping) == 0:
+        return float(damping), 0.0
+    alpha, beta = damping
+    return float(alpha), float(beta)
+
+
+def _bbox_size(problem, x0):
+    dim = getattr(problem, "dim", None)
+    if dim and x0.size % int(dim) == 0 and x0.size:
+        pts = x0.reshape(-1, int(dim))
+        size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    else:
+        size = float(np.ptp(x0)) if x0.size else 0.0
+    if size <= 0.0:
+        size = float(np.max(np.abs(x0))) if x0.size else 0.0
+    return size if size > 0.0 else 1.0
+
+
+def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symplectic_euler",
+              damping=None, save_every: int = 1, progress: Callable | None = None,
+              newton_tol: float = 1e-8, load: float = 1.0, newton_max_iter: int = 30,
+              linear_solver="auto", blowup: float = 1e3) -> DynamicResult:
+    """Integrate ``M dv/dt = force(x, load) - C v``, ``dx/dt = v`` from ``t = 0`` to ``t_end``.
+
+    Parameters
+    ----------
+    method : ``"symplectic_euler"`` (``v+ = v + dt M^-1 (f(x) - C v)``, ``x+ = x + dt v+``; first
+        order), ``"velocity_verlet"`` (second order; the mass-proportional damping of the second
+        half-kick is treated implicitly) or ``"implicit_euler"`` (Newton on
+        ``M (v+ - v) / dt = f(x + dt v+) - C v+`` with the Jacobian ``M + dt C + dt^2 K``; the
+        derivative of ``K`` in the ``beta K v`` term is neglected). ``n_steps = ceil(t_end / dt)``;
+        the last step is shortened to end exactly at ``t_end``.
+    damping : scalar mass-proportional coefficient ``alpha`` or Rayleigh pair ``(alpha, beta)``,
+        ``C = alpha M + beta K``. ``None`` (default) takes ``problem.damping`` if present, else 0;
+        pass ``0.0`` to force an undamped run.
+    save_every : save every n-th step (the initial and the final state are always saved).
+    progress : optional callable receiving ``{step, t, n_steps}`` at each saved step.
+    newton_tol : implicit Euler converges when ``||R[free]|| <= newton_tol * max(||M v_n||,
+        dt ||f(x_n)||, dt F_ref)`` with ``R`` the momentum residual and ``F_ref`` as in the static
+        criterion.
+    load : constant load factor passed to ``problem.force``.
+    blowup : divergence threshold: ``max |x - x0| > blowup * bounding-box size of x0``.
+
+    Raises
+    ------
+    DivergenceError when the state becomes non-finite or the displacement exceeds the bound;
+    ConvergenceError when the implicit Newton iteration fails.
+    """
+    t_start = time.perf_counter()
+    methods = ("symplectic_euler", "velocity_verlet", "implicit_euler")
+    if method not in methods:
+        raise ValueError(f"method must be one of {methods}, got {method!r}")
+    if not (dt > 0) or not (t_end >= 0):
+        raise ValueError("dt must be positive and t_end non-negative")
+    if save_every < 1:
+        raise ValueError("save_every must be >= 1")
+    n = int(problem.n_dof)
+    free = _free_mask(problem)
+    mass = _mass_vector(problem)
+    if np.any(mass[free] <= 0):
+        raise ValueError("masses of free dofs must be positive")
+    alpha, beta = _resolve_damping(problem, damping)
+    x = np.array(x0, dtype=float).reshape(-1)
+    v = np.array(v0, dtype=float).reshape(-1)
+    if x.shape != (n,) or v.shape != (n,):
+        raise ValueError(f"x0 and v0 must have {n} entries")
+    v[~free] = 0.0
+    x_ref = x.copy()
+    bound = blowup * _bbox_size(problem, x_ref)
+    symmetric = bool(getattr(problem, "symmetric", True))
+    conservative = _is_conservative(problem, x, load)
+    mf = mass[free]
+    inv_m = 1.0 / mf
+    n_steps = int(np.ceil(t_end / dt - 1e-9)) if t_end > 0 else 0
+    stats = {"n_steps": n_steps, "dt": dt, "method": method, "n_force_evals": 0,
+             "n_newton_iterations": 0, "n_linear_solves": 0, "damping": (alpha, beta)}
+    messages: list[str] = []
+
+    def force(xx):
+        stats["n_force_evals"] += 1
+        return np.asarray(problem.force(xx, load), dtype=float)[free]
+
+    def damping_force(xx, vf):
+        """-(alpha M + beta K) v on the free dofs, ``vf`` the free velocities."""
+        out = -alpha * mf * vf if alpha else np.zeros_like(vf)
+        if beta:
+            out = out - beta * (_submatrix(problem.stiffness(xx, load), free) @ vf)
+        return out
+
+    f_scale = _force_scale(problem, x, free) if method == "implicit_euler" else None
+
+    ts, xs, vs, kes, pes = [], [], [], [], []
+
+    def save(step, t):
+        ts.append(t)
+        xs.append(x.copy())
+        vs.append(v.copy())
+        kes.append(0.5 * float(mass[free] @ (v[free] ** 2)))
+        if conservative:
+            pes.append(_energy_or_none(problem, x, load))
+        if progress is not None:
+            progress({"step": step, "t": t, "n_steps": n_steps})
+
+    save(0, 0.0)
+    t = 0.0
+    with np.errstate(all="ignore"):
+        f = force(x) if method == "velocity_verlet" else None
+        for step in range(1, n_steps + 1):
+            h = dt if step < n_steps else t_end - (n_steps - 1) * dt
+            x_prev, v_prev = x.copy(), v.copy()
+            vf = v[free]
+            if method == "symplectic_euler":
+                a = (force(x) + damping_force(x, vf)) * inv_m
+                vf = vf + h * a
+                x = x.copy()
+                x[free] += h * vf
+            elif method == "velocity_verlet":
+                a = (f + damping_force(x, vf)) * inv_m
+                v_half = vf + 0.5 * h * a
+                x = x.copy()
+                x[free] += h * v_half
+                f = force(x)
+                # second half-kick: mass-proportional damping at v+ (implicit), beta K at v_half
+                g = f - beta * (_submatrix(problem.stiffness(x, load), free) @ v_half) if beta else f
+                vf = (v_half + 0.5 * h * inv_m * g) / (1.0 + 0.5 * h * alpha)
+            else:
+                vf = _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, newton_tol,
+                                          newton_max_iter, f_scale, linear_solver, symmetric, stats,
+                                          messages, step, t + h)
+                x = x.copy()
+                x[free] += h * vf
+            v = np.zeros(n)
+            v[free] = vf
+            t = step * dt if step < n_steps else float(t_end)
+            _check_state(problem, x, v, x_ref, bound, step, t, dt, method, x_prev, v_prev, load)
+            if step % save_every == 0 or step == n_steps:
+                save(step, t)
+
+    stats["wall_time"] = time.perf_counter() - t_start
+    stats["messages"] = messages
+    return DynamicResult(
+        t=np.array(ts), x=np.array(xs), v=np.array(vs), x_final=x.copy(), v_final=v.copy(),
+        kinetic_energy=np.array(kes), potential_energy=np.array(pes, dtype=float) if conservative else None,
+        stats=stats,
+    )
+
+
+def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, max_iter, f_scale,
+                         linear_solver, symmetric, stats, messages, step, t_new):
+    """Backward Euler velocity update on the free dofs (Newton with residual backtracking)."""
+    f0 = np.asarray(problem.force(x, load), dtype=float)[free]
+    scale = max(float(np.linalg.norm(mf * vf)), h * float(np.linalg.norm(f0)), h * f_scale, TINY)
+    threshold = tol * scale
+
+    def residual(w):
+        xt = x.copy()
+        xt[free] += h * w
+        stats["n_force_evals"] += 1
+        f = np.asarray(problem.force(xt, load), dtype=float)[free]
+        R = mf * (w - vf) - h * (f - alpha * mf * w)
+        if beta:
+            R = R + h * beta * (_submatrix(problem.stiffness(xt, load), free) @ w)
+        return R, xt
+
+    w = vf.copy()
+    R, xt = residual(w)
+    rn = float(np.linalg.norm(R))
+    it = 0
+    while not (rn <= threshold):
+        if it >= max_iter or not np.isfinite(rn):
+            raise ConvergenceError(
+                f"implicit Euler Newton iteration did not converge at step {step}, t = {t_new:.6g} s: "
+                f"iteration {it}, residual {rn:.3e} (threshold {threshold:.3e})",
+                iteration=it, residual=rn, x_last=x.copy(), step=step, time=t_new, load=load)
+        it += 1
+        K = _submatrix(problem.stiffness(xt, load), free)
+        J = sp.diags(mf * (1.0 + h * alpha)) + (h * h + h * beta) * K
+        try:
+            dw = _linear_solve(sp.csr_matrix(J), -R, linear_solver, symmetric, messages)
+        except _NewtonFailure as exc:
+            raise ConvergenceError(
+                f"implicit Euler linear solve failed at step {step}, t = {t_new:.6g} s, iteration {it}: {exc}",
+                iteration=it, residual=rn, x_last=x.copy(), step=step, time=t_new, load=load) from None
+        stats["n_linear_solves"] += 1
+        lam = 1.0
+        for _ in range(_MAX_BACKTRACKS + 1):
+            Rt, xtt = residual(w + lam * dw)
+            rtn = float(np.linalg.norm(Rt))
+            if np.isfinite(rtn) and rtn <= (1.0 - _ARMIJO_C * lam) * rn:
+                break
+            lam *= 0.5
+        else:
+            raise ConvergenceError(
+                f"implicit Euler line search failed at step {step}, t = {t_new:.6g} s, iteration {it}, "
+                f"residual {rn:.3e}", iteration=it, residual=rn, x_last=x.copy(), step=step, time=t_new,
+                load=load)
+        w = w + lam * dw
+        R, xt, rn = Rt, xtt, rtn
+    stats["n_newton_iterations"] += it
+    return w
+
+
+def _check_state(problem, x, v, x_ref, bound, step, t, dt, method, x_prev, v_prev, load):
+    """Raise DivergenceError if x or v is non-finite or the displacement exceeds ``bound``."""
+    quantity = None
+    if not np.all(np.isfinite(v)):
+        dof = int(np.flatnonzero(~np.isfinite(v))[0])
+        quantity, value = "velocity", v[dof]
+    elif not np.all(np.isfinite(x)):
+        dof = int(np.flatnonzero(~np.isfinite(x))[0])
+        quantity, value = "position", x[dof]
+    else:
+        disp = np.abs(x - x_ref)
+        dof = int(np.argmax(disp))
+        if disp[dof] > bound:
+            quantity, value = "displacement", x[dof] - x_ref[dof]
+    if quantity is None:
+        return
+    if quantity == "displacement":
+        what = f"displacement of dof {dof} = {value:.3e} exceeds the bound {bound:.3e}"
+    else:
+        what = f"{quantity} of dof {dof} = {value}"
+    hint = ""
+    if method != "implicit_euler":
+        try:
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                limit = explicit_stability_limit(problem, x_prev, load)
+            hint = (f"; dt = {dt:.3g} s may exceed the explicit stability limit ~ 2/omega_max = {limit:.3g} s"
+                    f" (estimated at the last finite state)")
+        except Exception:  # noqa: BLE001 - the hint is best effort
+            hint = "; dt may exceed the explicit stability limit ~ 2/omega_max"
+    raise DivergenceError(
+        f"{method} diverged: {what} at step {step}, t = {t:.6g} s{hint}",
+        step=step, time=t, quantity=quantity, dof=dof, value=float(value), x_last=x_prev, v_last=v_prev,
+    )

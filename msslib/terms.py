@@ -1,0 +1,697 @@
+"""Force terms of a mass-spring system: springs, volume energies, external loads, corrections.
+
+Every term works on the flat state ``x`` (node positions, ``n_nodes * dim`` long, interleaved by
+node, see :mod:`msslib.solvers`) and shares one interface:
+
+``energy(x) -> float or None``
+    Potential energy of the term (J) at unit load; ``None`` for a non-conservative term.
+``gradient(x) -> ndarray (n_dof,)``
+    ``dW/dx`` (N): the force of the term is minus this.  For a non-conservative term it is simply
+    minus its force (there is no ``W``).
+``hessian_pattern() -> (rows, cols)``
+    Dof indices of the term's Hessian entries, element by element (each element contributes a
+    dense ``n_local x n_local`` row-major block).  The pattern depends only on the topology: it
+    is computed once and cached.
+``hessian_values(x) -> ndarray``
+    Values of the entries of ``hessian_pattern()`` at ``x`` (N/m), filled by a numba loop.
+``hessian_coo(x) -> (rows, cols, vals)``
+    Convenience: the pattern and the values together (duplicates are to be summed).
+
+Class attributes describe how a :class:`msslib.model.Model` combines the terms:
+``conservative`` (False: the model's energy is ``None``), ``scales_with_load`` (True: external
+terms whose contribution is multiplied by the load factor) and ``symmetric`` (Hessian symmetry).
+
+Internal terms use the generated kernels of :mod:`msslib.generated.kernels` (energy, gradient and
+Hessian of the exact energies the derivations linearise), compiled by numba on first use with
+``cache=True``.  The first call of a kernel family compiles it (seconds; the hexahedron Hessian
+about ten seconds); later processes load it from ``__pycache__``.  Note numba's cache tracks the
+source file of the jitted loops only: after regenerating ``msslib/generated/kernels.py`` remove
+the ``msslib/__pycache__/terms.*.nbi``/``.nbc`` files so the loops are recompiled.
+
+Terms with no elements never call numba (cheap when absent).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from msslib.generated import kernels as _K
+
+__all__ = [
+    "Term",
+    "Springs",
+    "TetVolume",
+    "HexVolume",
+    "ExternalForce",
+    "Gravity",
+    "NodalForces",
+    "Traction",
+    "BaudetCorrection",
+    "sum_external_forces",
+]
+
+_jit = njit(cache=True, error_model="numpy", nogil=True)
+
+# kernels compiled for scalars (they also work on arrays in plain numpy)
+_s2e, _s2g, _s2h = (_jit(f) for f in (_K.spring2d_energy, _K.spring2d_gradient, _K.spring2d_hessian))
+_s3e, _s3g, _s3h = (_jit(f) for f in (_K.spring3d_energy, _K.spring3d_gradient, _K.spring3d_hessian))
+_te, _tg, _th = (_jit(f) for f in (_K.tet_volume_energy, _K.tet_volume_gradient, _K.tet_volume_hessian))
+_he, _hg, _hh = (_jit(f) for f in (_K.hex_volume_energy, _K.hex_volume_gradient, _K.hex_volume_hessian))
+
+
+# --------------------------------------------------------------------------------------------
+# numba loops.  ``x`` flat positions, ``conn`` (m, nodes) int64, per-element parameters p, q.
+# Gradient loops accumulate into ``g``; Hessian loops write one row-major block per element.
+# --------------------------------------------------------------------------------------------
+
+
+@_jit
+def _spring2d_energy_loop(x, conn, k, L0):
+    e = 0.0
+    for s in range(conn.shape[0]):
+        a, b = 2 * conn[s, 0], 2 * conn[s, 1]
+        e += _s2e(x[a], x[a + 1], x[b], x[b + 1], k[s], L0[s])
+    return e
+
+
+@_jit
+def _spring2d_gradient_loop(x, conn, k, L0, g):
+    for s in range(conn.shape[0]):
+        a, b = 2 * conn[s, 0], 2 * conn[s, 1]
+        r = _s2g(x[a], x[a + 1], x[b], x[b + 1], k[s], L0[s])
+        g[a] += r[0]
+        g[a + 1] += r[1]
+        g[b] += r[2]
+        g[b + 1] += r[3]
+
+
+@_jit
+def _spring2d_hessian_loop(x, conn, k, L0, out):
+    for s in range(conn.shape[0]):
+        a, b = 2 * conn[s, 0], 2 * conn[s, 1]
+        h = _s2h(x[a], x[a + 1], x[b], x[b + 1], k[s], L0[s])
+        for i in range(16):
+            out[s, i] = h[i]
+
+
+@_jit
+def _spring3d_energy_loop(x, conn, k, L0):
+    e = 0.0
+    for s in range(conn.shape[0]):
+        a, b = 3 * conn[s, 0], 3 * conn[s, 1]
+        e += _s3e(x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2], k[s], L0[s])
+    return e
+
+
+@_jit
+def _spring3d_gradient_loop(x, conn, k, L0, g):
+    for s in range(conn.shape[0]):
+        a, b = 3 * conn[s, 0], 3 * conn[s, 1]
+        r = _s3g(x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2], k[s], L0[s])
+        for i in range(3):
+            g[a + i] += r[i]
+            g[b + i] += r[3 + i]
+
+
+@_jit
+def _spring3d_hessian_loop(x, conn, k, L0, out):
+    for s in range(conn.shape[0]):
+        a, b = 3 * conn[s, 0], 3 * conn[s, 1]
+        h = _s3h(x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2], k[s], L0[s])
+        for i in range(36):
+            out[s, i] = h[i]
+
+
+@_jit
+def _gather3(x, nodes, c):
+    for j in range(nodes.shape[0]):
+        n = 3 * nodes[j]
+        c[3 * j] = x[n]
+        c[3 * j + 1] = x[n + 1]
+        c[3 * j + 2] = x[n + 2]
+
+
+@_jit
+def _tet_energy_loop(x, conn, kv, V0):
+    c = np.empty(12)
+    e = 0.0
+    for m in range(conn.shape[0]):
+        _gather3(x, conn[m], c)
+        e += _te(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11], kv[m], V0[m])
+    return e
+
+
+@_jit
+def _tet_gradient_loop(x, conn, kv, V0, g):
+    c = np.empty(12)
+    for m in range(conn.shape[0]):
+        _gather3(x, conn[m], c)
+        r = _tg(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11], kv[m], V0[m])
+        for j in range(4):
+            n = 3 * conn[m, j]
+            for d in range(3):
+                g[n + d] += r[3 * j + d]
+
+
+@_jit
+def _tet_hessian_loop(x, conn, kv, V0, out):
+    c = np.empty(12)
+    for m in range(conn.shape[0]):
+        _gather3(x, conn[m], c)
+        h = _th(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11], kv[m], V0[m])
+        for i in range(144):
+            out[m, i] = h[i]
+
+
+@_jit
+def _hex_energy_loop(x, conn, kap, V0):
+    c = np.empty(24)
+    e = 0.0
+    for m in range(conn.shape[0]):
+        _gather3(x, conn[m], c)
+        e += _he(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11],
+                 c[12], c[13], c[14], c[15], c[16], c[17], c[18], c[19], c[20], c[21], c[22], c[23],
+                 kap[m], V0[m])
+    return e
+
+
+@_jit
+def _hex_gradient_loop(x, conn, kap, V0, g):
+    c = np.empty(24)
+    for m in range(conn.shape[0]):
+        _gather3(x, conn[m], c)
+        r = _hg(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11],
+                c[12], c[13], c[14], c[15], c[16], c[17], c[18], c[19], c[20], c[21], c[22], c[23],
+                kap[m], V0[m])
+        for j in range(8):
+            n = 3 * conn[m, j]
+            for d in range(3):
+                g[n + d] += r[3 * j + d]
+
+
+@_jit
+def _hex_hessian_loop(x, conn, kap, V0, out):
+    c = np.empty(24)
+    for m in range(conn.shape[0]):
+        _gather3(x, conn[m], c)
+        h = _hh(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11],
+                c[12], c[13], c[14], c[15], c[16], c[17], c[18], c[19], c[20], c[21], c[22], c[23],
+                kap[m], V0[m])
+        for i in range(576):
+            out[m, i] = h[i]
+
+
+# --------------------------------------------------------------------------------------------
+# helpers
+# --------------------------------------------------------------------------------------------
+
+
+def _as_flat(x) -> np.ndarray:
+    return np.ascontiguousarray(x, dtype=float).ravel()
+
+
+def _per_element(name, values, m) -> np.ndarray:
+    values = np.ascontiguousarray(np.broadcast_to(np.asarray(values, dtype=float), (m,)))
+    return values.copy()
+
+
+def _connectivity(name, conn, nodes) -> np.ndarray:
+    conn = np.ascontiguousarray(conn, dtype=np.int64)
+    if conn.ndim != 2 or conn.shape[1] != nodes:
+        raise ValueError(f"{name} must have shape (m, {nodes}), got {conn.shape}")
+    if conn.size and conn.min() < 0:
+        raise ValueError(f"{name} holds negative node ids")
+    return conn
+
+
+def _format_bad(ids, values, label, conn=None, max_report=10) -> str:
+    parts = []
+    for i in ids[:max_report]:
+        nodes = f" (nodes {'-'.join(str(int(n)) for n in conn[i])})" if conn is not None else ""
+        parts.append(f"{label} {int(i)}{nodes}: {float(values[i])!r}")
+    more = f" and {len(ids) - max_report} more" if len(ids) > max_report else ""
+    return ", ".join(parts) + more
+
+
+def _block_pattern(conn: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and cols of dense element blocks, element-major, each block row-major."""
+    m, nv = conn.shape
+    dofs = (dim * conn[:, :, None] + np.arange(dim)).reshape(m, nv * dim)
+    n_loc = nv * dim
+    rows = np.repeat(dofs, n_loc, axis=1).ravel()
+    cols = np.tile(dofs, (1, n_loc)).ravel()
+    return rows, cols
+
+
+# --------------------------------------------------------------------------------------------
+# base classes
+# --------------------------------------------------------------------------------------------
+
+
+class Term:
+    """Base class; see the module docstring for the interface."""
+
+    conservative = True
+    scales_with_load = False
+    symmetric = True
+    dim: int = 3
+
+    def energy(self, x) -> float | None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def gradient(self, x) -> np.ndarray:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def max_node(self) -> int:
+        """Largest node id the term refers to (-1 if none); used to check it fits a mesh."""
+        return -1
+
+    def hessian_pattern(self) -> tuple[np.ndarray, np.ndarray]:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty
+
+    def hessian_values(self, x) -> np.ndarray:
+        return np.zeros(0)
+
+    def hessian_coo(self, x):
+        rows, cols = self.hessian_pattern()
+        return rows, cols, self.hessian_values(x)
+
+
+class _ElementTerm(Term):
+    """A term made of elements with ``conn`` (m, nodes), parameters ``p`` and ``q`` per element,
+    and three numba loops."""
+
+    _loops: tuple = ()
+    _n_local: int = 0
+
+    def __len__(self):
+        return len(self.conn)
+
+    def max_node(self) -> int:
+        return int(self.conn.max()) if self.conn.size else -1
+
+    def energy(self, x) -> float:
+        if len(self.conn) == 0:
+            return 0.0
+        return float(self._loops[0](_as_flat(x), self.conn, self._p, self._q))
+
+    def gradient(self, x) -> np.ndarray:
+        x = _as_flat(x)
+        g = np.zeros(x.size)
+        if len(self.conn):
+            self._loops[1](x, self.conn, self._p, self._q, g)
+        return g
+
+    def hessian_pattern(self):
+        if getattr(self, "_pattern", None) is None:
+            self._pattern = _block_pattern(self.conn, self.dim)
+        return self._pattern
+
+    def hessian_values(self, x) -> np.ndarray:
+        out = np.empty((len(self.conn), self._n_local))
+        if len(self.conn):
+            self._loops[2](_as_flat(x), self.conn, self._p, self._q, out)
+        return out.ravel()
+
+
+# --------------------------------------------------------------------------------------------
+# internal terms
+# --------------------------------------------------------------------------------------------
+
+
+class Springs(_ElementTerm):
+    """Springs ``k/2 (|x_b - x_a| - L0)^2`` between node pairs.
+
+    Parameters
+    ----------
+    pairs : (s, 2) int node ids.
+    k : (s,) spring constants (N/m), finite and > 0.  A zero or negative constant (typically from
+        a sliver or inverted element) raises ValueError naming the offending springs; it is never
+        used silently.
+    rest_length : (s,) rest lengths (m), finite and > 0.  A rest length that differs from the
+        distance of the nodes in the mesh prestrains the spring (e.g. Lloyd's squares).
+    dim : 2 or 3.
+    """
+
+    def __init__(self, pairs, k, rest_length, dim: int):
+        if dim not in (2, 3):
+            raise ValueError(f"dim must be 2 or 3, got {dim!r}")
+        self.dim = dim
+        self.conn = _connectivity("pairs", pairs, 2)
+        s = len(self.conn)
+        self.k = _per_element("k", k, s)
+        self.rest_length = _per_element("rest_length", rest_length, s)
+        bad = np.flatnonzero(~(np.isfinite(self.k) & (self.k > 0)))
+        if len(bad):
+            raise ValueError(
+                f"{len(bad)} spring(s) with a non-positive or non-finite spring constant k (N/m), "
+                f"e.g. from degenerate or inverted elements: {_format_bad(bad, self.k, 'spring', self.conn)}"
+            )
+        bad = np.flatnonzero(~(np.isfinite(self.rest_length) & (self.rest_length > 0)))
+        if len(bad):
+            raise ValueError(
+                f"{len(bad)} spring(s) with a non-positive or non-finite rest length (m): "
+                f"{_format_bad(bad, self.rest_length, 'spring', self.conn)}"
+            )
+        self._p, self._q = self.k, self.rest_length
+        self._n_local = (2 * dim) ** 2
+        self._loops = (
+            (_spring2d_energy_loop, _spring2d_gradient_loop, _spring2d_hessian_loop)
+            if dim == 2
+            else (_spring3d_energy_loop, _spring3d_gradient_loop, _spring3d_hessian_loop)
+        )
+
+    @property
+    def pairs(self) -> np.ndarray:
+        return self.conn
+
+    def lengths(self, x) -> np.ndarray:
+        """Current length of every spring (m)."""
+        p = _as_flat(x).reshape(-1, self.dim)
+        return np.linalg.norm(p[self.conn[:, 1]] - p[self.conn[:, 0]], axis=1)
+
+    def tensions(self, x) -> np.ndarray:
+        """Spring tensions ``k (l - L0)`` (N), positive when stretched."""
+        return self.k * (self.lengths(x) - self.rest_length)
+
+
+def _check_rest_volumes(name, V0):
+    bad = np.flatnonzero(~(np.isfinite(V0) & (V0 > 0)))
+    if len(bad):
+        raise ValueError(f"{name}: rest volumes V0 must be finite and > 0: {_format_bad(bad, V0, 'cell')}")
+
+
+class TetVolume(_ElementTerm):
+    """Lloyd's tetrahedron volume energy ``k_v / (2 V0^2) (V - V0)^2`` (V the signed volume).
+
+    ``tets`` (m, 4) positively oriented, ``k_v`` (m,) in J (N m) — it may be negative (Lloyd's
+    k_V is negative for nu < 3/13), only finiteness is checked — ``V0`` (m,) rest volumes > 0.
+    """
+
+    def __init__(self, tets, k_v, V0):
+        self.dim = 3
+        self.conn = _connectivity("tets", tets, 4)
+        m = len(self.conn)
+        self.k_v = _per_element("k_v", k_v, m)
+        self.V0 = _per_element("V0", V0, m)
+        if not np.isfinite(self.k_v).all():
+            raise ValueError("TetVolume: k_v must be finite")
+        _check_rest_volumes("TetVolume", self.V0)
+        self._p, self._q = self.k_v, self.V0
+        self._n_local = 144
+        self._loops = (_tet_energy_loop, _tet_gradient_loop, _tet_hessian_loop)
+
+
+class HexVolume(_ElementTerm):
+    """Golec's hexahedron volume correction ``kappa / (2 V0) (V - V0)^2`` with the averaged-edge
+    volume ``V`` (:func:`msslib.generated.kernels.hex_averaged_volume`).
+
+    ``hexes`` (m, 8) in VTK order, ``kappa`` (m,) in Pa, ``V0`` (m,) rest volumes > 0 (use the
+    averaged volume of the rest configuration so that the term is unloaded at rest).
+
+    ``kappa`` may be negative: Golec's kappa is negative for nu < 1/4, where the term *lowers*
+    the volumetric stiffness the springs give; it is then not convex by itself and only the sum
+    with the springs is positive definite.  Only finiteness is checked.
+    """
+
+    def __init__(self, hexes, kappa, V0):
+        self.dim = 3
+        self.conn = _connectivity("hexes", hexes, 8)
+        m = len(self.conn)
+        self.kappa = _per_element("kappa", kappa, m)
+        self.V0 = _per_element("V0", V0, m)
+        if not np.isfinite(self.kappa).all():
+            raise ValueError("HexVolume: kappa must be finite")
+        _check_rest_volumes("HexVolume", self.V0)
+        self._p, self._q = self.kappa, self.V0
+        self._n_local = 576
+        self._loops = (_hex_energy_loop, _hex_gradient_loop, _hex_hessian_loop)
+
+
+# --------------------------------------------------------------------------------------------
+# external (dead) loads, scaled by the load factor
+# --------------------------------------------------------------------------------------------
+
+
+class ExternalForce(Term):
+    """A constant (dead) nodal force ``f`` (N, flat ``(n_dof,)``) at unit load.
+
+    Energy ``-f . x``, gradient ``-f``, zero Hessian.  ``scales_with_load``: a model multiplies
+    it by the load factor.
+    """
+
+    scales_with_load = True
+
+    def __init__(self, forces, dim: int):
+        forces = np.asarray(forces, dtype=float)
+        if forces.ndim != 2 or forces.shape[1] != dim:
+            raise ValueError(f"forces must have shape (n_nodes, {dim}), got {forces.shape}")
+        if not np.isfinite(forces).all():
+            raise ValueError("forces must be finite")
+        self.dim = dim
+        self.nodal = forces
+        self.vector = forces.ravel().copy()
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.nodal)
+
+    def max_node(self) -> int:
+        return self.n_nodes - 1
+
+    @property
+    def total(self) -> np.ndarray:
+        """Resultant force (N), ``(dim,)``."""
+        return self.nodal.sum(axis=0)
+
+    def energy(self, x) -> float:
+        return -float(self.vector @ _as_flat(x))
+
+    def gradient(self, x) -> np.ndarray:
+        return -self.vector.copy()
+
+
+class NodalForces(ExternalForce):
+    """Dead nodal loads ``f`` of shape ``(n_nodes, dim)`` (N)."""
+
+    def __init__(self, forces):
+        forces = np.asarray(forces, dtype=float)
+        super().__init__(forces, forces.shape[1] if forces.ndim == 2 else 0)
+
+
+class Gravity(ExternalForce):
+    """Weight ``m_i g`` of every node: ``masses`` (n,) in kg, ``g`` (dim,) in m/s^2.
+
+    Energy ``-sum_i m_i g . x_i``; constant force, zero Hessian.
+    """
+
+    def __init__(self, masses, g):
+        masses = np.asarray(masses, dtype=float)
+        g = np.asarray(g, dtype=float).ravel()
+        if masses.ndim != 1:
+            raise ValueError(f"masses must have shape (n_nodes,), got {masses.shape}")
+        self.g = g
+        super().__init__(masses[:, None] * g[None, :], len(g))
+
+
+def _traction_nodal(points, facets, thickness):
+    """Consistent nodal weights ``w`` (f, nodes): the force on node a of facet e is
+    ``w[e, a] * traction[e]`` (reference configuration)."""
+    x = points[facets]
+    nf = facets.shape[1]
+    if nf == 2:
+        length = np.linalg.norm(x[:, 1] - x[:, 0], axis=1) * thickness
+        return np.repeat(length[:, None] / 2.0, 2, axis=1)
+    if nf == 3:
+        area = 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1)
+        return np.repeat(area[:, None] / 3.0, 3, axis=1)
+    if nf == 4:
+        # bilinear quad on [-1, 1]^2, corners counter-clockwise; 2 x 2 Gauss of N_a |dX/du x dX/dv|
+        w = np.zeros((len(facets), 4))
+        su = np.array([-1.0, 1.0, 1.0, -1.0])
+        sv = np.array([-1.0, -1.0, 1.0, 1.0])
+        for u in np.array([-1.0, 1.0]) / np.sqrt(3.0):
+            for v in np.array([-1.0, 1.0]) / np.sqrt(3.0):
+                du = 0.25 * ((x[:, 1] - x[:, 0]) * (1 - v) + (x[:, 2] - x[:, 3]) * (1 + v))
+                dv = 0.25 * ((x[:, 3] - x[:, 0]) * (1 - u) + (x[:, 2] - x[:, 1]) * (1 + u))
+                jac = np.linalg.norm(np.cross(du, dv), axis=1)
+                n = 0.25 * (1 + su * u) * (1 + sv * v)
+                w += jac[:, None] * n[None, :]
+        return w
+    raise ValueError(f"facets must have 2, 3 or 4 nodes, got {nf}")
+
+
+class Traction(ExternalForce):
+    """A traction (Pa) on boundary facets turned into consistent nodal dead loads.
+
+    ``mesh`` gives the reference node positions; ``facets`` (f, 2|3|4) node ids (e.g. from
+    :func:`msslib.mesh.boundary_facets`); ``traction`` (dim,) or (f, dim) in Pa, a fixed vector
+    (not a follower pressure).  Two-node facets (2D edges) carry ``traction * length * thickness``
+    (thickness in metres, 2D only) split in halves, triangles a third of ``traction * area`` per
+    node, quads the exact consistent forces ``integral N_a traction dA`` of the bilinear facet
+    (2 x 2 Gauss; exact for parallelograms).  ``total`` is the resultant.
+    """
+
+    def __init__(self, mesh, facets, traction, thickness: float = 1.0):
+        facets = np.asarray(facets, dtype=np.int64)
+        if facets.ndim != 2:
+            raise ValueError(f"facets must have shape (f, 2|3|4), got {facets.shape}")
+        facets = _connectivity("facets", facets, facets.shape[1])
+        dim = mesh.dim
+        if dim == 3 and thickness != 1.0:
+            raise ValueError("thickness applies to 2D meshes only")
+        if (dim == 2) != (facets.shape[1] == 2):
+            raise ValueError(f"{dim}D meshes need {'2-node' if dim == 2 else '3- or 4-node'} facets")
+        traction = np.broadcast_to(np.asarray(traction, dtype=float), (len(facets), dim))
+        w = _traction_nodal(mesh.points, facets, float(thickness))
+        nodal = np.zeros((mesh.n_nodes, dim))
+        for d in range(dim):
+            nodal[:, d] = np.bincount(facets.ravel(), weights=(w * traction[:, d:d + 1]).ravel(),
+                                      minlength=mesh.n_nodes)
+        self.facets = facets
+        self.traction = np.array(traction)
+        super().__init__(nodal, dim)
+
+
+def sum_external_forces(terms, n_nodes: int, dim: int) -> np.ndarray:
+    """Sum of the nodal forces ``(n_nodes, dim)`` at unit load of the :class:`ExternalForce`
+    terms in ``terms`` (other terms are ignored)."""
+    total = np.zeros((n_nodes, dim))
+    for t in terms:
+        if isinstance(t, ExternalForce):
+            if t.nodal.shape != total.shape:
+                raise ValueError(f"external term {type(t).__name__} has shape {t.nodal.shape}, expected {total.shape}")
+            total += t.nodal
+    return total
+
+
+# --------------------------------------------------------------------------------------------
+# Baudet's orthogonal correction (non-conservative, load dependent)
+# --------------------------------------------------------------------------------------------
+
+# local faces of a hexahedron (msslib.mesh order, right-hand normal outward) and the three pairs
+# of opposite faces: bottom/top, y-min/y-max, x-max/x-min of a reference cube
+_HEX_FACES = np.array([[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]])
+_FACE_PAIRS = np.array([[0, 1], [2, 4], [3, 5]])
+
+
+class BaudetCorrection(Term):
+    """Baudet et al.'s orthogonal correction forces for hexahedral (cube) elements.
+
+    Baudet's cube springs alone give the wrong Poisson contraction; the correction adds, for
+    every element with an externally loaded face, forces on the four faces orthogonal to the
+    elongation direction.  Construction (all at unit load, in the *reference* configuration):
+
+    1. External forces ``loads`` (n, 3) (an array, or terms whose :class:`ExternalForce` parts are
+       summed — pass only surface loads, not gravity) live on the nodes.  Candidate faces are the
+       mesh's boundary faces, with outward unit normal ``n_f``.
+    2. Sharing rule: the force ``f_a`` of node ``a`` is shared among the boundary faces containing
+       ``a`` in proportion to ``|f_a . n_f|``; so a traction on the top of a block goes entirely
+       to the top faces (a side face with normal orthogonal to the load gets nothing) and a node
+       inside a loaded surface splits its force equally among its faces.  The elongation force of
+       face ``f`` is ``F_f = sum_a share_af (f_a . n_f)`` (> 0 tension, < 0 compression); for a
+       uniform traction with consistent nodal forces it is exactly the face's normal resultant.
+       A face is loaded when ``F_f != 0``.
+    3. Per element and per pair of opposite faces the elongation force ``F_i`` is the one of the
+       two faces with the larger magnitude (if both are loaded, as in a free cube pulled at both
+       ends, the tension is counted once).
+    4. The correction amplitude is ``F_perp = c F_i`` with ``c = factor`` per element (from
+       :func:`msslib.parameters.baudet_cube` ``.correction_factor``, i.e. ``-(4 nu - 1) / 16``).
+       On each of the two other pairs of faces ``(j, j')`` the force ``F_perp d / 4`` is applied to
+       each node of ``j`` and ``-F_perp d / 4`` to each node of ``j'``, ``d`` the unit vector from
+       the centroid of ``j'`` to the centroid of ``j`` (the outward normal of ``j`` for a cube).
+       For nu > 1/4, ``c < 0``: a stretched element is pinched on its sides.
+
+    The two forces of a face pair are equal, opposite and collinear (they act along the line
+    through both face centroids), so every element's correction has zero resultant force and zero
+    moment, for any hexahedron shape.
+
+    Directions are those of the reference configuration: the correction is a constant nodal force
+    vector per unit load, scaled by the load factor.  Its Jacobian is therefore zero (no Hessian
+    entries) and the static stiffness stays that of the springs.  It is treated as
+    non-conservative (``energy`` returns None; Baudet's force is defined from the applied load,
+    not from a potential), so a model containing it reports ``energy = None``.
+    """
+
+    conservative = False
+    scales_with_load = True
+    dim = 3
+
+    def __init__(self, mesh, loads, factor):
+        if mesh.cell_type != "hexahedron":
+            raise ValueError(f"BaudetCorrection needs hexahedron cells, got {mesh.cell_type}")
+        if not isinstance(loads, np.ndarray) and not np.isscalar(loads):
+            try:
+                loads = np.asarray(loads, dtype=float)
+            except (TypeError, ValueError):
+                loads = sum_external_forces(loads, mesh.n_nodes, 3)
+        loads = np.asarray(loads, dtype=float)
+        if loads.shape != (mesh.n_nodes, 3):
+            raise ValueError(f"loads must have shape ({mesh.n_nodes}, 3), got {loads.shape}")
+        factor = _per_element("factor", factor, mesh.n_cells)
+        if not np.isfinite(factor).all():
+            raise ValueError("BaudetCorrection: factor must be finite")
+        self.factor = factor
+        self.loads = loads
+        self.face_force = self._face_elongation(mesh, loads)  # (m, 6)
+        nodal = self._correction(mesh, self.face_force, factor)
+        self.nodal = nodal
+        self.vector = nodal.ravel()
+
+    @staticmethod
+    def _face_elongation(mesh, loads):
+        m = mesh.n_cells
+        faces = mesh.cells[:, _HEX_FACES]  # (m, 6, 4)
+        flat = faces.reshape(-1, 4)
+        _, inverse, counts = np.unique(np.sort(flat, axis=1), axis=0, return_inverse=True, return_counts=True)
+        boundary = counts[inverse.ravel()] == 1
+        p = mesh.points[flat]
+        normal = np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1])
+        normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+        fid = np.repeat(np.flatnonzero(boundary), 4)
+        node = flat[boundary].ravel()
+        proj = np.einsum("ij,ij->i", loads[node], normal[fid])
+        w = np.abs(proj)
+        denom = np.bincount(node, weights=w, minlength=mesh.n_nodes)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = np.where(denom[node] > 0, w / denom[node], 0.0)
+        face_force = np.bincount(fid, weights=share * proj, minlength=len(flat))
+        return face_force.reshape(m, 6)
+
+    @staticmethod
+    def _correction(mesh, face_force, factor):
+        m = mesh.n_cells
+        nodal = np.zeros((mesh.n_nodes, 3))
+        centroid = mesh.points[mesh.cells[:, _HEX_FACES]].mean(axis=2)  # (m, 6, 3)
+        for i, (f0, f1) in enumerate(_FACE_PAIRS):
+            a, b = face_force[:, f0], face_force[:, f1]
+            F = np.where(np.abs(a) >= np.abs(b), a, b)
+            loaded = F != 0.0
+            if not loaded.any():
+                continue
+            amp = factor[loaded] * F[loaded] / 4.0  # per node
+            cells = mesh.cells[loaded]
+            for q, (j0, j1) in enumerate(_FACE_PAIRS):
+                if q == i:
+                    continue
+                d = centroid[loaded, j1] - centroid[loaded, j0]
+                d /= np.linalg.norm(d, axis=1, keepdims=True)
+                fj = amp[:, None] * d
+                for face, sign in ((j1, 1.0), (j0, -1.0)):
+                    nodes = cells[:, _HEX_FACES[face]]  # (k, 4)
+                    for c in range(3):
+                        nodal[:, c] += np.bincount(nodes.ravel(), weights=np.repeat(sign * fj[:, c], 4),
+                                                   minlength=mesh.n_nodes)
+        return nodal
+
+    def max_node(self) -> int:
+        return len(self.nodal) - 1
+
+    def energy(self, x):
+        return None
+
+    def gradient(self, x) -> np.ndarray:
+        """Minus the correction force at unit load (independent of ``x``)."""
+        return -self.vector.copy()
