@@ -365,7 +365,7 @@ def test_baudet_correction_single_cube(params):
     trac = Traction(mesh, top, [0.0, 0.0, 8.0])  # F_i = 8 N on the top face
     corr = baudet_correction(mesh, [(E0, NU0)], [trac])
     c = params.baudet_cube(E0, NU0, 1.0).correction_factor
-    assert np.isclose(c, -(4 * NU0 - 1) / 16)
+    assert np.isclose(c, -(4 * NU0 - 1) / 2)  # derived: resultants per face (erratum of eq. 8)
     assert np.allclose(corr.face_force[0], [0, 8.0, 0, 0, 0, 0])
     f = corr.nodal
     assert np.allclose(f.sum(axis=0), 0.0, atol=1e-12)
@@ -449,3 +449,28 @@ def test_prescribed_displacements_and_masks():
     assert model.stiffness(model.x0).nnz == model.n_dof  # empty model: the diagonal pattern only
     with pytest.raises(ValueError, match="free dofs"):
         Model(mesh, [], prescribed=presc)
+
+
+def test_baudet_cube_tension_gives_E_and_nu():
+    """A single Baudet cube in tension, with the derived correction, has the target E and nu
+    (linearised: a lone M2 cube has two zero-energy modes, which the face loads do not excite)."""
+    from msslib.model import baudet_cube_springs
+    E, nu, F = 1000.0, 0.4, 1e-3
+    mesh = M.hex_grid(1.0, 1.0, 1.0, 1, 1, 1)
+    top = mesh.cells[:, 4:]
+    bottom = mesh.cells[:, [0, 3, 2, 1]]
+    loads = [Traction(mesh, top, [0.0, 0.0, F]), Traction(mesh, bottom, [0.0, 0.0, -F])]
+    corr = baudet_correction(mesh, [(E, nu)], loads)
+    fixed = np.zeros((8, 3), bool)
+    c = mesh.cells[0]  # VTK order: pin node 0, node 1 (along x) in y, z and node 3 (along y) in z
+    fixed[c[0]] = True
+    fixed[c[1], [1, 2]] = True
+    fixed[c[3], 2] = True
+    model = Model(mesh, baudet_cube_springs(mesh, [(E, nu)]) + loads + [corr], fixed=fixed)
+    K = model.stiffness(model.x0).toarray()
+    u = np.linalg.lstsq(K, model.force(model.x0), rcond=None)[0].reshape(-1, 3)
+    P = mesh.points
+    ez = u[P[:, 2] > 0.5, 2].mean() - u[P[:, 2] < 0.5, 2].mean()
+    ex = u[P[:, 0] > 0.5, 0].mean() - u[P[:, 0] < 0.5, 0].mean()
+    assert F / ez == pytest.approx(E, rel=1e-4)
+    assert -ex / ez == pytest.approx(nu, rel=1e-4)
