@@ -21,6 +21,8 @@ returns a list of terms, to be combined with loads into a :class:`Model`.
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -402,21 +404,22 @@ def _tet_rest_volumes(mesh):
     return np.asarray(_K.tet_signed_volume(*[p[:, a, d] for a in range(4) for d in range(3)]), dtype=float)
 
 
-def lloyd_tet_springs(mesh, materials, volume: bool = False) -> list[Term]:
+def lloyd_tet_springs(mesh, materials, volume: bool = False, published: bool = False) -> list[Term]:
     """Lloyd et al.'s springs on the edges of a tetrahedral mesh.
 
     Each tetrahedron of volume ``V`` is treated as a regular one of the same volume, edge
     ``l_hat = (6 sqrt(2) V)^(1/3)``; its constant ``parameters.lloyd_tetrahedron(E, l_hat).k`` is
     added to each of its edges.  With ``volume=True`` the constants come from
     ``parameters.lloyd_tetrahedron_volume(E, l_hat, nu)`` (``k``, ``k_volume``) and a
-    :class:`TetVolume` term with ``k_v = k_volume`` and ``V0 = V`` is added.
+    :class:`TetVolume` term with ``k_v = k_volume`` and ``V0 = V`` is added; ``published=True`` uses
+    eq. 14 as printed (its values at nu = 1/4) instead of the optimum for each nu.
     """
     V = _require(mesh, "tetra")
     E, nu = material_arrays(mesh, materials)
     l_hat = np.cbrt(6.0 * np.sqrt(2.0) * V)
     P = _parameters()
     if volume:
-        k, k_vol = _per_cell(P.lloyd_tetrahedron_volume, ("k", "k_volume"), E, l_hat, nu)
+        k, k_vol = _per_cell(partial(P.lloyd_tetrahedron_volume, published=published), ("k", "k_volume"), E, l_hat, nu)
     else:
         (k,) = _per_cell(P.lloyd_tetrahedron, ("k",), E, l_hat)
     terms: list[Term] = [assemble_springs(mesh, "edges", lambda c, _p: k[c])]
@@ -425,28 +428,30 @@ def lloyd_tet_springs(mesh, materials, volume: bool = False) -> list[Term]:
     return terms
 
 
-def baudet_cube_springs(mesh, materials) -> list[Term]:
+def baudet_cube_springs(mesh, materials, published: bool = False) -> list[Term]:
     """Baudet et al.'s springs on a mesh of cubes: per cube ``k_edge`` on its 12 edges (summed over
     the cubes sharing an edge) and ``k_diagonal`` on its 4 inner diagonals
     (``parameters.baudet_cube(E, nu, a)``, ``a`` the cube's edge).  Add :func:`baudet_correction`
-    for the Poisson effect under load."""
+    for the Poisson effect under load. (The printed and derived spring constants agree;
+    ``published`` is accepted for symmetry with the other builders.)"""
     _require(mesh, "hexahedron")
     a = _cube_edges(mesh)
     E, nu = material_arrays(mesh, materials)
-    k_e, k_d = _per_cell(_parameters().baudet_cube, ("k_edge", "k_diagonal"), E, nu, a)
+    k_e, k_d = _per_cell(partial(_parameters().baudet_cube, published=published), ("k_edge", "k_diagonal"), E, nu, a)
     edges = assemble_springs(mesh, "edges", lambda c, _p: k_e[c])
     inner = assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_d[c])
     return [_merge_springs([edges, inner])]
 
 
-def baudet_correction(mesh, materials, loads) -> BaudetCorrection:
+def baudet_correction(mesh, materials, loads, published: bool = False) -> BaudetCorrection:
     """:class:`msslib.terms.BaudetCorrection` for a mesh of cubes with the per-cube factor
     ``parameters.baudet_cube(E, nu, a).correction_factor``; ``loads`` (n, 3) nodal surface forces
-    at unit load, or a list of terms whose external forces are summed (leave gravity out)."""
+    at unit load, or a list of terms whose external forces are summed (leave gravity out).
+    ``published=True`` uses the printed factor -(4 nu - 1)/16 (see the errata)."""
     _require(mesh, "hexahedron")
     a = _cube_edges(mesh)
     E, nu = material_arrays(mesh, materials)
-    (c,) = _per_cell(_parameters().baudet_cube, ("correction_factor",), E, nu, a)
+    (c,) = _per_cell(partial(_parameters().baudet_cube, published=published), ("correction_factor",), E, nu, a)
     if not isinstance(loads, np.ndarray):
         try:
             loads = np.asarray(loads, dtype=float)
@@ -460,16 +465,17 @@ def _hex_rest_volumes(mesh):
     return np.asarray(_K.hex_averaged_volume(*[p[:, a, d] for a in range(8) for d in range(3)]), dtype=float)
 
 
-def golec_cube_springs(mesh, materials, A) -> list[Term]:
+def golec_cube_springs(mesh, materials, A, published: bool = False) -> list[Term]:
     """Golec et al.'s cube model: per cube ``parameters.golec_cube(E, nu, a, A)`` gives ``k_edge``
     (12 edges), ``k_face`` (12 face diagonals) and ``k_inner`` (4 inner diagonals), each summed over
     the cubes sharing the pair, and ``kappa`` for a :class:`HexVolume` term per cube with ``V0``
     the averaged-edge volume at rest.  ``A`` (a scalar or one value per cell) is passed through to
-    ``golec_cube``."""
+    ``golec_cube``. ``published=True`` uses the printed constants, per element (see the errata);
+    the volume term keeps the dimensionally consistent energy kappa/(2 V0) (V - V0)^2."""
     _require(mesh, "hexahedron")
     a = _cube_edges(mesh)
     E, nu = material_arrays(mesh, materials)
-    k_e, k_f, k_i, kappa = _per_cell(_parameters().golec_cube, ("k_edge", "k_face", "k_inner", "kappa"),
+    k_e, k_f, k_i, kappa = _per_cell(partial(_parameters().golec_cube, published=published), ("k_edge", "k_face", "k_inner", "kappa"),
                                      E, nu, a, A)
     springs = _merge_springs([
         assemble_springs(mesh, "edges", lambda c, _p: k_e[c]),

@@ -881,70 +881,19 @@ def prepare(scene: Scene) -> Setup:
 # --------------------------------------------------------------------------------------------
 
 
-def _accepts(fn, name):
-    try:
-        return name in inspect.signature(fn).parameters
-    except (TypeError, ValueError):
-        return False
-
-
-def _published_terms(name, mesh, materials, opts):
-    """Spring/volume terms with the papers' printed constants (``published: true``)."""
-    from functools import partial
-
-    from msslib import model as M
-    from msslib import parameters as P
-    from msslib.terms import HexVolume, TetVolume
-
-    if name == "baudet_cube":
-        M._require(mesh, "hexahedron")
-        a = M._cube_edges(mesh)
-        E, nu = M.material_arrays(mesh, materials)
-        k_e, k_d = M._per_cell(partial(P.baudet_cube, published=True), ("k_edge", "k_diagonal"), E, nu, a)
-        return [M._merge_springs([M.assemble_springs(mesh, "edges", lambda c, _p: k_e[c]),
-                                  M.assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_d[c])])]
-    if name == "golec_cube":
-        M._require(mesh, "hexahedron")
-        a = M._cube_edges(mesh)
-        E, nu = M.material_arrays(mesh, materials)
-        k_e, k_f, k_i, kappa = M._per_cell(partial(P.golec_cube, published=True),
-                                           ("k_edge", "k_face", "k_inner", "kappa"), E, nu, a, opts["A"])
-        springs = M._merge_springs([
-            M.assemble_springs(mesh, "edges", lambda c, _p: k_e[c]),
-            M.assemble_springs(mesh, "face_diagonals", lambda c, _p: k_f[c]),
-            M.assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_i[c]),
-        ])
-        return [springs, HexVolume(mesh.cells, kappa, M._hex_rest_volumes(mesh))]
-    if name == "lloyd_tetrahedron_volume":
-        V = M._require(mesh, "tetra")
-        E, nu = M.material_arrays(mesh, materials)
-        l_hat = np.cbrt(6.0 * np.sqrt(2.0) * V)
-        k, k_vol = M._per_cell(partial(P.lloyd_tetrahedron_volume, published=True), ("k", "k_volume"), E, l_hat, nu)
-        return [M.assemble_springs(mesh, "edges", lambda c, _p: k[c]),
-                TetVolume(mesh.cells, k_vol, M._tet_rest_volumes(mesh))]
-    raise AssertionError(name)
-
-
 def _internal_terms(name, mesh, materials, opts, thickness):
     from msslib import model as M
 
-    published = opts["published"] and name in ("baudet_cube", "golec_cube", "lloyd_tetrahedron_volume")
+    published = opts["published"]
     builder = {
         "lloyd_triangle": lambda: M.lloyd_triangle_springs(mesh, materials, thickness),
         "van_gelder": lambda: M.van_gelder_springs(mesh, materials, thickness),
         "lloyd_square": lambda: M.lloyd_square_springs(mesh, materials, thickness),
         "lloyd_tetrahedron": lambda: M.lloyd_tet_springs(mesh, materials, volume=False),
-        "lloyd_tetrahedron_volume": lambda: M.lloyd_tet_springs(mesh, materials, volume=True),
-        "baudet_cube": lambda: M.baudet_cube_springs(mesh, materials),
-        "golec_cube": lambda: M.golec_cube_springs(mesh, materials, A=opts["A"]),
+        "lloyd_tetrahedron_volume": lambda: M.lloyd_tet_springs(mesh, materials, volume=True, published=published),
+        "baudet_cube": lambda: M.baudet_cube_springs(mesh, materials, published=published),
+        "golec_cube": lambda: M.golec_cube_springs(mesh, materials, A=opts["A"], published=published),
     }[name]
-    if published:
-        fn = {"baudet_cube": M.baudet_cube_springs, "golec_cube": M.golec_cube_springs,
-              "lloyd_tetrahedron_volume": M.lloyd_tet_springs}[name]
-        if _accepts(fn, "published"):  # the builders may grow the option themselves
-            extra = {"golec_cube": {"A": opts["A"]}, "lloyd_tetrahedron_volume": {"volume": True}}.get(name, {})
-            return fn(mesh, materials, published=True, **extra)
-        return _published_terms(name, mesh, materials, opts)
     return builder()
 
 
@@ -969,7 +918,7 @@ def _build_model(setup: Setup):
                     if kind in wanted:
                         internal.append(t)
             if "correction" in wanted:
-                internal.append(baudet_correction(mesh, materials, setup.surface_forces))
+                internal.append(baudet_correction(mesh, materials, setup.surface_forces, published=opts["published"]))
     except ValueError as exc:
         _fail("scene.model", f"{name}: {exc}")
     terms = list(internal)
