@@ -1,24 +1,73 @@
-# msslib workflow: derivations -> generated code and derivation results -> scene runs (NetCDF).
+# msslib workflow. One direction: derivations -> generated code -> runs (NetCDF) -> figures and
+# tables -> paper. Every rule calls one entry point of derivations/ or msslib, or one script of
+# experiments/; there is no physics here.
+#
 #   snakemake -j2                    everything
-#   snakemake -j2 --config quick=1   reduced version of every output (CI)
-#   snakemake -n                     show the whole DAG
-# Rules are thin: each calls one entry point of derivations/ or msslib.
+#   snakemake -j2 --config quick=1   a reduced version of every output (CI)
+#   snakemake -n                     the whole DAG
+#
+# Layout the rules discover (add a file, the DAG grows):
+#   experiments/<paper>/<name>.yaml              an experiment: cases x model variants (msslib.experiment)
+#   experiments/<paper>/studies/<study>.py       a sweep script writing one NetCDF (--out, --quick)
+#   experiments/<paper>/figures/<fig>.py         one figure (--out STEM writes STEM.png and STEM.pdf)
+#   experiments/<paper>/tables/<table>.py        one table (--out FILE.md)
+# Figure and table scripts name the results they read in a module-level INPUTS list.
+
+import ast
+from pathlib import Path
+
+import yaml
 
 QUICK = bool(int(config.get("quick", 0)))
+QFLAG = "--quick" if QUICK else ""
+PAPERS = ["lloyd", "baudet", "golec"]
 DERIVATIONS = ["triangle", "square", "rectangle", "tetrahedron", "cube_baudet", "cube_golec", "kernels"]
 ENGINE = ["__init__", "elasticity", "fem", "mss", "match", "lattice", "records", "codegen", "report"]
 SCENES = sorted(glob_wildcards("experiments/scenes/{name}.yaml").name)
 
+wildcard_constraints:
+    paper="|".join(PAPERS),
+    exp=r"[A-Za-z0-9_\-]+",
+    case=r"[A-Za-z0-9_\-]+?",
+    model=r"[A-Za-z0-9_\-]+",
+    name=r"[A-Za-z0-9_\-]+",
+
+
+def experiments():
+    return {(p.parent.name, p.stem): p for paper in PAPERS for p in sorted(Path("experiments", paper).glob("*.yaml"))}
+
+
+def runs(paper, exp):
+    raw = yaml.safe_load(Path("experiments", paper, f"{exp}.yaml").read_text())
+    cases = raw.get("cases") or {"default": {}}
+    return [f"{c}__{m}" for c in cases for m in raw["models"]]
+
+
+def scripts(kind):
+    return {(p.parent.parent.name, p.stem): p for paper in PAPERS for p in sorted(Path("experiments", paper, kind).glob("*.py"))}
+
+
+def declared_inputs(path):
+    """The INPUTS list a figure or table script declares (read, not executed)."""
+    for node in ast.parse(Path(path).read_text()).body:
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "INPUTS" for t in node.targets):
+            return list(ast.literal_eval(node.value))
+    return []
+
+
+FIGURES = [f"paper/figures/{p}_{n}.png" for p, n in scripts("figures")]
+TABLES = ([f"paper/tables/experiments/{p}_{n}.md" for p, n in experiments()]
+          + [f"paper/tables/{p}_{n}.md" for p, n in scripts("tables")])
+
 
 rule all:
     input:
-        "paper/errata.md",
-        "paper/derivations.md",
+        "paper/build/paper.html",
         expand("results/scenes/{name}.nc", name=SCENES),
 
 
 rule codegen:
-    """Re-derive every element family, regenerate msslib/generated/ and the errata."""
+    """Re-derive every element family; regenerate msslib/generated/, the errata and the derivation results."""
     input:
         expand("derivations/{m}.py", m=DERIVATIONS + ENGINE),
     output:
@@ -32,7 +81,7 @@ rule codegen:
 
 
 rule scene:
-    """Run one declarative scene (MSS or FEM) into a NetCDF result."""
+    """Run one example scene (MSS or FEM) into a NetCDF result."""
     input:
         scene="experiments/scenes/{name}.yaml",
         derived="paper/derivations.json",
@@ -42,3 +91,89 @@ rule scene:
         "logs/scenes/{name}.log",
     shell:
         "python -m msslib run {input.scene} --out {output} --quiet > {log} 2>&1"
+
+
+rule experiment_run:
+    """One (case, model variant) of an experiment."""
+    input:
+        exp="experiments/{paper}/{exp}.yaml",
+        derived="paper/derivations.json",
+    output:
+        "results/{paper}/{exp}/{case}__{model}.nc",
+    params:
+        quick=QFLAG,
+    log:
+        "logs/{paper}/{exp}/{case}__{model}.log",
+    shell:
+        "python -m msslib experiment run {input.exp} --case {wildcards.case} --model {wildcards.model} "
+        "{params.quick} --quiet --out {output} > {log} 2>&1"
+
+
+rule experiment_compare:
+    """Every variant against the reference, beside the published numbers: NetCDF and a table."""
+    input:
+        exp="experiments/{paper}/{exp}.yaml",
+        runs=lambda wc: expand("results/{paper}/{exp}/{run}.nc", paper=wc.paper, exp=wc.exp, run=runs(wc.paper, wc.exp)),
+    output:
+        nc="results/{paper}/{exp}/comparison.nc",
+        table="paper/tables/experiments/{paper}_{exp}.md",
+    log:
+        "logs/{paper}/{exp}/compare.log",
+    shell:
+        "python -m msslib experiment compare {input.exp} --results results/{wildcards.paper}/{wildcards.exp} "
+        "--out {output.nc} --table {output.table} > {log} 2>&1"
+
+
+rule study:
+    """A sweep that does not fit cases x models (e.g. error against strain or nu)."""
+    input:
+        script="experiments/{paper}/studies/{name}.py",
+        derived="paper/derivations.json",
+    output:
+        "results/{paper}/studies/{name}.nc",
+    params:
+        quick=QFLAG,
+    log:
+        "logs/{paper}/studies/{name}.log",
+    shell:
+        "python {input.script} --out {output} {params.quick} > {log} 2>&1"
+
+
+rule figure:
+    input:
+        script="experiments/{paper}/figures/{name}.py",
+        data=lambda wc: declared_inputs(f"experiments/{wc.paper}/figures/{wc.name}.py"),
+    output:
+        png="paper/figures/{paper}_{name}.png",
+        pdf="paper/figures/{paper}_{name}.pdf",
+    log:
+        "logs/{paper}/figures/{name}.log",
+    shell:
+        "python {input.script} --out paper/figures/{wildcards.paper}_{wildcards.name} > {log} 2>&1"
+
+
+rule table:
+    input:
+        script="experiments/{paper}/tables/{name}.py",
+        data=lambda wc: declared_inputs(f"experiments/{wc.paper}/tables/{wc.name}.py"),
+    output:
+        "paper/tables/{paper}_{name}.md",
+    log:
+        "logs/{paper}/tables/{name}.log",
+    shell:
+        "python {input.script} --out {output} > {log} 2>&1"
+
+
+rule paper:
+    """The paper: Markdown sources with figures, tables and numbers from results, to HTML."""
+    input:
+        source=sorted(Path("paper").glob("*.md.in")) + sorted(Path("paper", "sections").glob("*.md")),
+        derived=["paper/errata.md", "paper/derivations.md"],
+        figures=FIGURES,
+        tables=TABLES,
+    output:
+        "paper/build/paper.html",
+    log:
+        "logs/paper.log",
+    shell:
+        "python -m msslib paper paper/paper.md.in --out {output} > {log} 2>&1"

@@ -144,8 +144,90 @@ def _cmd_validate(args) -> int:
     return 0
 
 
+def _add_experiment(subparsers) -> None:
+    p = subparsers.add_parser("experiment", help="run one case of an experiment, or compare its runs",
+                              description="Experiments (msslib.experiment): cases x model variants of a base scene.")
+    sub = p.add_subparsers(dest="action", metavar="ACTION", required=True)
+    r = sub.add_parser("run", help="run one (case, model) of an experiment")
+    r.add_argument("experiment", help="experiment file (YAML)")
+    r.add_argument("--case", required=True)
+    r.add_argument("--model", required=True)
+    r.add_argument("--quick", action="store_true", help="apply the experiment's reduced (quick) overrides")
+    r.add_argument("--out", "-o", required=True, help="result file (NetCDF)")
+    r.add_argument("--quiet", "-q", action="store_true")
+    r.set_defaults(func=_cmd_experiment_run)
+    c = sub.add_parser("compare", help="compare every variant with the reference, beside the published numbers")
+    c.add_argument("experiment", help="experiment file (YAML)")
+    c.add_argument("--results", required=True, help="directory holding CASE__MODEL.nc")
+    c.add_argument("--out", "-o", required=True, help="comparison file (NetCDF)")
+    c.add_argument("--table", help="also write the comparison as a Markdown table")
+    c.set_defaults(func=_cmd_experiment_compare)
+    ls = sub.add_parser("list", help="print the CASE__MODEL run names of an experiment")
+    ls.add_argument("experiment")
+    ls.set_defaults(func=_cmd_experiment_list)
+
+
+def _cmd_experiment_run(args) -> int:
+    from msslib import experiment
+    from msslib.io import write_result
+
+    exp = experiment.load_experiment(args.experiment)
+    out = Path(args.out)
+    _check_writable(out, "output file")
+    ds = experiment.run(exp, args.case, args.model, quick=args.quick, progress=not args.quiet)
+    write_result(out, ds)
+    return 0
+
+
+def _cmd_experiment_compare(args) -> int:
+    from msslib import experiment
+    from msslib.io import read_result, write_result
+
+    exp = experiment.load_experiment(args.experiment)
+    out = Path(args.out)
+    _check_writable(out, "output file")
+    results = {}
+    for case, model in experiment.runs(exp):
+        path = Path(args.results) / f"{case}__{model}.nc"
+        if not path.is_file():
+            raise CommandError(f"missing run {str(path)!r}")
+        results[(case, model)] = read_result(path)
+    ds = experiment.compare(exp, results)
+    write_result(out, ds)
+    if args.table:
+        table = Path(args.table)
+        _check_writable(table, "table")
+        tmp = table.with_name(f".{table.name}.tmp")
+        tmp.write_text(experiment.markdown_table(ds))
+        os.replace(tmp, table)
+    return 0
+
+
+def _cmd_experiment_list(args) -> int:
+    from msslib import experiment
+
+    exp = experiment.load_experiment(args.experiment)
+    for case, model in experiment.runs(exp):
+        print(f"{case}__{model}")
+    return 0
+
+
+def _add_paper(subparsers) -> None:
+    p = subparsers.add_parser("paper", help="build the paper (Markdown with placeholders -> HTML)")
+    p.add_argument("source", help="main source, e.g. paper/paper.md.in")
+    p.add_argument("--out", "-o", required=True, help="HTML file (a .md twin is written beside it)")
+    p.set_defaults(func=_cmd_paper)
+
+
+def _cmd_paper(args) -> int:
+    from msslib.paper import build
+
+    build(args.source, args.out)
+    return 0
+
+
 #: subparser builders, in the order of the help text
-COMMANDS = [_add_run, _add_validate]
+COMMANDS = [_add_run, _add_validate, _add_experiment, _add_paper]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -25,6 +25,7 @@ from functools import partial
 
 import numpy as np
 import scipy.sparse as sp
+from numba import njit
 
 from msslib import mesh as _mesh
 from msslib.generated import kernels as _K
@@ -35,6 +36,10 @@ from msslib.terms import (
     Springs,
     Term,
     TetVolume,
+    _block_scatter_csr,
+    _ElementTerm,
+    _scatter_add,
+    _spring3d_hessian_csr,
     sum_external_forces,
 )
 
@@ -127,6 +132,20 @@ class Model:
     def _build_pattern(self):
         parts = [(t, *t.hessian_pattern()) for t in self.terms]
         self._hessian_terms = [(t, r, c) for t, r, c in parts if len(r)]
+        # Fast path: every term with Hessian entries is an element term with dense node blocks
+        # (all dofs of its nodes).  The pattern is then built at node level (a node pair stands
+        # for a dim x dim block) and the values are added directly into the CSR data by numba
+        # loops at precomputed positions; otherwise the generic dof-level path below is used.
+        # (Only when every node belongs to some element, so that the pattern is exactly the one
+        # of the generic path: the union of the element blocks and the diagonal.)
+        if self._hessian_terms and all(_is_block_term(t, self.dim) for t, _, _ in self._hessian_terms):
+            covered = np.zeros(self.n_nodes, dtype=bool)
+            for t, _, _ in self._hessian_terms:
+                covered[t.conn.ravel()] = True
+            if covered.all():
+                self._build_block_pattern()
+                return
+        self._block = None
         n = self.n_dof
         if self._hessian_terms:
             rows = np.concatenate([r for _, r, _ in self._hessian_terms])
@@ -149,6 +168,50 @@ class Model:
             self._scatter.append(inverse[start:start + len(r)])
             start += len(r)
 
+    def _build_block_pattern(self):
+        """Node-level pattern: node pairs of every element (and every node with itself)."""
+        nn, dim = self.n_nodes, self.dim
+        keys, owners = [], []
+        for t, _, _ in self._hessian_terms:
+            conn = t.conn
+            if isinstance(t, Springs) and dim == 3:
+                order, _, ib, _, _ = t.node_layout()
+                a = conn[order, 0]
+                b = conn[order, 1].astype(np.int64)
+                k = np.concatenate([a * nn + b, b * nn + a])
+            else:
+                k = (conn[:, :, None] * nn + conn[:, None, :]).ravel()
+            keys.append(k)
+            owners.append(len(k))
+        diag = np.arange(nn, dtype=np.int64)
+        keys.append(diag * nn + diag)
+        unique, inverse = np.unique(np.concatenate(keys), return_inverse=True)
+        inverse = inverse.ravel()
+        urow = unique // nn
+        ucol = unique % nn
+        nptr = np.zeros(nn + 1, dtype=np.int64)
+        np.cumsum(np.bincount(urow, minlength=nn), out=nptr[1:])
+        pos_all = inverse - nptr[np.concatenate([k // nn for k in keys])]  # position in node row
+        n = self.n_dof
+        idx_t = np.int32 if n < 2**31 else np.int64
+        self._nnz = dim * dim * len(unique)
+        self._indices = np.empty(self._nnz, dtype=idx_t)
+        self._indptr = np.empty(n + 1, dtype=idx_t)
+        _expand_block_pattern(nptr, ucol, dim, self._indices, self._indptr)
+        diag_pos = pos_all[-nn:].astype(np.int32)
+        fills = []
+        start = 0
+        for (t, _, _), size in zip(self._hessian_terms, owners):
+            pos = pos_all[start:start + size].astype(np.int32)
+            start += size
+            if isinstance(t, Springs) and dim == 3:
+                s = len(t.conn)
+                fills.append(("springs", pos[:s].copy(), pos[s:].copy()))
+            else:
+                nv = t.conn.shape[1]
+                fills.append(("blocks", pos.reshape(-1, nv, nv), None))
+        self._block = (nptr, diag_pos, fills)
+        self._scatter = None
     @property
     def nnz(self) -> int:
         """Number of stored entries of the stiffness pattern."""
@@ -181,10 +244,23 @@ class Model:
         """Tangent stiffness ``-d force / dx`` (CSR, fixed pattern incl. the full diagonal)."""
         x = np.asarray(x, dtype=float).ravel()
         data = np.zeros(self._nnz)
-        for (t, _, _), scatter in zip(self._hessian_terms, self._scatter):
-            s = self._scale(t, load)
-            if s != 0.0:
-                data += np.bincount(scatter, weights=t.hessian_values(x), minlength=self._nnz) * s
+        if self._block is not None:
+            nptr, diag_pos, fills = self._block
+            for (t, _, _), (kind, p, q) in zip(self._hessian_terms, fills):
+                s = float(self._scale(t, load))
+                if s == 0.0:
+                    continue
+                if kind == "springs":
+                    _, rowptr, ib, k, L0 = t.node_layout()
+                    _spring3d_hessian_csr(np.ascontiguousarray(x), rowptr, ib, k, L0, nptr, diag_pos, p, q, s, data)
+                else:
+                    vals = t.hessian_values(x).reshape(len(t.conn), -1)
+                    _block_scatter_csr(vals, t.conn, p, nptr, self.dim, s, data)
+        else:
+            for (t, _, _), scatter in zip(self._hessian_terms, self._scatter):
+                s = float(self._scale(t, load))
+                if s != 0.0:
+                    _scatter_add(data, scatter, t.hessian_values(x), s)
         K = sp.csr_matrix((data, self._indices.copy(), self._indptr.copy()), shape=(self.n_dof, self.n_dof))
         K.has_sorted_indices = True
         return K
@@ -211,6 +287,32 @@ class Model:
         """
         r = np.where(self.fixed, -self.force(x, load), 0.0)
         return r.reshape(self.n_nodes, self.dim)
+
+
+def _is_block_term(term, dim) -> bool:
+    """True for element terms whose Hessian pattern is the dense block of all dofs of their nodes
+    (the default :meth:`msslib.terms._ElementTerm.hessian_pattern`)."""
+    return (isinstance(term, _ElementTerm) and type(term).hessian_pattern is _ElementTerm.hessian_pattern
+            and type(term).hessian_values is _ElementTerm.hessian_values and term.dim == dim)
+
+
+@njit(cache=True, nogil=True)
+def _expand_block_pattern(nptr, ucol, dim, indices, indptr):
+    """Dof-level CSR (indices, indptr) of a node-level pattern (nptr, ucol): every node entry
+    becomes a dim x dim block; row ``dim a + i`` lists ``dim b + j`` for the nodes ``b`` of node
+    row ``a`` (sorted), ``j = 0..dim-1``."""
+    nn = nptr.shape[0] - 1
+    for a in range(nn):
+        deg = nptr[a + 1] - nptr[a]
+        for i in range(dim):
+            start = dim * dim * nptr[a] + i * dim * deg
+            indptr[dim * a + i] = start
+            q = start
+            for e in range(nptr[a], nptr[a + 1]):
+                for j in range(dim):
+                    indices[q] = dim * ucol[e] + j
+                    q += 1
+    indptr[dim * nn] = dim * dim * nptr[nn]
 
 
 # --------------------------------------------------------------------------------------------

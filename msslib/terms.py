@@ -203,6 +203,188 @@ def _hex_hessian_loop(x, conn, kap, V0, out):
 
 
 # --------------------------------------------------------------------------------------------
+# fast 3D spring loops (node-ordered layout).  The springs are sorted by their first node: the
+# springs of node ``a`` are ``rowptr[a]:rowptr[a + 1]`` with other ends ``ib`` (int32) and
+# constants ``k``, ``L0`` in that order.  The force of node ``a`` is accumulated in registers and
+# written once; only the other end is scattered.  The arithmetic is that of the generated kernels
+# (``c = k (L0 - l) / l``, ``g_a = -(x_a - x_b) c``, ``g_b = -g_a``), so the results agree with
+# them to round-off (the summation order per node differs).  fastmath without reassociation.
+# --------------------------------------------------------------------------------------------
+
+_FAST = {"nnan", "ninf", "nsz", "arcp", "contract", "afn"}
+_jit_fast = njit(cache=True, error_model="numpy", nogil=True, fastmath=_FAST)
+
+
+@_jit_fast
+def _spring3d_gradient_fast(x, rowptr, ib, k, L0, g):
+    for na in range(rowptr.shape[0] - 1):
+        a = 3 * na
+        xa0, xa1, xa2 = x[a], x[a + 1], x[a + 2]
+        ga0 = 0.0
+        ga1 = 0.0
+        ga2 = 0.0
+        for s in range(rowptr[na], rowptr[na + 1]):
+            b = 3 * ib[s]
+            d0 = xa0 - x[b]
+            d1 = xa1 - x[b + 1]
+            d2 = xa2 - x[b + 2]
+            l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            c = k[s] * (L0[s] - l) / l
+            f0 = d0 * c
+            f1 = d1 * c
+            f2 = d2 * c
+            ga0 -= f0
+            ga1 -= f1
+            ga2 -= f2
+            g[b] += f0
+            g[b + 1] += f1
+            g[b + 2] += f2
+        g[a] += ga0
+        g[a + 1] += ga1
+        g[a + 2] += ga2
+
+
+@_jit_fast
+def _spring3d_energy_fast(x, rowptr, ib, k, L0):
+    e = 0.0
+    for na in range(rowptr.shape[0] - 1):
+        a = 3 * na
+        for s in range(rowptr[na], rowptr[na + 1]):
+            b = 3 * ib[s]
+            d0 = x[a] - x[b]
+            d1 = x[a + 1] - x[b + 1]
+            d2 = x[a + 2] - x[b + 2]
+            r = L0[s] - np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            e += 0.5 * k[s] * r * r
+    return e
+
+
+@_jit_fast
+def _spring3d_hessian_csr(x, rowptr, ib, k, L0, nptr, diag, pab, pba, scale, data):
+    """Add ``scale`` times the spring Hessian to CSR ``data`` of a node-blocked pattern.
+
+    Node row ``a`` has ``deg = nptr[a + 1] - nptr[a]`` neighbour nodes (itself included); dof row
+    ``3 a + i`` starts at ``9 nptr[a] + 3 i deg`` and entry ``(3 a + i, 3 b + j)`` sits at
+    ``+ 3 p + j`` with ``p`` the position of ``b`` in node row ``a`` (``pab``/``pba`` per spring,
+    ``diag`` per node, all relative to the row start)."""
+    for na in range(rowptr.shape[0] - 1):
+        a = 3 * na
+        ra = 9 * nptr[na]
+        dega = 3 * (nptr[na + 1] - nptr[na])
+        h00 = 0.0
+        h01 = 0.0
+        h02 = 0.0
+        h11 = 0.0
+        h12 = 0.0
+        h22 = 0.0
+        for s in range(rowptr[na], rowptr[na + 1]):
+            nb = ib[s]
+            b = 3 * nb
+            d0 = x[a] - x[b]
+            d1 = x[a + 1] - x[b + 1]
+            d2 = x[a + 2] - x[b + 2]
+            l2 = d0 * d0 + d1 * d1 + d2 * d2
+            l = np.sqrt(l2)
+            c7 = 1.0 / l2
+            r = L0[s] - l
+            c10 = -r / l
+            c14 = (r / (l2 * l) + c7) * k[s] * scale
+            c10 *= k[s] * scale
+            k00 = d0 * d0 * c14 + c10
+            k11 = d1 * d1 * c14 + c10
+            k22 = d2 * d2 * c14 + c10
+            k01 = d0 * d1 * c14
+            k02 = d0 * d2 * c14
+            k12 = d1 * d2 * c14
+            h00 += k00
+            h01 += k01
+            h02 += k02
+            h11 += k11
+            h12 += k12
+            h22 += k22
+            # off-diagonal blocks -K
+            q = ra + 3 * pab[s]
+            data[q] -= k00
+            data[q + 1] -= k01
+            data[q + 2] -= k02
+            q += dega
+            data[q] -= k01
+            data[q + 1] -= k11
+            data[q + 2] -= k12
+            q += dega
+            data[q] -= k02
+            data[q + 1] -= k12
+            data[q + 2] -= k22
+            rb = 9 * nptr[nb]
+            degb = 3 * (nptr[nb + 1] - nptr[nb])
+            q = rb + 3 * pba[s]
+            data[q] -= k00
+            data[q + 1] -= k01
+            data[q + 2] -= k02
+            q += degb
+            data[q] -= k01
+            data[q + 1] -= k11
+            data[q + 2] -= k12
+            q += degb
+            data[q] -= k02
+            data[q + 1] -= k12
+            data[q + 2] -= k22
+            # diagonal block of b
+            q = rb + 3 * diag[nb]
+            data[q] += k00
+            data[q + 1] += k01
+            data[q + 2] += k02
+            q += degb
+            data[q] += k01
+            data[q + 1] += k11
+            data[q + 2] += k12
+            q += degb
+            data[q] += k02
+            data[q + 1] += k12
+            data[q + 2] += k22
+        q = ra + 3 * diag[na]
+        data[q] += h00
+        data[q + 1] += h01
+        data[q + 2] += h02
+        q += dega
+        data[q] += h01
+        data[q + 1] += h11
+        data[q + 2] += h12
+        q += dega
+        data[q] += h02
+        data[q + 1] += h12
+        data[q + 2] += h22
+
+
+@_jit
+def _block_scatter_csr(vals, conn, pos, nptr, dim, scale, data):
+    """Add ``scale`` times dense element blocks ``vals`` (m, (nv dim)^2, row-major) to CSR ``data``
+    of a node-blocked pattern; ``pos[e, p, q]`` position of node ``conn[e, q]`` in node row
+    ``conn[e, p]`` (see :func:`_spring3d_hessian_csr`)."""
+    m, nv = conn.shape
+    n_loc = nv * dim
+    for e in range(m):
+        for p in range(nv):
+            na = conn[e, p]
+            ra = dim * dim * nptr[na]
+            deg = dim * (nptr[na + 1] - nptr[na])
+            for i in range(dim):
+                row = ra + i * deg
+                base = (p * dim + i) * n_loc
+                for q in range(nv):
+                    col = row + dim * pos[e, p, q]
+                    off = base + q * dim
+                    for j in range(dim):
+                        data[col + j] += scale * vals[e, off + j]
+
+
+@_jit
+def _scatter_add(data, slots, vals, scale):
+    for i in range(slots.shape[0]):
+        data[slots[i]] += scale * vals[i]
+
+
+# --------------------------------------------------------------------------------------------
 # helpers
 # --------------------------------------------------------------------------------------------
 
@@ -362,6 +544,45 @@ class Springs(_ElementTerm):
             if dim == 2
             else (_spring3d_energy_loop, _spring3d_gradient_loop, _spring3d_hessian_loop)
         )
+        self._layout = None
+
+    def node_layout(self):
+        """Node-ordered layout of the springs used by the fast 3D loops (built once, cached).
+
+        Returns ``(order, rowptr, ib, k, L0)``: ``order`` the permutation of the springs sorted by
+        first node (then second), ``rowptr`` (n_nodes + 1,) int64 offsets by first node, ``ib``
+        int32 second nodes, and the constants in that order (contiguous float64)."""
+        if self._layout is None:
+            conn = self.conn
+            n = int(conn.max()) + 1 if conn.size else 0
+            order = np.lexsort((conn[:, 1], conn[:, 0]))
+            rowptr = np.zeros(n + 1, dtype=np.int64)
+            np.cumsum(np.bincount(conn[:, 0], minlength=n), out=rowptr[1:])
+            idx_t = np.int32 if n < 2**31 else np.int64
+            self._layout = (order, rowptr, np.ascontiguousarray(conn[order, 1], dtype=idx_t),
+                            np.ascontiguousarray(self.k[order]), np.ascontiguousarray(self.rest_length[order]))
+        return self._layout
+
+    def energy(self, x) -> float:
+        if self.dim != 3 or len(self.conn) == 0:
+            return super().energy(x)
+        _, rowptr, ib, k, L0 = self.node_layout()
+        return float(_spring3d_energy_fast(_as_flat(x), rowptr, ib, k, L0))
+
+    def gradient(self, x) -> np.ndarray:
+        if self.dim != 3 or len(self.conn) == 0:
+            return super().gradient(x)
+        x = _as_flat(x)
+        g = np.zeros(x.size)
+        _, rowptr, ib, k, L0 = self.node_layout()
+        if 3 * (len(rowptr) - 1) > x.size:
+            raise IndexError(f"x has {x.size} entries, the springs refer to node {len(rowptr) - 2}")
+        _spring3d_gradient_fast(x, rowptr, ib, k, L0, g)
+        return g
+
+    def gradient_reference(self, x) -> np.ndarray:
+        """Gradient through the generated scalar kernel (the plain loop); for tests/benchmarks."""
+        return super().gradient(x)
 
     @property
     def pairs(self) -> np.ndarray:

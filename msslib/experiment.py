@@ -1,0 +1,242 @@
+"""Experiments: a base scene, named load cases and model variants, a reference, published numbers.
+
+An experiment file (YAML, one per experiment of the papers, under ``experiments/<paper>/``) is
+
+.. code-block:: yaml
+
+    name: lloyd_membrane_equilateral       # optional; default: the file name
+    paper: lloyd                           # lloyd | baudet | golec
+    title: Equilateral membrane, stretch / compression / shear
+    section: "Sec. 5.1, Fig. 9"
+    scene: {...}                           # a scene (see msslib.scene), the common part
+    cases:                                 # load cases: overrides merged into the scene
+      stretch: {loads: [...]}
+      shear: {loads: [...]}
+    models:                                # model variants: overrides merged after the case
+      mss: {model: lloyd_triangle}
+      fem: {model: fem_linear}
+    reference: fem                         # the variant the others are compared with (optional)
+    quick: {geometry: {args: {n: 4}}}      # overrides for the reduced (CI) build
+    published:                             # numbers printed in the paper, with their unit
+      stretch: {mss: {max: [0.033, cm], mean: [0.008, cm]}}
+
+Overrides merge mappings key by key; any other value (lists included) replaces the base value. A
+run is one (case, model) pair: :func:`scene_of` gives its scene, :func:`run` solves it. The
+comparison (:func:`compare`) measures every non-reference variant against the reference of the
+same case (per-node Euclidean distance: mean, standard deviation and maximum, absolute and relative
+to the largest reference displacement) and puts the published values beside them. When the meshes
+differ (a reference computed at another resolution), the reference displacement is interpolated at
+the variant's nodes with the reference's own shape functions.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+KEYS = {"name", "paper", "title", "section", "description", "scene", "cases", "models", "reference", "quick", "published"}
+PAPERS = ("lloyd", "baudet", "golec")
+UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "%": 1e-2, "1": 1.0, "Pa": 1.0, "kPa": 1e3, "s": 1.0, "m^3": 1.0, "cm^3": 1e-6}
+METRICS = ("mean", "std", "max")
+
+
+@dataclass(frozen=True)
+class Experiment:
+    name: str
+    paper: str
+    title: str
+    section: str
+    scene: dict
+    cases: dict
+    models: dict
+    reference: str | None
+    quick: dict
+    published: dict
+    base_dir: Path
+    description: str = ""
+    path: Path | None = field(default=None)
+
+
+def _fail(path, msg):
+    raise ValueError(f"{path}: {msg}")
+
+
+def load_experiment(path) -> Experiment:
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"experiment file not found: {str(path)!r}")
+    raw = yaml.safe_load(path.read_text(encoding="utf-8"))
+    if not isinstance(raw, dict):
+        _fail("experiment", "must be a mapping")
+    unknown = sorted(set(raw) - KEYS)
+    if unknown:
+        _fail(f"experiment.{unknown[0]}", f"unknown key; expected one of {', '.join(sorted(KEYS))}")
+    for key in ("paper", "scene", "models"):
+        if key not in raw:
+            _fail(f"experiment.{key}", "missing")
+    if raw["paper"] not in PAPERS:
+        _fail("experiment.paper", f"{raw['paper']!r} is not one of {PAPERS}")
+    cases = raw.get("cases") or {"default": {}}
+    models = raw["models"]
+    for key, val in (("cases", cases), ("models", models), ("scene", raw["scene"])):
+        if not isinstance(val, dict) or not val:
+            _fail(f"experiment.{key}", "must be a non-empty mapping")
+    for name in list(cases) + list(models):
+        if "__" in name or "/" in name:
+            _fail("experiment", f"case/model name {name!r} must not contain '__' or '/'")
+    ref = raw.get("reference")
+    if ref is not None and ref not in models:
+        _fail("experiment.reference", f"{ref!r} is not one of the models {sorted(models)}")
+    published = raw.get("published") or {}
+    for case, per_model in published.items():
+        if case not in cases:
+            _fail(f"experiment.published.{case}", f"unknown case; expected one of {sorted(cases)}")
+        for model, values in per_model.items():
+            if model not in models:
+                _fail(f"experiment.published.{case}.{model}", f"unknown model; expected one of {sorted(models)}")
+            for metric, v in values.items():
+                if not (isinstance(v, list) and len(v) == 2 and v[1] in UNITS):
+                    _fail(f"experiment.published.{case}.{model}.{metric}", f"expected [value, unit] with unit in {sorted(UNITS)}, got {v!r}")
+    return Experiment(name=raw.get("name", path.stem), paper=raw["paper"], title=raw.get("title", path.stem),
+                      section=str(raw.get("section", "")), scene=raw["scene"], cases=cases, models=models,
+                      reference=ref, quick=raw.get("quick") or {}, published=published, base_dir=path.parent,
+                      description=raw.get("description", ""), path=path)
+
+
+def merge(base, override):
+    """Deep merge: mappings key by key, anything else replaced (a copy is returned)."""
+    if isinstance(base, dict) and isinstance(override, dict):
+        out = copy.deepcopy(base)
+        for k, v in override.items():
+            out[k] = merge(out[k], v) if k in out else copy.deepcopy(v)
+        return out
+    return copy.deepcopy(override)
+
+
+def scene_of(exp: Experiment, case: str, model: str, quick: bool = False) -> dict:
+    if case not in exp.cases:
+        raise ValueError(f"{exp.name}: unknown case {case!r}; expected one of {sorted(exp.cases)}")
+    if model not in exp.models:
+        raise ValueError(f"{exp.name}: unknown model {model!r}; expected one of {sorted(exp.models)}")
+    scene = merge(exp.scene, exp.cases[case] or {})
+    scene = merge(scene, exp.models[model] or {})
+    if quick:
+        scene = merge(scene, exp.quick)
+    scene["name"] = f"{exp.name}/{case}/{model}"
+    return scene
+
+
+def runs(exp: Experiment):
+    return [(c, m) for c in exp.cases for m in exp.models]
+
+
+def run(exp: Experiment, case: str, model: str, quick: bool = False, progress=False):
+    from msslib.scene import load_scene, run_scene
+
+    scene = load_scene(scene_of(exp, case, model, quick), base_dir=exp.base_dir)
+    ds = run_scene(scene, progress=progress)
+    ds.attrs.update(experiment=exp.name, paper=exp.paper, case=case, variant=model, quick=int(quick))
+    return ds
+
+
+# ---- comparison ------------------------------------------------------------------------------
+
+def interpolate(ref_mesh, ref_u, points):
+    """Reference displacement at ``points`` with the reference mesh's shape functions."""
+    from msslib.fem import to_skfem
+
+    skmesh, elem = to_skfem(ref_mesh)
+    from skfem import Basis
+
+    basis = Basis(skmesh, elem)
+    lo, hi = ref_mesh.points.min(axis=0), ref_mesh.points.max(axis=0)
+    pts = np.clip(points, lo, hi)  # boundary nodes may sit a rounding error outside
+    P = basis.probes(pts.T)
+    return np.column_stack([P @ ref_u[:, d] for d in range(ref_u.shape[1])])
+
+
+def _published(exp, case, model):
+    out = {}
+    for metric, (value, unit) in (exp.published.get(case, {}).get(model, {}) or {}).items():
+        out[metric] = (float(value) * UNITS[unit], unit)
+    return out
+
+
+def compare(exp: Experiment, results: dict):
+    """``results[(case, model)]`` are the run datasets; returns an xarray Dataset with dims
+    (case, variant) of error statistics against the reference and the published values."""
+    import xarray as xr
+
+    from msslib.io import mesh_from_result
+    from msslib.metrics import displacement_error
+
+    variants = [m for m in exp.models if m != exp.reference]
+    cases = list(exp.cases)
+    shape = (len(cases), len(variants))
+    data = {f"error_{s}": np.full(shape, np.nan) for s in METRICS}
+    data.update({f"relative_error_{s}": np.full(shape, np.nan) for s in METRICS})
+    data["reference_max_displacement"] = np.full(len(cases), np.nan)
+    data["max_displacement"] = np.full(shape, np.nan)
+    data["wall_time"] = np.full(shape, np.nan)
+    pub = {f"published_{s}": np.full(shape, np.nan) for s in ("mean", "std", "max", "relative_mean", "relative_std", "relative_max")}
+    for i, case in enumerate(cases):
+        ref = results.get((case, exp.reference)) if exp.reference else None
+        if ref is not None:
+            u_ref = ref["displacement"].transpose("node", "axis").values
+            data["reference_max_displacement"][i] = np.linalg.norm(u_ref, axis=1).max()
+        for j, model in enumerate(variants):
+            ds = results[(case, model)]
+            u = ds["displacement"].transpose("node", "axis").values
+            data["max_displacement"][i, j] = np.linalg.norm(u, axis=1).max()
+            data["wall_time"][i, j] = float(ds.attrs.get("wall_time_s", np.nan))
+            if ref is not None:
+                X = ds["rest_position"].transpose("node", "axis").values
+                Xr = ref["rest_position"].transpose("node", "axis").values
+                if X.shape == Xr.shape and np.allclose(X, Xr, atol=1e-12 * np.abs(Xr).max()):
+                    ur = u_ref
+                else:
+                    ur = interpolate(mesh_from_result(ref), u_ref, X)
+                err = displacement_error(u, ur, relative_to=data["reference_max_displacement"][i])
+                for s in METRICS:
+                    data[f"error_{s}"][i, j] = getattr(err, s)
+                    data[f"relative_error_{s}"][i, j] = getattr(err, f"rel_{s}")
+            for metric, (value, unit) in _published(exp, case, model).items():
+                key = f"published_{'relative_' if unit == '%' else ''}{metric}"
+                if key in pub:
+                    pub[key][i, j] = value
+    coords = {"case": cases, "variant": variants}
+    units = {"wall_time": "s"}
+    ds = xr.Dataset(coords=coords)
+    for name, arr in {**data, **pub}.items():
+        dims = ("case",) if arr.ndim == 1 else ("case", "variant")
+        unit = units.get(name, "1" if "relative" in name else "m")
+        ds[name] = xr.DataArray(arr, dims=dims, attrs={"units": unit, "long_name": name.replace("_", " ")})
+    ds.attrs.update(experiment=exp.name, paper=exp.paper, title=exp.title, section=exp.section,
+                    reference=exp.reference or "")
+    return ds
+
+
+def markdown_table(ds) -> str:
+    """The comparison as a Markdown table: ours and published, side by side (mm and %)."""
+    lines = [f"**{ds.attrs['title']}** ({ds.attrs['paper']}, {ds.attrs['section']}); reference: {ds.attrs['reference'] or '-'}", "",
+             "| case | model | mean (mm) | SD (mm) | max (mm) | published mean | published SD | published max | max, rel. (%) | published max, rel. (%) | wall time (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+
+    def mm(v):
+        return "-" if not np.isfinite(v) else f"{v * 1e3:.3g}"
+
+    def pc(v):
+        return "-" if not np.isfinite(v) else f"{v * 100:.3g}"
+
+    for case in ds.case.values:
+        for var in ds.variant.values:
+            r = ds.sel(case=case, variant=var)
+            lines.append(
+                f"| {case} | {var} | {mm(r.error_mean)} | {mm(r.error_std)} | {mm(r.error_max)} | "
+                f"{mm(r.published_mean)} | {mm(r.published_std)} | {mm(r.published_max)} | "
+                f"{pc(r.relative_error_max)} | {pc(r.published_relative_max)} | {float(r.wall_time):.3g} |")
+    return "\n".join(lines) + "\n"
