@@ -55,6 +55,8 @@ def declared_inputs(path):
     return []
 
 
+COMPARISONS = [f"results/{p}/{n}/comparison.nc" for p, n in experiments()]
+STUDIES = [f"results/{p}/studies/{n}.nc" for p, n in scripts("studies")]
 FIGURES = [f"paper/figures/{p}_{n}.png" for p, n in scripts("figures")]
 TABLES = ([f"paper/tables/experiments/{p}_{n}.md" for p, n in experiments()]
           + [f"paper/tables/{p}_{n}.md" for p, n in scripts("tables")])
@@ -171,6 +173,7 @@ rule paper:
         derived=["paper/errata.md", "paper/derivations.md"],
         figures=FIGURES,
         tables=TABLES,
+        results=COMPARISONS + STUDIES,
     output:
         "paper/build/paper.html",
     log:

@@ -175,10 +175,9 @@ class Model:
         for t, _, _ in self._hessian_terms:
             conn = t.conn
             if isinstance(t, Springs) and dim == 3:
-                order, _, ib, _, _ = t.node_layout()
-                a = conn[order, 0]
-                b = conn[order, 1].astype(np.int64)
-                k = np.concatenate([a * nn + b, b * nn + a])
+                order, rowptr, nb, _, _ = t.symmetric_layout()
+                a = np.repeat(np.arange(len(rowptr) - 1, dtype=np.int64), np.diff(rowptr))
+                k = a * nn + nb
             else:
                 k = (conn[:, :, None] * nn + conn[:, None, :]).ravel()
             keys.append(k)
@@ -205,8 +204,7 @@ class Model:
             pos = pos_all[start:start + size].astype(np.int32)
             start += size
             if isinstance(t, Springs) and dim == 3:
-                s = len(t.conn)
-                fills.append(("springs", pos[:s].copy(), pos[s:].copy()))
+                fills.append(("springs", pos, None))
             else:
                 nv = t.conn.shape[1]
                 fills.append(("blocks", pos.reshape(-1, nv, nv), None))
@@ -251,8 +249,8 @@ class Model:
                 if s == 0.0:
                     continue
                 if kind == "springs":
-                    _, rowptr, ib, k, L0 = t.node_layout()
-                    _spring3d_hessian_csr(np.ascontiguousarray(x), rowptr, ib, k, L0, nptr, diag_pos, p, q, s, data)
+                    _, rowptr, nb, k, L0 = t.symmetric_layout()
+                    _spring3d_hessian_csr(np.ascontiguousarray(x), rowptr, nb, k, L0, p, nptr, diag_pos, s, data)
                 else:
                     vals = t.hessian_values(x).reshape(len(t.conn), -1)
                     _block_scatter_csr(vals, t.conn, p, nptr, self.dim, s, data)
