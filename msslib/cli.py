@@ -226,8 +226,50 @@ def _cmd_paper(args) -> int:
     return 0
 
 
+def _add_plan(subparsers) -> None:
+    p = subparsers.add_parser("plan", help="the cheapest model and resolution within an error budget",
+                              description="Measure (or read) the speed/error front of a scene and pick the cheapest "
+                                          "(model, resolution) whose error against converged non-linear FEM is within budget.")
+    p.add_argument("scene", help="scene file (YAML) with a mesh generator")
+    p.add_argument("--max-error", type=float, required=True, help="budget: max node error / max reference displacement")
+    p.add_argument("--front", help="a front measured before (NetCDF from `plan --save` or the workflow)")
+    p.add_argument("--save", help="write the measured front here (NetCDF)")
+    p.add_argument("--levels", default="1,2,3", help="resolution levels to measure (default 1,2,3)")
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--budget", type=float, default=30.0, help="wall-time budget per run (s); slower runs are recorded as failed")
+    p.set_defaults(func=_cmd_plan)
+
+
+def _cmd_plan(args) -> int:
+    from msslib import planning
+    from msslib.io import read_result, write_result
+
+    if not args.max_error > 0:
+        raise CommandError(f"--max-error must be > 0, got {args.max_error}")
+    if args.front:
+        front = read_result(args.front)
+    else:
+        levels = tuple(int(v) for v in args.levels.split(","))
+        front = planning.measure_front(args.scene, levels=levels, repeats=args.repeats, budget=args.budget,
+                                       progress=lambda s: print(s, file=sys.stderr))
+        if args.save:
+            _check_writable(Path(args.save), "front file")
+            write_result(args.save, front)
+    best = planning.choose(front, args.max_error)
+    print(f"reference: {front.attrs['reference_model']} at level {front.attrs['reference_level']}")
+    for m, lv, t, e in planning.pareto(front):
+        print(f"  front: {m:26s} level {lv}: {t:.3g} s, max error {100 * e:.3g} %")
+    if best is None:
+        raise CommandError(f"no measured model/resolution reaches max error {args.max_error:g}; "
+                           f"smallest measured: {100 * float(front.error_max.min()):.3g} %")
+    m, lv, t, e = best
+    print(f"choice: {m} at resolution level {lv}: max error {100 * e:.3g} % <= {100 * args.max_error:.3g} %, "
+          f"median wall time {t:.3g} s")
+    return 0
+
+
 #: subparser builders, in the order of the help text
-COMMANDS = [_add_run, _add_validate, _add_experiment, _add_paper]
+COMMANDS = [_add_run, _add_validate, _add_experiment, _add_paper, _add_plan]
 
 
 def build_parser() -> argparse.ArgumentParser:

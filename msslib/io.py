@@ -170,7 +170,11 @@ def _attr_value(value):
     if isinstance(value, os.PathLike):
         return os.fspath(value)
     if isinstance(value, (list, tuple, np.ndarray)):
-        arr = np.asarray(value) if not isinstance(value, np.ndarray) else value
+        try:
+            arr = np.asarray(value) if not isinstance(value, np.ndarray) else value
+        except ValueError:  # ragged nesting, e.g. residual histories per load step: stored as JSON
+            arr = np.asarray(None)
+            return json.dumps(value, default=_json_default, sort_keys=True)
         if arr.ndim == 0:
             return _attr_value(arr.item())
         if arr.ndim == 1 and arr.size and arr.dtype.kind in "biuf":
