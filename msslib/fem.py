@@ -53,7 +53,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .mesh import CELL_TYPES, Mesh
+from .mesh import CELL_TYPES, Mesh, check_cells
 
 __all__ = [
     "FemResult",
@@ -169,6 +169,7 @@ class _Geometry:
     def __init__(self, mesh: Mesh):
         import skfem
 
+        check_cells(mesh)  # ValueError naming inverted or degenerate cells (else a singular matrix)
         self.mesh = mesh
         self.dim = mesh.dim
         self.skmesh, self.elem = to_skfem(mesh)
@@ -521,7 +522,8 @@ def solve_nonlinear(
     and converged when the residual force norm on the free dofs is at most
     ``tol * max(|load|, |reactions|)`` (load = current external force vector). A failed increment
     (no convergence in ``max_iter`` iterations, or an inverted element) is halved, at most
-    ``max_halvings`` times in a row; then :class:`RuntimeError` names the step and the residual.
+    ``max_halvings`` times in a row and never below ``1 / (steps * 2**max_halvings)``; then
+    :class:`RuntimeError` names the step and the residual.
     2D: ``plane="stress"`` (default, as in :func:`solve_linear`; exact plane stress of the 3D law, see
     the module docstring) or ``"strain"`` (``F33 = 1``). ``progress(step, n_steps)`` is called after every converged nominal step.
 
@@ -614,7 +616,9 @@ def solve_nonlinear(
             continue
         halvings += 1
         n_halvings += 1
-        if halvings > max_halvings:
+        # also stop when the increment has shrunk below nominal / 2**max_halvings: near a limit
+        # point, alternating successes and halvings would otherwise creep towards it forever
+        if halvings > max_halvings or dlf * 0.5 < dlf_nominal * 0.5**max_halvings * (1.0 - 1e-12):
             step = int(np.floor(lf / dlf_nominal + 1e-9)) + 1
             raise RuntimeError(
                 f"Newton did not converge in load step {step} of {steps} (load factor {lf:.6g} -> {target:.6g}, "

@@ -1,0 +1,259 @@
+"""Hard cases of the mass-spring models: the behaviour measured by ``experiments/stability.py``.
+
+The cases are built by the helpers of that script (loaded from its file), so the test suite and
+the recorded experiment cannot drift apart.  Meshes are kept small (the whole module runs in
+well under half a minute); every threshold below is the measured value plus a margin, and its
+comment says why the behaviour is what it is.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from msslib import cli
+from msslib import mesh as M
+from msslib import model as MD
+from msslib import solvers as S
+from msslib.scene import load_scene, prepare
+
+_SCRIPT = Path(__file__).resolve().parents[1] / "experiments" / "stability.py"
+
+
+def _load_script():
+    spec = importlib.util.spec_from_file_location("msslib_stability_experiment", _SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+st = _load_script()
+
+
+# --------------------------------------------------------------------------------------------
+# nearly incompressible material, 10 % compression on symmetry planes (homogeneous solution)
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def nu_results():
+    return {nu: st.nu_case(nu, n=2) for nu in st.NU_VALUES}
+
+
+@pytest.mark.parametrize("nu", st.NU_VALUES)
+def test_nu_sweep_golec_derived_follows_neohookean(nu_results, nu):
+    r = nu_results[nu]
+    ref, golec = r["fem_neohookean"], r["golec_derived"]
+    assert golec["converged"] and ref["converged"]
+    # Golec's derived lattice is exactly isotropic with (E, nu): a homogeneous state is matched up
+    # to the difference of the non-linear laws (0.8 % at nu = 0.45, -> 0 as nu -> 1/2)
+    assert golec["error"] < 0.01
+    assert abs(golec["volume_ratio"] - ref["volume_ratio"]) < 2e-3
+
+
+def test_nu_4999_golec_keeps_volume_springs_alone_do_not(nu_results):
+    r = nu_results[0.4999]
+    assert r["fem_neohookean"]["volume_ratio"] == pytest.approx(1.0, abs=1e-4)
+    # with its volume term the derived Golec cube loses less than 0.01 % of its volume ...
+    assert 1.0 - r["golec_derived"]["volume_ratio"] < 1e-4
+    assert r["golec_derived"]["error"] < 1e-3
+    # ... the printed constants less than 0.1 %
+    assert 1.0 - r["golec_published"]["volume_ratio"] < 1e-3
+    # without the volume term the springs behave like nu = 1/4 whatever nu: about 5.5 % lost
+    assert 0.94 < r["golec_springs_only"]["volume_ratio"] < 0.95
+    assert r["golec_springs_only"]["error"] > 0.25
+    # Baudet's correction acts only on the loaded layer of cubes: 3.5-4 % of the volume is lost
+    assert r["baudet_cube"]["converged"] and r["baudet_cube"]["volume_ratio"] < 0.97
+    # Lloyd's volume term keeps the volume but not the shape; without it ~8 % is lost
+    assert 1.0 - r["lloyd_tetrahedron_volume"]["volume_ratio"] < 1e-3
+    assert r["lloyd_tetrahedron_volume"]["error"] > 0.1
+    assert r["lloyd_tetrahedron"]["volume_ratio"] < 0.93
+
+
+def test_nu_sweep_springs_only_volume_does_not_depend_on_nu(nu_results):
+    v = [nu_results[nu]["golec_springs_only"]["volume_ratio"] for nu in st.NU_VALUES]
+    assert np.ptp(v) < 1e-6
+    loss_ref = [1.0 - nu_results[nu]["fem_neohookean"]["volume_ratio"] for nu in st.NU_VALUES]
+    assert loss_ref == sorted(loss_ref, reverse=True)  # the reference loses less and less
+
+
+# --------------------------------------------------------------------------------------------
+# large compression, clamped faces (barrelling)
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def compression():
+    return {c: st.compression_case(c, n=3) for c in (0.3, 0.5)}
+
+
+def test_compression_30_percent_converges(compression):
+    r = compression[0.3]
+    for name in st.MSS_MODELS + st.FEM_MODELS:
+        assert r[name]["converged"], (name, r[name]["outcome"])
+    for name in ("golec_derived", "golec_published", "golec_springs_only", "baudet_cube",
+                 "lloyd_tetrahedron_volume", "fem_neohookean"):
+        assert r[name]["n_inverted"] == 0, name
+    assert r["golec_derived"]["error"] < 0.05
+    # Lloyd's springs alone converge to a state with inverted tetrahedra: nothing resists inversion
+    assert r["lloyd_tetrahedron"]["n_inverted"] > 0
+    assert r["lloyd_tetrahedron"]["min_volume_ratio"] < 0
+
+
+def test_compression_50_percent(compression):
+    r = compression[0.5]
+    for name in st.MSS_MODELS:  # with a sensible force scale every model converges ...
+        assert r[name]["converged"], (name, r[name]["outcome"])
+    # ... the neo-Hookean reference and Golec's cube without inverting an element
+    assert r["fem_neohookean"]["n_inverted"] == 0
+    assert r["golec_derived"]["n_inverted"] == 0
+    assert r["golec_derived"]["error"] < 0.1
+    assert abs(r["golec_derived"]["volume_ratio"] - r["fem_neohookean"]["volume_ratio"]) < 0.06
+    # the tetrahedral MSS (even with Lloyd's volume term) and SVK converge to inverted states
+    for name in ("lloyd_tetrahedron", "lloyd_tetrahedron_volume", "fem_svk"):
+        assert r[name]["n_inverted"] > 0 and r[name]["min_volume_ratio"] < 0, name
+
+
+@pytest.mark.xfail(strict=True, reason="solvers.static_solve: under pure displacement control F_ref is "
+                   "||force(apply_prescribed(x0, 1))||, which vanishes when the prescribed nodes land on a "
+                   "reflected rest configuration (50 % compression of 4 layers: springs at rest length), so "
+                   "the criterion tol * F_ref ~ 1e-20 N is unreachable; needs e.g. ||K(x0) u_prescribed||")
+def test_default_force_scale_under_displacement_control():
+    hexm, _ = st.cube_meshes(0.1, 4)
+    fixed, presc, _ = st.clamped_bc(hexm, 0.5)
+    model = MD.Model(hexm, st.mss_terms("golec_springs_only", hexm, [(st.E0, 0.3)]), fixed=fixed, prescribed=presc)
+    S.static_solve(model, model.x0, load_steps=10, max_cuts=2)
+
+
+# --------------------------------------------------------------------------------------------
+# inverted input
+# --------------------------------------------------------------------------------------------
+
+
+def test_inverted_input_is_refused_by_every_model():
+    r = st.inverted_case()
+    for name in st.MSS_MODELS + st.FEM_MODELS:
+        assert not r[name]["ran"], name
+        assert "inverted" in r[name]["outcome"] and "cell 1 " in r[name]["outcome"], r[name]["outcome"]
+
+
+# --------------------------------------------------------------------------------------------
+# badly shaped tetrahedra: Lloyd's constant vs the exact element-wise least squares
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("nu", [0.25, 0.3, 0.45])
+def test_elementwise_least_squares_reproduces_lloyd_on_regular_tetrahedron(nu):
+    X = st.shape_coordinates("regular")
+    k, _ = st.elementwise_lsq(X, st.E0, nu)
+    np.testing.assert_allclose(k, st.lloyd_constant(X, st.E0, nu), rtol=1e-9)
+
+
+@pytest.mark.parametrize("shape, n_negative", [("sliver", 2), ("cap", 3), ("wedge", 1), ("spindle", 0)])
+def test_bad_tetrahedra_least_squares_constants(shape, n_negative):
+    X = st.shape_coordinates(shape)
+    assert st.lloyd_constant(X, st.E0, 0.3) > 0  # the equivalent-edge formula stays positive
+    k, _ = st.elementwise_lsq(X, st.E0, 0.3)
+    assert int((k < 0).sum()) == n_negative
+
+
+def test_sliver_negative_constant_rejected_by_springs_with_its_index():
+    X = st.shape_coordinates("sliver")
+    k, _ = st.elementwise_lsq(X, st.E0, 0.3)
+    mesh = M.Mesh(X, np.array([[0, 1, 2, 3]]), "tetra")
+    edges = M.unique_edges(mesh)
+    pairs = edges.pairs
+    local = {tuple(sorted(e)): i for i, e in enumerate(st.TET_EDGES.tolist())}
+    k_pairs = k[[local[tuple(p)] for p in pairs.tolist()]]
+    bad = np.flatnonzero(k_pairs <= 0)
+    assert len(bad) == 2
+    with pytest.raises(ValueError) as info:
+        MD.assemble_springs(mesh, edges, lambda _c, p: k[[local[tuple(q)] for q in p.tolist()]])
+    for i in bad:
+        a, b = pairs[i]
+        assert f"spring {i} (nodes {a}-{b})" in str(info.value)
+
+
+# --------------------------------------------------------------------------------------------
+# two materials, 1000x stiffness contrast
+# --------------------------------------------------------------------------------------------
+
+
+def test_contrast_1000_bar_golec_matches_fem():
+    homogeneous = st.contrast_case(1.0, n=(4, 1, 1))
+    contrast = st.contrast_case(1000.0, n=(4, 1, 1))
+    for name in st.MSS_MODELS:
+        assert contrast[name]["converged"], (name, contrast[name]["outcome"])
+    # Golec's derived lattice is exact for homogeneous strain; what remains comes from the clamped
+    # end and the material interface: 1.5 % for one material, 2.9 % at 1000x (measured on this
+    # mesh; 1.3 % / 1.75 % on 8 x 2 x 2).  5 % bounds both and stays far below the other models.
+    assert homogeneous["golec_derived"]["error"] < 0.03
+    assert contrast["golec_derived"]["error"] < 0.05
+    assert contrast["golec_springs_only"]["error"] < 0.08
+    assert contrast["baudet_cube"]["error"] < 0.06
+    # the printed Golec constants (interior totals used per element) are ~3x too stiff
+    assert contrast["golec_published"]["error"] > 0.5
+    # Lloyd's tetrahedra are far off with or without contrast
+    assert contrast["lloyd_tetrahedron"]["error"] > 0.5
+
+
+# --------------------------------------------------------------------------------------------
+# time step above the explicit stability limit
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["golec_derived", "lloyd_tetrahedron"])
+def test_explicit_step_above_limit_diverges_implicit_is_stable(name):
+    model = st.cantilever(name)
+    limit = S.explicit_stability_limit(model, model.x0)
+    dt = 1.5 * limit
+    v0 = np.zeros(model.n_dof)
+    with pytest.raises(S.DivergenceError, match="symplectic_euler diverged") as info:
+        S.integrate(model, model.x0, v0, dt=dt, t_end=100 * dt, method="symplectic_euler", damping=0.0)
+    assert info.value.step < 30  # the highest mode grows ~6.9x per step at omega dt = 3
+    assert np.isfinite(info.value.x_last).all() and np.isfinite(info.value.v_last).all()
+    res = S.integrate(model, model.x0, v0, dt=dt, t_end=40 * dt, method="implicit_euler", damping=0.0)
+    assert np.isfinite(res.x).all() and np.isfinite(res.v).all()
+    u_static = np.abs(S.static_solve(model, model.x0).x - model.x0).max()
+    # a suddenly applied load overshoots to at most twice the static deflection (undamped,
+    # linear); implicit Euler only removes energy
+    assert np.abs(res.x - model.x0).max() <= 2.0 * u_static
+
+
+def _cantilever_scene(method, dt, t_end):
+    return {
+        "name": "cantilever_over_limit",
+        "geometry": {"generator": "hex_grid", "args": {"lx": 0.2, "ly": 0.05, "lz": 0.05, "nx": 4, "ny": 1, "nz": 1}},
+        "materials": [{"E": st.E0, "nu": 0.3, "density": st.DENSITY}],
+        "model": {"type": "golec_cube", "A": 1.0},
+        "boundary": [{"select": {"plane": ["x", 0.0]}, "fix": "all"}],
+        "loads": [{"type": "gravity", "g": [0.0, 0.0, -9.81]}],
+        "solver": {"type": "dynamic", "method": method, "dt": float(dt), "t_end": float(t_end)},
+    }
+
+
+def test_cli_explicit_over_limit_fails_without_output(tmp_path, capsys):
+    setup = prepare(load_scene(_cantilever_scene("symplectic_euler", 1e-4, 1e-3)))
+    limit = S.explicit_stability_limit(setup.model, setup.model.x0)
+    dt = 1.5 * limit
+    for method, code in (("symplectic_euler", 1), ("implicit_euler", 0)):
+        scene = tmp_path / f"{method}.yaml"
+        scene.write_text(yaml.safe_dump(_cantilever_scene(method, dt, 40 * dt)))
+        out = tmp_path / f"{method}.nc"
+        assert cli.main(["run", str(scene), "--out", str(out), "--quiet"]) == code
+        err = capsys.readouterr().err
+        if code:
+            assert "msslib: error:" in err and "diverged" in err and "stability limit" in err
+            assert not out.exists()
+        else:
+            from msslib.io import read_result
+
+            ds = read_result(out)
+            assert np.isfinite(ds["displacement"].values).all()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["implicit_euler.nc", "implicit_euler.yaml", "symplectic_euler.yaml"]
