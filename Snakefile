@@ -166,6 +166,21 @@ rule table:
         "python {input.script} --out {output} > {log} 2>&1"
 
 
+rule stability:
+    """Hard cases: where each model breaks, and how."""
+    input:
+        script="experiments/stability.py",
+        derived="paper/derivations.json",
+    output:
+        "results/stability.nc",
+    params:
+        quick=QFLAG,
+    log:
+        "logs/stability.log",
+    shell:
+        "python {input.script} --out {output} {params.quick} > {log} 2>&1"
+
+
 rule paper:
     """The paper: Markdown sources with figures, tables and numbers from results, to HTML."""
     input:

@@ -1,0 +1,60 @@
+"""Stability table: every hard case x model, with the error, volume ratio, inverted elements and how it broke."""
+
+import argparse
+import os
+from pathlib import Path
+
+import numpy as np
+
+from msslib.io import read_result
+
+INPUTS = ["results/stability.nc"]
+
+
+def cell(r):
+    text = " ".join(str(r.outcome.values).split())
+    if not int(r.ran):
+        return text[:70] if text else "-"
+    parts = []
+    if not int(r.converged):
+        parts.append(f"**{text[:70]}**" if text else "**no convergence**")
+    e, v, inv = float(r.error), float(r.volume_ratio), int(r.n_inverted)
+    if np.isfinite(e):
+        parts.append(f"err {100 * e:.2g} %")
+    if np.isfinite(v):
+        parts.append(f"V/V0 {v:.4g}")
+    if inv > 0:
+        parts.append(f"**{inv} inverted**")
+    return ", ".join(parts) or str(r.outcome.values)[:60]
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--out", required=True)
+    a = p.parse_args()
+    d = read_result(INPUTS[0])
+    models = [str(m) for m in d.model.values]
+    lines = [f"Hard cases (E = {d.attrs['E']:g} Pa). *err*: largest node error relative to the largest displacement of "
+             "neo-Hookean FEM on the same mesh; *V/V0*: volume ratio.", "",
+             "| case | " + " | ".join(models) + " |", "|---" * (len(models) + 1) + "|"]
+    for c in d.case.values:
+        lines.append(f"| {c} | " + " | ".join(cell(d.sel(case=c, model=m)) for m in models) + " |")
+    lines += ["", "How each run ended (first words of the outcome):", ""]
+    for c in d.case.values:
+        for m in models:
+            text = " ".join(str(d.outcome.sel(case=c, model=m).values).split())
+            if text and not text.startswith("ok"):
+                lines.append(f"- {c}, {m}: {text[:200]}")
+    lines += ["", "Bad tetrahedra: Lloyd's equivalent-edge constant vs the element-wise least-squares optimum "
+              "(N/m, E as above):", "", "| shape | Lloyd k | least-squares k per edge | negative |", "|---|---|---|---|"]
+    for s in d.shape.values:
+        k = d.k_lsq.sel(shape=s).values
+        lines.append(f"| {s} | {float(d.k_lloyd.sel(shape=s)):.4g} | {', '.join(f'{v:.3g}' for v in k)} | {int((k < 0).sum())} |")
+    out = Path(a.out)
+    tmp = out.with_name(f".{out.name}.tmp")
+    tmp.write_text("\n".join(lines) + "\n")
+    os.replace(tmp, out)
+
+
+if __name__ == "__main__":
+    main()
