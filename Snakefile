@@ -48,11 +48,18 @@ def scripts(kind):
 
 
 def declared_inputs(path):
-    """The INPUTS list a figure or table script declares (read, not executed)."""
-    for node in ast.parse(Path(path).read_text()).body:
-        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "INPUTS" for t in node.targets):
-            return list(ast.literal_eval(node.value))
-    return []
+    """The INPUTS list a figure or table script declares, computed from its top-level assignments
+    only (constants and comprehensions; imports and functions are not run)."""
+    tree = ast.parse(Path(path).read_text())
+    body = [n for n in tree.body if isinstance(n, ast.Assign)]
+    namespace = {"__builtins__": {"range": range, "str": str, "int": int, "len": len, "sorted": sorted,
+                                  "zip": zip, "enumerate": enumerate, "list": list, "dict": dict}}
+    for node in body:
+        try:
+            exec(compile(ast.Module(body=[node], type_ignores=[]), str(path), "exec"), namespace)
+        except Exception:
+            pass
+    return list(namespace.get("INPUTS", []))
 
 
 COMPARISONS = [f"results/{p}/{n}/comparison.nc" for p, n in experiments()]
