@@ -466,7 +466,8 @@ def lloyd_triangle_springs(mesh, materials, t: float) -> list[Term]:
     per triangle ``parameters.lloyd_triangle(E, t).k`` on each of its edges, summed over the
     triangles sharing an edge; rest lengths are the mesh distances."""
     _require(mesh, "triangle")
-    E, _ = material_arrays(mesh, materials)
+    E, nu = material_arrays(mesh, materials)
+    _parameters().check_material(E, nu, "lloyd_triangle")
     (k,) = _per_cell(_parameters().lloyd_triangle, ("k",), E, t)
     return [assemble_springs(mesh, "edges", lambda cells, _p: k[cells])]
 
@@ -475,7 +476,8 @@ def van_gelder_springs(mesh, materials, t: float) -> list[Term]:
     """Van Gelder's springs: per triangle ``parameters.van_gelder_triangle(E, t, A_e, l).k`` on each
     edge of length ``l`` (``A_e`` the triangle's area), summed over the adjacent triangles."""
     area = _require(mesh, "triangle")
-    E, _ = material_arrays(mesh, materials)
+    E, nu = material_arrays(mesh, materials)
+    _parameters().check_material(E, nu, "van_gelder_triangle")
     fn = _parameters().van_gelder_triangle
 
     def k_fn(cells, node_pairs):
@@ -491,7 +493,8 @@ def lloyd_square_springs(mesh, materials, t: float) -> list[Term]:
     the elements sharing them; rest lengths are ``rest_factor_edge`` and ``rest_factor_diagonal``
     times the mesh distances (prestrained springs)."""
     _require(mesh, "quad")
-    E, _ = material_arrays(mesh, materials)
+    E, nu = material_arrays(mesh, materials)
+    _parameters().check_material(E, nu, "lloyd_square")
     k_e, k_d, f_e, f_d = _per_cell(_parameters().lloyd_square,
                                    ("k_edge", "k_diagonal", "rest_factor_edge", "rest_factor_diagonal"), E, t)
     edges = assemble_springs(mesh, "edges", lambda c, p: (k_e[c], f_e[c] * _pair_lengths(mesh, p)))
@@ -516,6 +519,7 @@ def lloyd_tet_springs(mesh, materials, volume: bool = False, published: bool = F
     """
     V = _require(mesh, "tetra")
     E, nu = material_arrays(mesh, materials)
+    _parameters().check_material(E, nu, None if volume else "lloyd_tetrahedron")
     l_hat = np.cbrt(6.0 * np.sqrt(2.0) * V)
     P = _parameters()
     if volume:

@@ -31,23 +31,50 @@ class FormulaValidityWarning(UserWarning):
     """A formula is used outside the conditions under which it was derived."""
 
 
+def _offending(value, bad):
+    """The value itself (scalars) or the first offending entry and where it is (arrays)."""
+    v = np.asarray(value, dtype=float)
+    if v.ndim == 0:
+        return repr(value)
+    i = int(np.flatnonzero(bad.ravel())[0])
+    return f"{float(v.ravel()[i])!r} (entry {i} of {v.size})"
+
+
 def _positive(name, value):
     v = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(v)) or np.any(v <= 0):
-        raise ValueError(f"{name} must be finite and > 0, got {value!r}")
+    bad = ~np.isfinite(v) | (v <= 0)
+    if np.any(bad):
+        raise ValueError(f"{name} must be finite and > 0, got {_offending(value, bad)}")
     return value
 
 
 def _poisson(nu, low=-1.0, high=0.5):
     v = np.asarray(nu, dtype=float)
-    if not np.all(np.isfinite(v)) or np.any(v <= low) or np.any(v >= high):
-        raise ValueError(f"Poisson's ratio nu must lie in ({low:g}, {high:g}), got {nu!r}")
+    bad = ~np.isfinite(v) | (v <= low) | (v >= high)
+    if np.any(bad):
+        raise ValueError(f"Poisson's ratio nu must lie in ({low:g}, {high:g}), got {_offending(nu, bad)}")
     return nu
 
 
 def _warn_nu(nu, exact, model):
-    if nu is not None and np.any(np.abs(np.asarray(nu, dtype=float) - exact) > 1e-9):
-        warnings.warn(f"{model} is exact only for nu = {exact:.6g}; got nu = {nu!r}", FormulaValidityWarning, stacklevel=3)
+    if nu is None:
+        return
+    off = np.abs(np.asarray(nu, dtype=float) - exact) > 1e-9
+    if np.any(off):
+        warnings.warn(f"{model} is exact only for nu = {exact:.6g}; got nu = {_offending(nu, off)}",
+                      FormulaValidityWarning, stacklevel=3)
+
+
+VALID_NU = {"lloyd_triangle": 1 / 3, "van_gelder_triangle": 1 / 3, "lloyd_square": 1 / 3, "lloyd_tetrahedron": 1 / 4}
+
+
+def check_material(E, nu, model=None):
+    """Validate E > 0 and -1 < nu < 1/2 (scalars or arrays; ValueError naming the value) and warn
+    (``FormulaValidityWarning``) when ``model`` is exact or optimal only at another nu."""
+    _positive("E", E)
+    _poisson(nu)
+    if model in VALID_NU:
+        _warn_nu(nu, VALID_NU[model], model)
 
 
 @dataclass(frozen=True)

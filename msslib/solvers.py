@@ -88,7 +88,9 @@ __all__ = [
 ]
 
 TINY = np.finfo(float).tiny
-ITERATIVE_THRESHOLD = 20_000  # free dofs above which "auto" uses preconditioned CG for SPD systems
+ITERATIVE_THRESHOLD = 8_000  # free dofs above which "auto" uses preconditioned CG for SPD systems
+# (measured crossover on lattice stiffnesses, single thread: SuperLU's fill grows like n^(4/3..2)
+# in 3D and is slower than AMG-preconditioned CG from a few thousand dofs on; see benchmarks/)
 
 
 class ConvergenceError(RuntimeError):
@@ -323,17 +325,68 @@ def _ic0_preconditioner(A):
     raise ValueError("IC(0) broke down even with a diagonal shift")
 
 
-def _preconditioner(A):
-    try:
-        import pyamg  # optional
+def _rigid_body_modes(coords, dim):
+    """Near-null space of elasticity on free nodes: ``dim`` translations and the rotations about
+    the centroid, ``(n_nodes * dim, 3 | 6)``, dofs interleaved by node."""
+    c = coords - coords.mean(axis=0)
+    nn = len(c)
+    if dim == 2:
+        B = np.zeros((2 * nn, 3))
+        B[0::2, 0] = B[1::2, 1] = 1.0
+        B[0::2, 2], B[1::2, 2] = -c[:, 1], c[:, 0]
+        return B
+    B = np.zeros((3 * nn, 6))
+    B[0::3, 0] = B[1::3, 1] = B[2::3, 2] = 1.0
+    B[1::3, 3], B[2::3, 3] = -c[:, 2], c[:, 1]
+    B[0::3, 4], B[2::3, 4] = c[:, 2], -c[:, 0]
+    B[0::3, 5], B[1::3, 5] = -c[:, 1], c[:, 0]
+    scale = np.abs(B[:, dim:]).max()
+    if scale > 0:
+        B[:, dim:] /= scale
+    return B
 
-        return pyamg.smoothed_aggregation_solver(sp.csr_matrix(A)).aspreconditioner(cycle="V")
+
+def _amg_preconditioner(A, context):
+    """pyamg smoothed aggregation; with node-aligned free dofs (``context['dim']`` and
+    ``context['coords']`` of the free nodes) it works on dim x dim blocks (BSR) with the rigid
+    body modes as near-null space, which is what makes it scale on elasticity; otherwise scalar
+    with the constant vector.  Raises ImportError without pyamg."""
+    import pyamg  # optional
+
+    A = sp.csr_matrix(A)
+    dim = context.get("dim") if context else None
+    coords = context.get("coords") if context else None
+    if dim and coords is not None and A.shape[0] == dim * len(coords) and len(coords) > 0:
+        A = A.tobsr(blocksize=(dim, dim))
+        ml = pyamg.smoothed_aggregation_solver(
+            A, B=_rigid_body_modes(coords, dim), strength=("symmetric", {"theta": 0.0}),
+            smooth=("jacobi", {"omega": 4.0 / 3.0}), improve_candidates=None, max_coarse=500)
+    else:
+        ml = pyamg.smoothed_aggregation_solver(A)
+    return ml.aspreconditioner(cycle="V")
+
+
+def _preconditioner(A, context=None):
+    try:
+        return _amg_preconditioner(A, context)
     except ImportError:
         return _ic0_preconditioner(A)
 
 
-def _linear_solve(A, b, method, symmetric, messages):
-    """Solve ``A x = b``; raise _NewtonFailure when the matrix is singular or the solve fails."""
+def _direct_solve(A, b, symmetric):
+    """SuperLU; for symmetric matrices with the minimum-degree ordering of A^T + A, which fills
+    less than the default COLAMD on lattice stiffnesses.  Non-symmetric: COLAMD."""
+    spec = "MMD_AT_PLUS_A" if symmetric else "COLAMD"
+    return spla.splu(sp.csc_matrix(A), permc_spec=spec).solve(np.asarray(b, dtype=float))
+
+
+def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10):
+    """Solve ``A x = b``; raise _NewtonFailure when the matrix is singular or the solve fails.
+
+    ``context`` (optional dict) holds ``dim`` and ``coords`` (free nodes) for the AMG near-null
+    space and a ``cache`` where the AMG hierarchy is kept and reused for the next matrices of the
+    same solve (Newton iterations, time steps) as long as CG converges fast with it.  ``rtol`` is
+    the CG tolerance (relative to ``||b||``)."""
     if callable(method):
         x = np.asarray(method(A, b), dtype=float)
         if not np.all(np.isfinite(x)):
@@ -344,25 +397,71 @@ def _linear_solve(A, b, method, symmetric, messages):
     n = A.shape[0]
     use_cg = method == "cg" or (method == "auto" and symmetric and n > ITERATIVE_THRESHOLD)
     if use_cg:
+        cache = context.setdefault("cache", {}) if context is not None else {}
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                M = _preconditioner(A)
-                x, info = _cg(A, b, M, rtol=1e-10, maxiter=max(1000, int(20 * np.sqrt(n))))
+                maxiter = max(1000, int(20 * np.sqrt(n)))
+                M = cache.get("M") if cache.get("shape") == A.shape else None
+                reused = M is not None
+                if M is None:
+                    M = _preconditioner(A, context)
+                count = [0]
+
+                def _count(_xk):
+                    count[0] += 1
+
+                x, info = _cg_counted(A, b, M, rtol, maxiter, _count)
+                if reused and (info != 0 or count[0] > 2 * cache.get("iterations", maxiter) + 10):
+                    # the kept hierarchy no longer fits the matrix: rebuild it and solve again
+                    M = _preconditioner(A, context)
+                    reused = False
+                    count[0] = 0
+                    x, info = _cg_counted(A, b, M, rtol, maxiter, _count)
+                if not reused:
+                    cache.update(M=M, shape=A.shape, iterations=count[0])
             if info == 0 and np.all(np.isfinite(x)):
                 return x
+            cache.clear()
             messages.append(f"CG did not converge (info={info}); falling back to sparse LU")
         except (RuntimeError, ValueError, ArithmeticError) as exc:
+            cache.clear()
             messages.append(f"preconditioned CG failed ({exc}); falling back to sparse LU")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            x = spla.splu(sp.csc_matrix(A)).solve(np.asarray(b, dtype=float))
+            x = _direct_solve(A, b, symmetric)
     except RuntimeError as exc:  # "Factor is exactly singular"
         raise _NewtonFailure(f"singular stiffness matrix ({exc})") from None
     if not np.all(np.isfinite(x)):
         raise _NewtonFailure("linear solve produced non-finite values (singular stiffness?)")
     return x
+
+
+def _cg_counted(A, b, M, rtol, maxiter, callback):
+    try:
+        return spla.cg(A, b, rtol=rtol, atol=0.0, M=M, maxiter=maxiter, callback=callback)
+    except TypeError:  # scipy < 1.12 spells it tol
+        return spla.cg(A, b, tol=rtol, atol=0.0, M=M, maxiter=maxiter, callback=callback)
+
+
+def _solver_context(problem, x, free):
+    """Context of :func:`_linear_solve`: spatial dimension and coordinates of the free nodes when
+    the free dofs are whole nodes (all or none of a node's dofs free)."""
+    dim = getattr(problem, "dim", None)
+    ctx = {"cache": {}}
+    try:
+        dim = int(dim) if dim else 0
+    except (TypeError, ValueError):
+        dim = 0
+    if dim in (2, 3) and free.size % dim == 0:
+        f = free.reshape(-1, dim)
+        whole = f.all(axis=1)
+        if np.array_equal(whole, f.any(axis=1)):
+            ctx["dim"] = dim
+            ctx["node_free"] = whole
+            ctx["coords"] = np.asarray(x, dtype=float).reshape(-1, dim)[whole]
+    return ctx
 
 
 def _force_scale(problem, x0, free):
@@ -372,6 +471,12 @@ def _force_scale(problem, x0, free):
     if np.isfinite(s) and s > TINY:
         return s
     xp = _with_prescribed(problem, x0, 1.0)
+    # displacement control: the linear force of the prescribed motion, K(x0) (xp - x0), is a scale
+    # that stays finite even when the prescribed state happens to be force-free (e.g. a mirror image)
+    with np.errstate(all="ignore"):
+        s = float(np.linalg.norm(problem.stiffness(x0, 1.0) @ (xp - x0)))
+    if np.isfinite(s) and s > TINY:
+        return s
     with np.errstate(all="ignore"):
         s = float(np.linalg.norm(np.asarray(problem.force(xp, 1.0), dtype=float)))
     if np.isfinite(s) and s > TINY:
@@ -418,7 +523,7 @@ def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy):
 
 
 def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_solver,
-            symmetric, use_energy, messages, progress, step_index):
+            symmetric, use_energy, messages, progress, step_index, solver_context=None):
     """Newton iteration at a fixed load. Returns (x, iterations, residual history).
 
     Raises _NewtonFailure with attributes ``iteration`` and ``residual`` on failure."""
@@ -426,6 +531,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         r = np.asarray(problem.force(x, load), dtype=float)[free]
     rnorm = float(np.linalg.norm(r))
     history = [rnorm]
+    context = _solver_context(problem, x, free) if solver_context is None else solver_context
     e = _energy_or_none(problem, x, load) if (line_search and use_energy) else None
     it = 0
 
@@ -444,7 +550,10 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         with np.errstate(all="ignore"):
             K = _submatrix(problem.stiffness(x, load), free)
         try:
-            dx = _linear_solve(K, r, linear_solver, symmetric, messages)
+            # CG tolerance: 1e-10, but never much tighter than needed to bring the linear part of
+            # the next residual 10x below the convergence threshold (no over-solving)
+            rtol = min(1e-6, max(1e-10, 0.1 * threshold / rnorm)) if rnorm > 0 else 1e-10
+            dx = _linear_solve(K, r, linear_solver, symmetric, messages, context, rtol)
         except _NewtonFailure as exc:
             raise fail(str(exc)) from None
         if line_search:
@@ -482,8 +591,11 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
     max_iter : Newton iterations allowed per load step before the step counts as failed.
     line_search : backtracking with the Armijo condition on the energy when ``problem.energy``
         returns a number and the Newton direction descends it, otherwise on ``||force[free]||^2``.
-    linear_solver : ``"auto"`` (sparse LU; preconditioned CG — pyamg if installed, else incomplete Cholesky IC(0) — for
-        symmetric systems with more than 20 000 free dofs, falling back to LU), ``"direct"``,
+    linear_solver : ``"auto"`` (sparse LU — minimum-degree ordering for symmetric systems — up to
+        ``ITERATIVE_THRESHOLD`` = 8 000 free dofs; above, for symmetric systems, CG preconditioned
+        by pyamg smoothed aggregation if installed (node blocks and rigid-body modes when the free
+        dofs are whole nodes; the hierarchy is reused across Newton iterations) or else by
+        incomplete Cholesky IC(0), falling back to LU), ``"direct"``,
         ``"cg"``, or a callable ``(K_free, rhs) -> dx``.
     progress : optional callable receiving a dict ``{load_step, load, iteration, residual,
         threshold}`` after each Newton iteration.
@@ -514,6 +626,7 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
     residuals: list[list[float]] = []
     loads: list[float] = []
     nominal = 1.0 / load_steps
+    solver_context = _solver_context(problem, x, free)  # AMG hierarchy kept across iterations
     lam = 0.0
     dlam = nominal
     n_cuts = 0
@@ -526,7 +639,8 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
         guess = _with_prescribed(problem, x, target)
         try:
             x_new, it, hist = _newton(problem, guess, free, target, threshold, max_iter, line_search,
-                                      linear_solver, symmetric, use_energy, messages, progress, step_index)
+                                      linear_solver, symmetric, use_energy, messages, progress, step_index,
+                                      solver_context)
         except _NewtonFailure as exc:
             if cuts_this_step >= max_cuts:
                 raise ConvergenceError(
@@ -712,6 +826,7 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
         return out
 
     f_scale = _force_scale(problem, x, free) if method == "implicit_euler" else None
+    solver_context = _solver_context(problem, x, free) if method == "implicit_euler" else None
 
     ts, xs, vs, kes, pes = [], [], [], [], []
 
@@ -750,7 +865,7 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
             else:
                 vf = _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, newton_tol,
                                           newton_max_iter, f_scale, linear_solver, symmetric, stats,
-                                          messages, step, t + h)
+                                          messages, step, t + h, solver_context)
                 x = x.copy()
                 x[free] += h * vf
             v = np.zeros(n)
@@ -770,7 +885,7 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
 
 
 def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, max_iter, f_scale,
-                         linear_solver, symmetric, stats, messages, step, t_new):
+                         linear_solver, symmetric, stats, messages, step, t_new, solver_context=None):
     """Backward Euler velocity update on the free dofs (Newton with residual backtracking)."""
     f0 = np.asarray(problem.force(x, load), dtype=float)[free]
     scale = max(float(np.linalg.norm(mf * vf)), h * float(np.linalg.norm(f0)), h * f_scale, TINY)
@@ -800,7 +915,7 @@ def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, ma
         K = _submatrix(problem.stiffness(xt, load), free)
         J = sp.diags(mf * (1.0 + h * alpha)) + (h * h + h * beta) * K
         try:
-            dw = _linear_solve(sp.csr_matrix(J), -R, linear_solver, symmetric, messages)
+            dw = _linear_solve(sp.csr_matrix(J), -R, linear_solver, symmetric, messages, solver_context)
         except _NewtonFailure as exc:
             raise ConvergenceError(
                 f"implicit Euler linear solve failed at step {step}, t = {t_new:.6g} s, iteration {it}: {exc}",

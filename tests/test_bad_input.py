@@ -82,10 +82,6 @@ BUILDERS = {
     "baudet_correction": lambda mats: MD.baudet_correction(HEX, mats, np.ones((HEX.n_nodes, 3))),
     "golec_cube_springs": lambda mats: MD.golec_cube_springs(HEX, mats, 1.0),
 }
-# builders that never look at nu (they neither check it nor warn): a fix is needed in model.py
-IGNORE_NU = {"lloyd_triangle_springs", "van_gelder_springs", "lloyd_square_springs", "lloyd_tet_springs"}
-_IGNORES_NU = ("msslib.model: the builder never passes nu to msslib.parameters, so an out-of-range nu "
-               "is accepted silently (fix: call the parameters function with nu=...)")
 
 
 @pytest.mark.parametrize("value", BAD_E)
@@ -96,9 +92,7 @@ def test_builders_reject_bad_E(name, value):
 
 
 @pytest.mark.parametrize("value", [0.5, -1.0])
-@pytest.mark.parametrize("name", [
-    pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=_IGNORES_NU)) if n in IGNORE_NU else n
-    for n in sorted(BUILDERS)])
+@pytest.mark.parametrize("name", sorted(BUILDERS))
 def test_builders_reject_bad_nu(name, value):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", P.FormulaValidityWarning)
@@ -106,8 +100,6 @@ def test_builders_reject_bad_nu(name, value):
             BUILDERS[name]([(E, value)])
 
 
-@pytest.mark.xfail(strict=True, reason="msslib.model.lloyd_triangle_springs / lloyd_square_springs do not pass "
-                   "nu to parameters.lloyd_triangle / lloyd_square, so no FormulaValidityWarning for nu != 1/3")
 @pytest.mark.parametrize("name", ["lloyd_triangle_springs", "lloyd_square_springs"])
 def test_builders_warn_outside_formula_validity(name):
     with pytest.warns(P.FormulaValidityWarning, match="nu = 0.3"):

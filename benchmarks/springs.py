@@ -1,0 +1,87 @@
+"""1-2: spring force evaluation and sparse Hessian assembly on a cube lattice."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from msslib import mesh as M
+from msslib import model as MD
+from msslib import terms as T
+
+from .common import median_time
+
+
+def lattice(n: int, E: float = 1e4, nu: float = 0.25):
+    """n^3 cubes of 1 cm, springs on edges, face and inner diagonals (Golec's constants at
+    nu = 1/4, where his volume term vanishes: the springs alone are the model)."""
+    mesh = M.hex_grid(0.01 * n, 0.01 * n, 0.01 * n, n, n, n)
+    springs = MD.golec_cube_springs(mesh, [(E, nu)], 1.0)[0]
+    return mesh, springs
+
+
+def numpy_gradient(x, a, b, k, L0, n_dof):
+    """Baseline: vectorised numpy with np.bincount scatter."""
+    p = x.reshape(-1, 3)
+    d = p[a] - p[b]
+    l = np.sqrt(np.einsum("ij,ij->i", d, d))
+    f = d * (k * (L0 - l) / l)[:, None]
+    g = np.empty((n_dof // 3, 3))
+    for c in range(3):
+        g[:, c] = np.bincount(b, weights=f[:, c], minlength=n_dof // 3) - np.bincount(a, weights=f[:, c], minlength=n_dof // 3)
+    return g.ravel()
+
+
+def stream_bandwidth(nbytes: int = 64_000_000) -> float:
+    """numpy copy bandwidth (bytes read + written per second), large arrays (out of cache)."""
+    a = np.random.default_rng(0).random(nbytes // 8)
+    b = np.empty_like(a)
+    t = median_time(lambda: np.copyto(b, a), repeat=7)
+    return 2 * a.nbytes / t
+
+
+def run(res, quick: bool):
+    n = 15 if quick else 30
+    mesh, springs = lattice(n)
+    s = len(springs.conn)
+    x = mesh.points.ravel() + 1e-4 * np.random.default_rng(1).standard_normal(mesh.n_nodes * 3)
+    rep = 7 if quick else 15
+    a, b = springs.conn[:, 0].copy(), springs.conn[:, 1].copy()
+    t_np = median_time(lambda: numpy_gradient(x, a, b, springs.k, springs.rest_length, x.size), repeat=3)
+    t_ref = median_time(lambda: springs.gradient_reference(x), repeat=rep)
+    t_fast = median_time(lambda: springs.gradient(x), repeat=rep)
+    g, g_ref = springs.gradient(x), springs.gradient_reference(x)
+    err = float(np.abs(g - g_ref).max() / np.abs(g_ref).max())
+    tag = f"lattice {n}^3 cubes, {s} springs"
+    res.add("spring_force_numpy_bincount", s / t_np / 1e6, "M springs/s", 1.0, "itself", tag)
+    res.add("spring_force_numba_plain", s / t_ref / 1e6, "M springs/s", t_np / t_ref, "numpy_bincount")
+    res.add("spring_force_fast", s / t_fast / 1e6, "M springs/s", t_ref / t_fast, "numba_plain",
+            "target >= 150 M springs/s")
+    res.add("spring_force_fast_rel_error", err, "(max |g - g_generated| / max |g|)", None, None, "must be <= 1e-12")
+    # bandwidth bound: bytes one pass must move (node-ordered layout)
+    _, rowptr, ib, k, L0 = springs.node_layout()
+    nbytes = ib.nbytes + k.nbytes + L0.nbytes + rowptr.nbytes + x.nbytes + 2 * x.nbytes  # x read, g read+write
+    bw = stream_bandwidth()
+    limit = s / (nbytes / bw)
+    res.add("stream_copy_bandwidth", bw / 1e9, "GB/s", None, None, "numpy copy, read+write bytes")
+    res.add("spring_force_bandwidth_limit", limit / 1e6, "M springs/s", None, None,
+            f"{nbytes / s:.1f} bytes/spring per pass at the copy bandwidth")
+    res.add("spring_force_fraction_of_bandwidth_limit", (s / t_fast) / limit, "", None, None)
+
+    # ---- Hessian assembly
+    model = MD.Model(mesh, [springs])
+    t_fill = median_time(lambda: model.stiffness(x), repeat=rep)
+    rows, cols = springs.hessian_pattern()
+    vals = np.empty((s, 36))
+
+    def coo():
+        T._spring3d_hessian_loop(x, springs.conn, springs.k, springs.rest_length, vals)
+        return sp.coo_matrix((vals.ravel(), (rows, cols)), shape=(x.size, x.size)).tocsr()
+
+    t_coo = median_time(coo, repeat=3)
+    K, Kc = model.stiffness(x), coo()
+    herr = float(abs(K - Kc).max() / abs(Kc).max())
+    res.add("hessian_assembly_scipy_coo", t_coo * 1e3, "ms", 1.0, "itself", f"values + COO->CSR, nnz {Kc.nnz}")
+    res.add("hessian_assembly_fast", t_fill * 1e3, "ms", t_coo / t_fill, "scipy_coo",
+            "Model.stiffness, precomputed CSR pattern; target ratio >= 30")
+    res.add("hessian_assembly_rel_error", herr, "", None, None)
