@@ -38,6 +38,29 @@ from numba import njit
 
 from msslib.generated import kernels as _K
 
+
+def _drop_stale_numba_cache() -> None:
+    """numba's on-disk cache of the loops below is keyed on this file only, not on the generated
+    kernels they inline: when ``msslib/generated/kernels.py`` changes (re-derived), drop it."""
+    import hashlib
+    from pathlib import Path
+
+    try:
+        cache_dir = Path(__file__).resolve().parent / "__pycache__"
+        digest = hashlib.sha256(Path(_K.__file__).read_bytes()).hexdigest()
+        stamp = cache_dir / "terms.kernels-sha256"
+        if stamp.is_file() and stamp.read_text() == digest:
+            return
+        for f in cache_dir.glob("terms.*.nb[ic]"):
+            f.unlink(missing_ok=True)
+        cache_dir.mkdir(exist_ok=True)
+        stamp.write_text(digest)
+    except OSError:  # read-only installation: numba falls back to compiling in memory
+        pass
+
+
+_drop_stale_numba_cache()
+
 __all__ = [
     "Term",
     "Springs",
