@@ -40,7 +40,6 @@ def _findings_md(derivations) -> str:
 def write(derivations) -> None:
     paper = ROOT / "paper"
     paper.mkdir(exist_ok=True)
-    # only modules that report something; keep earlier results of modules not re-derived now
     (paper / "errata.md").write_text(_errata_md(derivations))
     (paper / "derivations.md").write_text(_findings_md(derivations))
     data = {m: {"title": d.title,

@@ -319,7 +319,7 @@ def _expand_block_pattern(nptr, ucol, dim, indices, indptr):
 
 
 def _parameters():
-    from msslib import parameters  # written by the lead; imported lazily
+    from msslib import parameters  # imported lazily
 
     return parameters
 

@@ -221,7 +221,7 @@ def test_golec_correction_dimensions():
 
 # ---- generated code -------------------------------------------------------------------------
 
-DERIVED = ["triangle", "square", "tetrahedron", "cube_baudet", "cube_golec", "kernels"]
+DERIVED = ["triangle", "square", "rectangle", "tetrahedron", "cube_baudet", "cube_golec", "kernels"]
 
 
 @pytest.mark.parametrize("module", DERIVED)

@@ -1,5 +1,5 @@
 # Generated from derivations/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 3597d5a059c93696bc9581e9fae8c7f93e3fcc41302685a9e960a2728531da43
+# source-sha256: 3ae6ed7f5d3c50f096b6ed1110334eaefc74c71e35a0c697741746a0bad1a887
 # body-sha256: a35ff5265d287f0040075799752d846c04cfcc02c51cc80aa3045cf95055a64d
 """Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 0b41ded46007ecbef2b028a8e9b1e1d57dfba8f870247caa80bbf9ca165c579a
+# source-sha256: b773434246f0ee5383e4bcd2ac6c1c4b3c1984966b03854e8b9f8f59cb45a8a7
 # body-sha256: 27a48c1508e2c336a6de6ee220c683003e0ac46e9e9f1ac653a3e8238d975b82
 """Cube with edge, face and inner springs and volume correction (Golec et al.).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/kernels.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 4f4c9cbc22d31ab27ac469b10e5338a18dc9cea9b2bee026e97d45d687eb4441
+# source-sha256: 5ea662896dd3f94ffe6bf5d8d69f4315ef54d51cab28ead9d03dbadffdc7523e
 # body-sha256: 697db20548f54e3fa8340025635f2b0c82ddf3f46b91b62364777ff0a18ee566
 """Energy, gradient and Hessian kernels.
 

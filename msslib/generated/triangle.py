@@ -1,5 +1,5 @@
 # Generated from derivations/triangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 7ee83b83c50cd446016aeac93fbc84b865a659fc30aef9eb91f0073e9b9ee991
+# source-sha256: 729d8e62ca7c02cc914395b5c553c336df7d125adaa4521498088ffa56b9b2fc
 # body-sha256: c6ba7510b590fab05b555a4882f6db07bb64bbe5ac2fa7a67658d8e149997bb2
 """Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9).
 
