@@ -102,20 +102,24 @@ rule scene:
         "python -m msslib run {input.scene} --out {output} --quiet > {log} 2>&1"
 
 
-rule experiment_run:
-    """One (case, model variant) of an experiment."""
-    input:
-        exp="experiments/{paper}/{exp}.yaml",
-        derived="paper/derivations.json",
-    output:
-        "results/{paper}/{exp}/{case}__{model}.nc",
-    params:
-        quick=QFLAG,
-    log:
-        "logs/{paper}/{exp}/{case}__{model}.log",
-    shell:
-        "python -m msslib experiment run {input.exp} --case {wildcards.case} --model {wildcards.model} "
-        "{params.quick} --quiet --out {output} > {log} 2>&1"
+# One job per experiment runs all its (case, model) pairs in one process (the imports cost more
+# than a small run); each pair is still its own NetCDF file.
+for (_paper, _exp), _path in experiments().items():
+    rule:
+        name:
+            f"experiment_{_paper}_{_exp}"
+        input:
+            exp=str(_path),
+            derived="paper/derivations.json",
+        output:
+            [f"results/{_paper}/{_exp}/{r}.nc" for r in runs(_paper, _exp)],
+        params:
+            quick=QFLAG,
+            outdir=f"results/{_paper}/{_exp}",
+        log:
+            f"logs/{_paper}/{_exp}/runs.log",
+        shell:
+            "python -m msslib experiment run-all {input.exp} --out-dir {params.outdir} {params.quick} --quiet > {log} 2>&1"
 
 
 rule experiment_compare:

@@ -162,6 +162,12 @@ def _add_experiment(subparsers) -> None:
     c.add_argument("--out", "-o", required=True, help="comparison file (NetCDF)")
     c.add_argument("--table", help="also write the comparison as a Markdown table")
     c.set_defaults(func=_cmd_experiment_compare)
+    a = sub.add_parser("run-all", help="run every (case, model) of an experiment in one process")
+    a.add_argument("experiment", help="experiment file (YAML)")
+    a.add_argument("--out-dir", required=True, help="directory for CASE__MODEL.nc")
+    a.add_argument("--quick", action="store_true", help="apply the experiment's reduced (quick) overrides")
+    a.add_argument("--quiet", "-q", action="store_true")
+    a.set_defaults(func=_cmd_experiment_run_all)
     ls = sub.add_parser("list", help="print the CASE__MODEL run names of an experiment")
     ls.add_argument("experiment")
     ls.set_defaults(func=_cmd_experiment_list)
@@ -176,6 +182,22 @@ def _cmd_experiment_run(args) -> int:
     _check_writable(out, "output file")
     ds = experiment.run(exp, args.case, args.model, quick=args.quick, progress=not args.quiet)
     write_result(out, ds)
+    return 0
+
+
+def _cmd_experiment_run_all(args) -> int:
+    from msslib import experiment
+    from msslib.io import write_result
+
+    exp = experiment.load_experiment(args.experiment)
+    out_dir = Path(args.out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    runs = experiment.runs(exp)
+    for i, (case, model) in enumerate(runs, 1):
+        out = out_dir / f"{case}__{model}.nc"
+        if not args.quiet:
+            print(f"[{i}/{len(runs)}] {exp.name}: {case} / {model}", file=sys.stderr, flush=True)
+        write_result(out, experiment.run(exp, case, model, quick=args.quick, progress=not args.quiet))
     return 0
 
 

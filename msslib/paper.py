@@ -43,6 +43,9 @@ def _value(root: Path, spec: str) -> str:
         else:
             sel[k] = v
     with xr.open_dataset(path) as ds:
+        for k, v in list(sel.items()):  # labels are text in the template: match the coordinate's type
+            if k in ds.coords and ds[k].dtype.kind in "fiu":
+                sel[k] = ds[k].dtype.type(float(v))
         if var in ds.variables:
             val = ds[var].sel(sel) if sel else ds[var]
             val = float(val.values)
