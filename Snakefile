@@ -192,6 +192,18 @@ rule stability:
         "python {input.script} --out {output} {params.quick} > {log} 2>&1"
 
 
+rule benchmarks:
+    """Speed figures with their baselines (reduced sizes unless --config benchmarks=full)."""
+    output:
+        "results/benchmarks.json",
+    params:
+        size="" if config.get("benchmarks") == "full" else "--quick",
+    log:
+        "logs/benchmarks.log",
+    shell:
+        "python -m benchmarks {params.size} --out {output} > {log} 2>&1"
+
+
 rule paper:
     """The paper: Markdown sources with figures, tables and numbers from results, to HTML."""
     input:

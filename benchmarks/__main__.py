@@ -56,7 +56,9 @@ def main(argv=None):
             "pyamg": amg, "wall_s": time.perf_counter() - t0}
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"meta": meta, "figures": res.figures}, indent=2))
+    tmp = out.with_name(f".{out.name}.tmp")
+    tmp.write_text(json.dumps({"meta": meta, "figures": res.figures}, indent=2))
+    os.replace(tmp, out)  # atomic: no partial file
     print(f"wrote {out} ({len(res.figures)} figures, {meta['wall_s']:.1f} s)")
     return 0
 

@@ -1,0 +1,32 @@
+"""The benchmark figures with their baselines, threads and load, as a Markdown table."""
+
+import argparse
+import json
+import os
+from pathlib import Path
+
+INPUTS = ["results/benchmarks.json"]
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--out", required=True)
+    a = p.parse_args()
+    data = json.loads(Path(INPUTS[0]).read_text())
+    m = data["meta"]
+    lines = [f"`python -m benchmarks{' --quick' if m['quick'] else ''}`: BLAS and numba pinned to "
+             f"{m['threads_blas']}/{m['threads_numba']} thread(s) ({m['thread_pools']}); {m['cpu_count']} cores, "
+             f"load average {m['load_average']:.1f} at the start; numpy {m['numpy']}, numba {m['numba']}, "
+             f"pyamg {m['pyamg']}; {m['wall_s']:.0f} s in all." + (" Reduced sizes." if m["quick"] else ""), "",
+             "| figure | value | unit | ratio to baseline | baseline | note |", "|---|---|---|---|---|---|"]
+    for name, f in data["figures"].items():
+        r = "-" if f["ratio_to_baseline"] is None else f"{f['ratio_to_baseline']:.3g}"
+        lines.append(f"| {name} | {f['value']:.4g} | {f['unit']} | {r} | {f['baseline'] or '-'} | {f['note']} |")
+    out = Path(a.out)
+    tmp = out.with_name(f".{out.name}.tmp")
+    tmp.write_text("\n".join(lines) + "\n")
+    os.replace(tmp, out)
+
+
+if __name__ == "__main__":
+    main()
