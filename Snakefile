@@ -137,10 +137,16 @@ rule experiment_compare:
         "--out {output.nc} --table {output.table} > {log} 2>&1"
 
 
+def shared(wc):
+    """Helper modules next to a group's scripts (experiments/<paper>/*.py): edits rebuild."""
+    return sorted(str(p) for p in Path("experiments", wc.paper).glob("*.py"))
+
+
 rule study:
     """A sweep that does not fit cases x models (e.g. error against strain or nu)."""
     input:
         script="experiments/{paper}/studies/{name}.py",
+        shared=shared,
         derived="paper/derivations.json",
     output:
         "results/{paper}/studies/{name}.nc",
@@ -155,6 +161,7 @@ rule study:
 rule figure:
     input:
         script="experiments/{paper}/figures/{name}.py",
+        shared=shared,
         data=lambda wc: declared_inputs(f"experiments/{wc.paper}/figures/{wc.name}.py"),
     output:
         png="paper/figures/{paper}_{name}.png",
@@ -168,6 +175,7 @@ rule figure:
 rule table:
     input:
         script="experiments/{paper}/tables/{name}.py",
+        shared=shared,
         data=lambda wc: declared_inputs(f"experiments/{wc.paper}/tables/{wc.name}.py"),
     output:
         "paper/tables/{paper}_{name}.md",

@@ -1,0 +1,342 @@
+"""Shared pieces of the Baudet et al. (2007) studies (not a study itself: studies/*.py import it).
+
+* :func:`block` -- a box of Baudet cubes with symmetry planes x = 0, y = 0, z = 0 (an octant of a
+  body twice as large in every direction), a unit load on chosen faces and the correction built
+  from that load (derived factor, or the printed one with ``published=True``);
+* :class:`Path` -- the model with its load multiplied by a factor, moved from one factor to the
+  next (continuation: each equilibrium starts from the previous one);
+* :func:`follow` -- load continuation until a measured quantity reaches a target;
+* :func:`write` -- atomic NetCDF output through :func:`msslib.io.write_result`.
+
+All quantities SI. Loads are dead loads in the reference configuration (nominal stresses), as in
+the paper's definitions (eqs. 1-6: forces over the rest areas, changes over rest lengths).
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path as _P
+
+import numpy as np
+
+from msslib import mesh as M
+from msslib import model as MD
+from msslib import terms as T
+from msslib.solvers import static_solve
+
+E0 = 1.0e3  # Pa: the errors do not depend on E (all spring constants and forces scale with it)
+A0 = 0.1  # m, cube edge
+NUS = (0.1, 0.2, 0.3, 0.4, 0.499)  # nu = 0.5 of the paper as 0.499 (nu < 1/2 for the FEM-style parameters)
+NU_LABELS = tuple(f"{v:g}" for v in NUS)
+FACTORS = ("derived", "printed")
+STEPS = 40  # load levels per curve (set to 10 by --quick)
+
+
+def parse(doc):
+    p = argparse.ArgumentParser(description=doc)
+    p.add_argument("--out", required=True, help="output NetCDF file")
+    p.add_argument("--quick", action="store_true", help="reduced version (CI)")
+    args = p.parse_args()
+    global STEPS
+    STEPS = 10 if args.quick else 40
+    return args
+
+
+def face_facets(mesh, axis, value):
+    """Boundary facets lying in the plane ``x_axis = value``."""
+    facets = M.boundary_facets(mesh)
+    nodes = M.select_nodes(mesh, plane=(axis, value))
+    return facets[np.all(np.isin(facets, nodes), axis=1)]
+
+
+def block(n, nu, *, published=False, tractions=(), fixed_planes="xyz", fix_all_planes=(), E=E0, a=A0,
+          correction=True):
+    """Box of ``n = (nx, ny, nz)`` cubes of edge ``a``.
+
+    ``tractions``: list of ``(axis, value, traction_vector)``: a dead traction (Pa, at unit load)
+    on the boundary face ``x_axis = value``. ``fixed_planes``: axes whose ``= 0`` plane is a
+    symmetry plane (normal displacement fixed). ``fix_all_planes``: axes whose ``= 0`` face is
+    clamped (all displacements fixed). Returns ``(mesh, model)``; the model has the springs, the
+    loads and Baudet's correction computed from those loads (left out with ``correction=False``).
+    """
+    mesh = M.hex_grid(a * n[0], a * n[1], a * n[2], *n)
+    terms = list(MD.baudet_cube_springs(mesh, [(E, nu)], published=published))
+    loads = [T.Traction(mesh, face_facets(mesh, ax, val), vec) for ax, val, vec in tractions]
+    terms += loads
+    # One correction per loaded face, summed (the correction is linear in the face forces): msslib
+    # shares the load of a node among the boundary faces it pushes on, which halves the elongation
+    # force at an edge where two loaded faces meet (pressure on a box); built face by face, each
+    # face gets exactly its own normal resultant.
+    if correction:
+        terms += [MD.baudet_correction(mesh, [(E, nu)], [ld], published=published) for ld in loads]
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    for ax in fixed_planes:
+        d = "xyz".index(ax)
+        fixed[M.select_nodes(mesh, plane=(ax, 0.0)), d] = True
+    for ax in fix_all_planes:
+        fixed[M.select_nodes(mesh, plane=(ax, 0.0)), :] = True
+    return mesh, MD.Model(mesh, terms, fixed=fixed)
+
+
+class Path:
+    """``model`` with the load factor mapped from [0, 1] onto [s0, s1] (load continuation)."""
+
+    def __init__(self, model, s0, s1):
+        self.m, self.s0, self.s1 = model, float(s0), float(s1)
+        self.n_dof, self.free, self.symmetric, self.dim = model.n_dof, model.free, model.symmetric, model.dim
+        self.mass = model.mass
+
+    def _s(self, load):
+        return self.s0 + load * (self.s1 - self.s0)
+
+    def force(self, x, load=1.0):
+        return self.m.force(x, self._s(load))
+
+    def stiffness(self, x, load=1.0):
+        return self.m.stiffness(x, self._s(load))
+
+    def energy(self, x, load=1.0):
+        return None
+
+    def apply_prescribed(self, x, load=1.0):
+        return self.m.apply_prescribed(x, self._s(load))
+
+
+def unit_load_norm(model):
+    f = model.external_force(1.0)
+    return float(np.linalg.norm(f[model.free]))
+
+
+def follow(model, measure, target, first_step, *, max_levels=400, tol=1e-10, grow=1.0, n_steps=None):
+    """Increase the load factor from 0 in steps until ``|measure(x)| >= target``.
+
+    ``measure(x)`` returns the controlling quantity (e.g. the axial strain) of the flat state ``x``;
+    ``first_step`` is the initial load increment; later increments aim at equal increments of the
+    measure (``target / 40`` by default through the secant slope), times ``grow``. Returns the list
+    of load factors and the list of states (flat positions), the rest state excluded.
+    """
+    x = model.x0.copy()
+    s, ds = 0.0, float(first_step) * 1e-2  # probe: the response may be far softer than expected
+    scale = unit_load_norm(model)
+    loads, states = [], []
+    dq = target / (n_steps or STEPS)
+    for _ in range(max_levels):
+        s1 = s + ds
+        r = static_solve(Path(model, s, s1), x, load_steps=1, tol=tol, max_iter=60,
+                         force_scale=max(abs(s1), 1e-300) * scale)
+        x, s = r.x, s1
+        q = measure(x)
+        loads.append(s)
+        states.append(x.copy())
+        if abs(q) >= target:
+            break
+        slope = abs(q) / abs(s) if s != 0 else 0.0
+        if slope > 0:
+            ds = np.sign(ds) * min(dq / slope * grow, 4.0 * abs(ds), abs(s) + abs(ds))
+    else:
+        raise RuntimeError(f"target {target} not reached after {max_levels} load levels")
+    return np.array(loads), states
+
+
+def write(ds, out, t0):
+    from msslib.io import write_result
+
+    ds.attrs.setdefault("paper", "baudet")
+    ds.attrs["wall_time_s"] = time.perf_counter() - t0
+    _P(out).parent.mkdir(parents=True, exist_ok=True)
+    write_result(out, ds)
+
+
+class Reduced:
+    """``model`` restricted to positions ``x = x0 + B y`` (``B`` sparse or dense ``(n_dof, r)``):
+    the state of the solver is ``y`` (r values, start at 0), forces and stiffness are projected
+    (``B^T f``, ``B^T K B``). Used for kinematic ties, e.g. a rigid loading plate."""
+
+    def __init__(self, model, B):
+        import scipy.sparse as sp
+
+        self.m, self.B = model, sp.csr_matrix(B)
+        self.n_dof = self.B.shape[1]
+        self.free = np.ones(self.n_dof, dtype=bool)
+        self.symmetric, self.dim = model.symmetric, 1
+        self.mass = np.ones(self.n_dof)
+        self.s0, self.s1 = 0.0, 1.0
+
+    def x(self, y):
+        return self.m.x0 + self.B @ np.asarray(y, dtype=float)
+
+    def _s(self, load):
+        return self.s0 + load * (self.s1 - self.s0)
+
+    def force(self, y, load=1.0):
+        return self.B.T @ self.m.force(self.x(y), self._s(load))
+
+    def stiffness(self, y, load=1.0):
+        import scipy.sparse as sp
+
+        return sp.csr_matrix(self.B.T @ self.m.stiffness(self.x(y), self._s(load)) @ self.B)
+
+    def energy(self, y, load=1.0):
+        return None
+
+
+def follow_reduced(red, measure, target, first_step, *, max_levels=400, tol=1e-10, n_steps=None):
+    """:func:`follow` for a :class:`Reduced` problem; ``measure`` gets full positions."""
+    y = np.zeros(red.n_dof)
+    s, ds = 0.0, float(first_step) * 1e-2
+    f1 = red.B.T @ red.m.external_force(1.0)
+    scale = float(np.linalg.norm(f1))
+    loads, states = [], []
+    dq = target / (n_steps or STEPS)
+    for _ in range(max_levels):
+        red.s0, red.s1 = s, s + ds
+        r = static_solve(red, y, load_steps=1, tol=tol, max_iter=60, force_scale=max(abs(s + ds), 1e-300) * scale)
+        y, s = r.x, s + ds
+        x = red.x(y)
+        q = measure(x)
+        loads.append(s)
+        states.append(x.copy())
+        if abs(q) >= target:
+            break
+        slope = abs(q) / abs(s)
+        if slope > 0:
+            ds = np.sign(ds) * min(dq / slope, 4.0 * abs(ds), abs(s) + abs(ds))
+    else:
+        raise RuntimeError(f"target {target} not reached after {max_levels} load levels")
+    return np.array(loads), states
+
+
+def tie_matrix(n_nodes, free_nodes, groups):
+    """``B`` for :class:`Reduced`: every node of ``free_nodes`` moves on its own (3 columns each),
+    every group (a list of node ids) moves as one rigid translation (3 columns); other nodes are
+    fixed. Column order: free nodes, then groups."""
+    rows, cols = [], []
+    c = 0
+    for a in free_nodes:
+        for d in range(3):
+            rows.append(3 * a + d)
+            cols.append(c)
+            c += 1
+    for g in groups:
+        for d in range(3):
+            for a in g:
+                rows.append(3 * a + d)
+                cols.append(c)
+            c += 1
+    import scipy.sparse as sp
+
+    return sp.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(3 * n_nodes, c))
+
+
+# ---- figures ----------------------------------------------------------------------------------
+
+def figure_args(doc):
+    p = argparse.ArgumentParser(description=doc)
+    p.add_argument("--out", required=True, help="output stem (writes STEM.png and STEM.pdf)")
+    return p.parse_args()
+
+
+def open_result(path):
+    import xarray as xr
+
+    with xr.open_dataset(path) as ds:
+        return ds.load()
+
+
+def magnified(ds, factor):
+    out = ds.copy()
+    out["displacement"] = ds["displacement"] * factor
+    return out
+
+
+def shapes_and_errors(pairs, ref, *, plane, magnify, length_unit="mm", title=None, panel=(3.0, 3.0)):
+    """One column per MSS result: top, its wireframe (red) over the FEM reference coloured by the
+    true |u| (mm), displacements magnified ``magnify`` times for the drawing; bottom, the per-node
+    error |u_MSS - u_FEM| (mm) on the MSS mesh (FEM interpolated at the MSS nodes)."""
+    from matplotlib.lines import Line2D
+
+    from msslib import plotting
+
+    n = len(pairs)
+    fig = plotting.figure(figsize=(panel[0] * n + 1.4, 2 * panel[1] + 0.8))
+    axes = fig.subplots(2, n, squeeze=False)
+    u_ref = np.linalg.norm(ref["displacement"].values, axis=-1)
+    umax = float(u_ref.max()) * 1e3
+    errs = {k: plotting.node_error(v, ref) for k, v in pairs.items()}
+    emax = max(float(e.max()) for e in errs.values()) * 1e3
+    ref_m = magnified(ref, magnify)
+    im = em = None
+    for j, (name, ds) in enumerate(pairs.items()):
+        top, bot = axes[0, j], axes[1, j]
+        plotting.deformed_mesh(top, ref, color="0.75", deformed=False, plane=plane, length_unit=length_unit, linewidth=0.4)
+        im = plotting.deformed_mesh(top, ref_m, color=None, colorby=u_ref, plane=plane, length_unit=length_unit,
+                                    vmin=0.0, vmax=umax)
+        plotting.deformed_mesh(top, magnified(ds, magnify), color="tab:red", plane=plane, length_unit=length_unit,
+                               linewidth=0.9)
+        top.set_title(name)
+        em = plotting.deformed_mesh(bot, ds, color="0.6", colorby=errs[name], plane=plane, length_unit=length_unit,
+                                    cmap="magma_r", vmin=0.0, vmax=emax, linewidth=0.3)
+        if j:
+            top.set_ylabel("")
+            bot.set_ylabel("")
+    fig.colorbar(im, ax=axes[0, :].tolist(), label="FEM |u| (mm)", shrink=0.9)
+    fig.colorbar(em, ax=axes[1, :].tolist(), label="|u$_{MSS}$ - u$_{FEM}$| (mm)", shrink=0.9)
+    handles = [Line2D([], [], color="tab:red", lw=1.0, label=f"MSS (displacement x{magnify:g})"),
+               Line2D([], [], color="tab:green", lw=6, alpha=0.5, label=f"FEM, coloured by |u| (x{magnify:g})"),
+               Line2D([], [], color="0.75", lw=0.6, label="rest shape")]
+    fig.legend(handles=handles, loc="outside upper center", ncol=3, frameon=False)
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+NU_COLORS = {"0.1": "tab:blue", "0.2": "tab:orange", "0.3": "tab:green", "0.4": "tab:red", "0.499": "tab:purple"}
+
+
+def curves(da, x, *, xlabel, ylabel, panels, xscale=100.0, yscale=100.0, absolute=False, dashed=None, ylog=False,
+           marks=None):
+    """Error curves per nu: one panel per entry of ``panels`` ({title: selection dict}); ``dashed``
+    an optional second selection drawn dashed in the same panel ({label: selection}). ``marks``:
+    published points {title: [(x, y, nu_label), ...]} drawn as black-edged markers."""
+    from matplotlib.lines import Line2D
+
+    from msslib import plotting
+
+    n = len(panels)
+    fig = plotting.figure(figsize=(3.6 * n + 0.4, 3.4))
+    axes = fig.subplots(1, n, squeeze=False, sharey=not ylog and False)[0]
+    for ax, (title, sel) in zip(axes, panels.items()):
+        for nu in da["nu"].values:
+            y = da.sel(**sel, nu=nu).values * yscale
+            ax.plot(x * xscale, np.abs(y) if absolute else y, color=NU_COLORS.get(str(nu)), label=f"nu = {nu}")
+            if dashed:
+                for lab, sel2 in dashed.items():
+                    y2 = da.sel(**{**sel, **sel2}, nu=nu).values * yscale
+                    ax.plot(x * xscale, np.abs(y2) if absolute else y2, color=NU_COLORS.get(str(nu)), ls="--")
+        for (px, py, nu) in (marks or {}).get(title, []):
+            ax.plot(px, py, "o", mfc=NU_COLORS.get(nu, "k"), mec="k", ms=6)
+        ax.set_title(title)
+        ax.set_xlabel(xlabel)
+        ax.grid(alpha=0.3)
+        if ylog:
+            ax.set_yscale("log")
+    axes[0].set_ylabel(ylabel)
+    handles, labels = axes[0].get_legend_handles_labels()
+    if dashed:
+        handles += [Line2D([], [], color="k", ls="-", label="solid: " + next(iter(panels.values())).get("geometry", "")),
+                    Line2D([], [], color="k", ls="--", label="dashed: " + ", ".join(dashed))]
+    if marks:
+        handles.append(Line2D([], [], ls="", marker="o", mfc="w", mec="k", label="published (text)"))
+    fig.legend(handles=handles, loc="outside upper center", ncol=min(len(handles), 4), frameon=False)
+    return fig
+
+
+def section_deflection(ds):
+    """Mean vertical (-z) displacement of every cross-section x = const of a result: the
+    deflection of the neutral axis for a beam bent about y (x values, deflections, both in m)."""
+    X = ds["rest_position"].transpose("node", "axis").values
+    u = ds["displacement"].transpose("node", "axis").values
+    xs = np.unique(np.round(X[:, 0], 12))
+    w = np.array([-u[np.isclose(X[:, 0], v), 2].mean() for v in xs])
+    return xs, w

@@ -1,0 +1,24 @@
+"""Baudet Fig. 8: error of the bulk modulus against the volume change (deflation < 0 < inflation)."""
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import baudet_common as C  # noqa: E402
+from msslib import plotting  # noqa: E402
+
+INPUTS = ["results/baudet/studies/bulk.nc"]
+
+
+def main():
+    args = C.figure_args(__doc__)
+    ds = C.open_result(INPUTS[0])
+    panels = {"derived factor -(4nu-1)/2": {"geometry": "cube", "factor": "derived"},
+              "printed factor -(4nu-1)/16": {"geometry": "cube", "factor": "printed"}}
+    fig = C.curves(ds["B_error"], ds["volume_change"].values, xlabel="volume change dV/V0 (%)", ylabel="B error (%)",
+                   panels=panels, dashed={"block of 4x4x4 cubes": {"geometry": "block"}})
+    plotting.save(fig, args.out)
+
+
+if __name__ == "__main__":
+    main()

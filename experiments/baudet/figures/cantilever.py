@@ -1,0 +1,23 @@
+"""Baudet Fig. 10: cantilever under gravity, MSS wireframes over the FEM reference and error maps."""
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import baudet_common as C  # noqa: E402
+from msslib import plotting  # noqa: E402
+
+RES = ("4x1x1", "8x2x2", "16x4x4")
+INPUTS = [f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES] + ["results/baudet/cantilever/gravity__fem.nc"]
+
+
+def main():
+    args = C.figure_args(__doc__)
+    ref = C.open_result(INPUTS[-1])
+    pairs = {f"{r} cubes": C.open_result(p) for r, p in zip(RES, INPUTS[:-1])}
+    fig = C.shapes_and_errors(pairs, ref, plane="xz", magnify=100.0, panel=(3.6, 1.6))
+    plotting.save(fig, args.out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,36 @@
+"""Baudet Figs. 9-10: deflection of the cantilever's neutral axis, MSS and FEM against eq. 10."""
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import baudet_common as C  # noqa: E402
+from msslib import plotting  # noqa: E402
+
+RES = ("4x1x1", "8x2x2", "16x4x4")
+INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]
+          + ["results/baudet/cantilever/gravity__fem.nc", "results/baudet/studies/cantilever_eq10.nc"])
+
+
+def main():
+    args = C.figure_args(__doc__)
+    eq = C.open_result(INPUTS[-1])
+    fig = plotting.figure(figsize=(6.0, 3.6))
+    ax = fig.add_subplot()
+    ax.plot(eq["x"] * 1e3, eq["deflection_eq10"] * 1e3, "k-", lw=2, label="eq. 10 (Euler-Bernoulli)")
+    ax.plot(eq["x"] * 1e3, eq["deflection_timoshenko"] * 1e3, "k:", lw=1.5, label="eq. 10 + shear (Timoshenko)")
+    x, w = C.section_deflection(C.open_result(INPUTS[-2]))
+    ax.plot(x * 1e3, w * 1e3, color="0.5", lw=3, alpha=0.6, label="FEM (linear, 48x12x12)")
+    for r, p, c in zip(RES, INPUTS[:3], ("tab:red", "tab:orange", "tab:blue")):
+        x, w = C.section_deflection(C.open_result(p))
+        ax.plot(x * 1e3, w * 1e3, "o-", color=c, ms=4, label=f"MSS {r}")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("deflection of the neutral axis, downwards (mm)")
+    ax.invert_yaxis()
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    plotting.save(fig, args.out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,23 @@
+"""Baudet Fig. 7: sheared beam, MSS wireframes over the FEM reference and per-node error maps."""
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import baudet_common as C  # noqa: E402
+from msslib import plotting  # noqa: E402
+
+RES = ("2x2x6", "4x4x12", "8x8x24")
+INPUTS = [f"results/baudet/shear_beam/shear__mss_{r}.nc" for r in RES] + ["results/baudet/shear_beam/shear__fem.nc"]
+
+
+def main():
+    args = C.figure_args(__doc__)
+    ref = C.open_result(INPUTS[-1])
+    pairs = {f"{r} cubes": C.open_result(p) for r, p in zip(RES, INPUTS[:-1])}
+    fig = C.shapes_and_errors(pairs, ref, plane="xz", magnify=10.0, panel=(2.2, 4.2))
+    plotting.save(fig, args.out)
+
+
+if __name__ == "__main__":
+    main()

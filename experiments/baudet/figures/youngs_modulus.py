@@ -1,0 +1,26 @@
+"""Baudet Fig. 4: error of Young's modulus against the axial strain, derived vs printed factor."""
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import baudet_common as C  # noqa: E402
+from msslib import plotting  # noqa: E402
+
+INPUTS = ["results/baudet/studies/tension.nc"]
+PUBLISHED = [(10.0, 2.7, "0.3"), (10.0, 2.0, "0.4"), (10.0, 1.5, "0.499")]  # Sec. 5 text, nu = 0.5 as 0.499
+
+
+def main():
+    args = C.figure_args(__doc__)
+    ds = C.open_result(INPUTS[0])
+    panels = {"derived factor -(4nu-1)/2": {"geometry": "cube", "factor": "derived"},
+              "printed factor -(4nu-1)/16": {"geometry": "cube", "factor": "printed"}}
+    fig = C.curves(ds["E_error"], ds["strain"].values, xlabel="axial strain (%)", ylabel="E error (%)",
+                   panels=panels, dashed={"beam of 4x4x12 cubes": {"geometry": "beam"}},
+                   marks={k: PUBLISHED for k in panels})
+    plotting.save(fig, args.out)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,33 @@
+"""Tip deflection of the cantilever's neutral axis: MSS resolutions and FEM against eq. 10."""
+
+import argparse
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import baudet_common as C  # noqa: E402
+
+RES = ("4x1x1", "8x2x2", "16x4x4")
+INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]
+          + ["results/baudet/cantilever/gravity__fem.nc", "results/baudet/studies/cantilever_eq10.nc"])
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--out", required=True)
+    args = p.parse_args()
+    eq = C.open_result(INPUTS[-1])
+    tip, tip_s = float(eq["tip_eq10"]), float(eq["tip_timoshenko"])
+    lines = ["**Cantilever: tip deflection of the neutral axis** (mean vertical displacement of the free end section)", "",
+             "| model | tip deflection (mm) | vs eq. 10 (%) | vs eq. 10 + shear (%) |", "|---|---|---|---|",
+             f"| eq. 10 (Euler-Bernoulli, nu = 0) | {tip * 1e3:.4g} | 0 | {100 * (tip / tip_s - 1):+.3g} |",
+             f"| eq. 10 + Timoshenko shear | {tip_s * 1e3:.4g} | {100 * (tip_s / tip - 1):+.3g} | 0 |"]
+    for name, path in [("FEM linear 48x12x12", INPUTS[3])] + [(f"MSS {r}", q) for r, q in zip(RES, INPUTS[:3])]:
+        _, w = C.section_deflection(C.open_result(path))
+        lines.append(f"| {name} | {w[-1] * 1e3:.4g} | {100 * (w[-1] / tip - 1):+.3g} | {100 * (w[-1] / tip_s - 1):+.3g} |")
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    main()
