@@ -146,17 +146,38 @@ def run(exp: Experiment, case: str, model: str, quick: bool = False, progress=Fa
 # ---- comparison ------------------------------------------------------------------------------
 
 def interpolate(ref_mesh, ref_u, points):
-    """Reference displacement at ``points`` with the reference mesh's shape functions."""
+    """Reference displacement at ``points`` with the reference mesh's shape functions.
+
+    Points outside the reference mesh (a curved or zig-zag boundary meshed at another resolution)
+    take the displacement of the nearest reference node; the rest are interpolated exactly.
+    """
+    from scipy.spatial import cKDTree
+    from skfem import Basis
+
     from msslib.fem import to_skfem
 
     skmesh, elem = to_skfem(ref_mesh)
-    from skfem import Basis
-
     basis = Basis(skmesh, elem)
-    lo, hi = ref_mesh.points.min(axis=0), ref_mesh.points.max(axis=0)
-    pts = np.clip(points, lo, hi)  # boundary nodes may sit a rounding error outside
-    P = basis.probes(pts.T)
-    return np.column_stack([P @ ref_u[:, d] for d in range(ref_u.shape[1])])
+
+    def probe(pts):
+        P = basis.probes(pts.T)
+        return np.column_stack([P @ ref_u[:, d] for d in range(ref_u.shape[1])])
+
+    try:
+        return probe(points)
+    except ValueError:  # some points lie outside: probe one by one
+        pass
+    out = np.empty((len(points), ref_u.shape[1]))
+    outside = []
+    for i, p in enumerate(points):
+        try:
+            out[i] = probe(p[None, :])[0]
+        except ValueError:
+            outside.append(i)
+    if outside:
+        _, nearest = cKDTree(ref_mesh.points).query(points[outside])
+        out[outside] = ref_u[nearest]
+    return out
 
 
 def _published(exp, case, model):
