@@ -20,7 +20,7 @@ import yaml
 
 QUICK = bool(int(config.get("quick", 0)))
 QFLAG = "--quick" if QUICK else ""
-PAPERS = ["lloyd", "baudet", "golec", "performance"]
+PAPERS = ["lloyd", "baudet", "golec", "performance", "summary"]
 DERIVATIONS = ["triangle", "square", "rectangle", "tetrahedron", "cube_baudet", "cube_golec", "kernels"]
 ENGINE = ["__init__", "elasticity", "fem", "mss", "match", "lattice", "records", "codegen", "report"]
 SCENES = sorted(glob_wildcards("experiments/scenes/{name}.yaml").name)
