@@ -824,18 +824,22 @@ class BaudetCorrection(Term):
     1. External forces ``loads`` (n, 3) (an array, or terms whose :class:`ExternalForce` parts are
        summed — pass only surface loads, not gravity) live on the nodes.  Candidate faces are the
        mesh's boundary faces, with outward unit normal ``n_f``.
-    2. Sharing rule: the force ``f_a`` of node ``a`` is shared among the boundary faces containing
-       ``a`` in proportion to ``|f_a . n_f|``; so a traction on the top of a block goes entirely
-       to the top faces (a side face with normal orthogonal to the load gets nothing) and a node
-       inside a loaded surface splits its force equally among its faces.  The elongation force of
-       face ``f`` is ``F_f = sum_a share_af (f_a . n_f)`` (> 0 tension, < 0 compression); for a
-       uniform traction with consistent nodal forces it is exactly the face's normal resultant.
-       A face is loaded when ``F_f != 0``.
+    2. Sharing rule: the normal component ``f_a . n_f`` of the force of node ``a`` is shared
+       equally among the boundary faces containing ``a`` *with the same normal* (coplanar faces
+       of neighbouring elements). Faces with other normals get their own normal component, so at
+       an edge or corner where loaded faces meet (pressure on a box) every face receives its full
+       normal load. The elongation force of face ``f`` is ``F_f = sum_a (f_a . n_f) / m_af``
+       (> 0 tension, < 0 compression, ``m_af`` the number of coplanar boundary faces at ``a``);
+       for uniform normal tractions with consistent nodal forces it is exactly each face's normal
+       resultant. A face is loaded when ``F_f != 0``. Limitation: a load tangential to a face
+       (shear) at an edge node also has a normal component on the adjacent side face and is
+       counted there.
     3. Per element and per pair of opposite faces the elongation force ``F_i`` is the one of the
        two faces with the larger magnitude (if both are loaded, as in a free cube pulled at both
        ends, the tension is counted once).
     4. The correction amplitude is ``F_perp = c F_i`` with ``c = factor`` per element (from
-       :func:`msslib.parameters.baudet_cube` ``.correction_factor``, i.e. ``-(4 nu - 1) / 16``).
+       :func:`msslib.parameters.baudet_cube` ``.correction_factor``: ``-(4 nu - 1) / 2`` derived
+       for resultants per face, ``-(4 nu - 1) / 16`` as printed, see the errata).
        On each of the two other pairs of faces ``(j, j')`` the force ``F_perp d / 4`` is applied to
        each node of ``j`` and ``-F_perp d / 4`` to each node of ``j'``, ``d`` the unit vector from
        the centroid of ``j'`` to the centroid of ``j`` (the outward normal of ``j`` for a cube).
@@ -890,10 +894,10 @@ class BaudetCorrection(Term):
         fid = np.repeat(np.flatnonzero(boundary), 4)
         node = flat[boundary].ravel()
         proj = np.einsum("ij,ij->i", loads[node], normal[fid])
-        w = np.abs(proj)
-        denom = np.bincount(node, weights=w, minlength=mesh.n_nodes)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            share = np.where(denom[node] > 0, w / denom[node], 0.0)
+        # number of boundary faces at the node with the same (rounded) normal
+        key = np.column_stack([node, np.round(normal[fid] * 1e6).astype(np.int64)])
+        _, group, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        share = 1.0 / count[group.ravel()]
         face_force = np.bincount(fid, weights=share * proj, minlength=len(flat))
         return face_force.reshape(m, 6)
 

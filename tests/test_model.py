@@ -474,3 +474,16 @@ def test_baudet_cube_tension_gives_E_and_nu():
     ex = u[P[:, 0] > 0.5, 0].mean() - u[P[:, 0] < 0.5, 0].mean()
     assert F / ez == pytest.approx(E, rel=1e-4)
     assert -ex / ez == pytest.approx(nu, rel=1e-4)
+
+
+def test_baudet_correction_faces_under_pressure_get_their_full_load():
+    """Pressure on all six faces of a cube: every face's elongation force is its own resultant
+    (corner nodes carry three faces' loads; each face takes its own normal component)."""
+    mesh = M.hex_grid(2.0, 2.0, 2.0, 1, 1, 1)
+    p = 3.0
+    loads = []
+    for f in M.boundary_facets(mesh):
+        n = np.cross(mesh.points[f[1]] - mesh.points[f[0]], mesh.points[f[2]] - mesh.points[f[0]])
+        loads.append(Traction(mesh, f[None, :], -p * n / np.linalg.norm(n)))
+    corr = baudet_correction(mesh, [(E0, NU0)], loads)
+    assert np.allclose(corr.face_force, -p * 4.0)
