@@ -24,6 +24,8 @@ PAPERS = ["lloyd", "baudet", "golec", "performance", "summary"]
 DERIVATIONS = ["triangle", "square", "rectangle", "tetrahedron", "cube_baudet", "cube_golec", "kernels"]
 ENGINE = ["__init__", "elasticity", "fem", "mss", "match", "lattice", "records", "codegen", "report"]
 SCENES = sorted(glob_wildcards("experiments/scenes/{name}.yaml").name)
+# every result depends on the library that computed it: a change in msslib reruns what it touches
+MSSLIB = sorted(str(p) for p in Path("msslib").rglob("*.py"))
 
 wildcard_constraints:
     paper="|".join(PAPERS),
@@ -94,6 +96,7 @@ rule scene:
     input:
         scene="experiments/scenes/{name}.yaml",
         derived="paper/derivations.json",
+        code=MSSLIB,
     output:
         "results/scenes/{name}.nc",
     log:
@@ -111,6 +114,7 @@ for (_paper, _exp), _path in experiments().items():
         input:
             exp=str(_path),
             derived="paper/derivations.json",
+            code=MSSLIB,
         output:
             [f"results/{_paper}/{_exp}/{r}.nc" for r in runs(_paper, _exp)],
         params:
@@ -147,6 +151,7 @@ rule study:
     input:
         script="experiments/{paper}/studies/{name}.py",
         shared=shared,
+        code=MSSLIB,
         derived="paper/derivations.json",
     output:
         "results/{paper}/studies/{name}.nc",
@@ -190,6 +195,7 @@ rule stability:
     input:
         script="experiments/stability.py",
         derived="paper/derivations.json",
+        code=MSSLIB,
     output:
         "results/stability.nc",
     params:
@@ -202,6 +208,8 @@ rule stability:
 
 rule benchmarks:
     """Speed figures with their baselines (reduced sizes unless --config benchmarks=full)."""
+    input:
+        code=MSSLIB + sorted(str(p) for p in Path("benchmarks").glob("*.py")),
     output:
         "results/benchmarks.json",
     params:
