@@ -6,24 +6,13 @@ rest shape in grey; bottom row: the distance between MSS and reference at every 
     python membrane_arbitrary.py --out paper/figures/lloyd_membrane_arbitrary
 """
 
-import argparse
+import sys
 from pathlib import Path
 
-from msslib import plotting
-from msslib.io import read_result
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from comparison_figure import inputs, main  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[3]
-INPUTS = [
-    "results/lloyd/membrane_arbitrary/stretch__eq8.nc",
-    "results/lloyd/membrane_arbitrary/stretch__fem.nc",
-    "results/lloyd/membrane_arbitrary/compression__eq8.nc",
-    "results/lloyd/membrane_arbitrary/compression__fem.nc",
-    "results/lloyd/membrane_arbitrary/shear__eq8.nc",
-    "results/lloyd/membrane_arbitrary/shear__fem.nc",
-    "results/lloyd/membrane_arbitrary/stretch__eq9.nc",
-    "results/lloyd/membrane_arbitrary/compression__eq9.nc",
-    "results/lloyd/membrane_arbitrary/shear__eq9.nc",
-]
+EXPERIMENT = "membrane_arbitrary"
 # (column title, case, variant, reference)
 COLUMNS = [
     ("a) eq. 8, stretch", "stretch", "eq8", "fem"),
@@ -33,21 +22,8 @@ COLUMNS = [
     ("e) eq. 9, compression", "compression", "eq9", "fem"),
     ("f) eq. 9, shear", "shear", "eq9", "fem"),
 ]
-
-
-def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="output stem: writes STEM.png and STEM.pdf")
-    args = ap.parse_args(argv)
-
-    def load(case, model):
-        return read_result(ROOT / "results" / "lloyd" / "membrane_arbitrary" / f"{case}__{model}.nc")
-
-    pairs = {title: (load(case, var), load(case, ref)) for title, case, var, ref in COLUMNS}
-    fig = plotting.comparison_figure(pairs, plane="xy", variant_label="MSS",
-                                     reference_label="FEM", panel_width=2.6)
-    plotting.save(fig, args.out)
-
+INPUTS = [f"results/lloyd/{EXPERIMENT}/{case}__{m}.nc" for _, case, var, ref in COLUMNS for m in (var, ref)]
 
 if __name__ == "__main__":
-    main()
+    assert INPUTS == inputs(EXPERIMENT, COLUMNS)
+    main(EXPERIMENT, COLUMNS, __doc__.splitlines()[0], plane="xy", panel_width=2.6)
