@@ -10,6 +10,15 @@ Commands
     second unless ``--quiet``.
 ``validate SCENE.yaml``
     Check the scene and build its mesh, boundary conditions, loads and model without solving.
+``experiment run|run-all|compare|list EXPERIMENT.yaml ...``
+    Run the (case, model) pairs of an experiment and compare them with its reference
+    (:mod:`msslib.experiment`).
+``plan SCENE.yaml --max-error E``
+    The cheapest measured (model, resolution) within an error budget (:mod:`msslib.planning`).
+``vtu RESULT.nc --out OUT.vtu``
+    Export any result to VTU for ParaView.
+``paper SOURCE --out OUT.html``
+    Build the paper (:mod:`msslib.paper`).
 
 Exit codes: 0 success, 1 bad input or a failed solve (a one-line ``msslib: error: ...`` message on
 stderr, no traceback), 2 bad command-line usage (argparse).
@@ -234,6 +243,26 @@ def _cmd_experiment_list(args) -> int:
     return 0
 
 
+def _add_vtu(subparsers) -> None:
+    p = subparsers.add_parser("vtu", help="export a NetCDF result to VTU (ParaView)",
+                              description="Write the final state of any msslib result file as a VTU file.")
+    p.add_argument("result", help="result file (NetCDF) written by msslib")
+    p.add_argument("--out", "-o", required=True, help="VTU file")
+    p.set_defaults(func=_cmd_vtu)
+
+
+def _cmd_vtu(args) -> int:
+    from msslib.io import read_result
+
+    src = Path(args.result)
+    if not src.is_file():
+        raise CommandError(f"result file not found: {str(src)!r}")
+    out = Path(args.out)
+    _check_writable(out, "VTU file")
+    _write_vtu(out, read_result(src))
+    return 0
+
+
 def _add_paper(subparsers) -> None:
     p = subparsers.add_parser("paper", help="build the paper (Markdown with placeholders -> HTML)")
     p.add_argument("source", help="main source, e.g. paper/paper.md.in")
@@ -291,7 +320,7 @@ def _cmd_plan(args) -> int:
 
 
 #: subparser builders, in the order of the help text
-COMMANDS = [_add_run, _add_validate, _add_experiment, _add_paper, _add_plan]
+COMMANDS = [_add_run, _add_validate, _add_experiment, _add_paper, _add_plan, _add_vtu]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -285,3 +285,17 @@ def test_duplicate_yaml_key(tmp_path, capsys):
     scene.write_text((SCENES / "golec_compression.yaml").read_text() + "model: baudet_cube\n")
     assert main(["validate", str(scene)]) == 1
     assert "duplicate key 'model'" in _error_line(capsys)
+
+
+def test_any_result_exports_to_vtu(tmp_path):
+    import meshio
+
+    from msslib.cli import main
+
+    scene = Path(__file__).resolve().parent.parent / "experiments" / "scenes" / "membrane_fem_stretch.yaml"
+    nc, vtu = tmp_path / "r.nc", tmp_path / "r.vtu"
+    assert main(["run", str(scene), "--out", str(nc), "--quiet"]) == 0
+    assert main(["vtu", str(nc), "--out", str(vtu)]) == 0
+    m = meshio.read(vtu)
+    assert "displacement" in m.point_data and m.point_data["displacement"].shape[1] == 3
+    assert main(["vtu", str(tmp_path / "missing.nc"), "--out", str(vtu)]) == 1
