@@ -12,25 +12,25 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def _errata_md(derivations) -> str:
-    out = ["# Errata in the founding papers", "",
+    out = ["## Errata in the founding papers", "",
            "Generated from `derivations/` by `python -m derivations.codegen`; do not edit. Each entry names the "
            "test that proves it.", ""]
     n = 0
     for m, d in derivations.items():
         for e in d.errata:
             n += 1
-            out += [f"## {n}. {e.paper}, {e.where}", "",
+            out += [f"### {n}. {e.paper}, {e.where}", "",
                     f"- printed: ${e.printed}$", f"- derived: ${e.correct}$", "",
                     e.explanation, "", f"Proof: `{e.proof}` (derivation `derivations/{m}.py`).", ""]
     return "\n".join(out)
 
 
 def _findings_md(derivations) -> str:
-    out = ["# Derivation results", "", "Generated from `derivations/`; do not edit.", ""]
+    out = ["## Derivation results", "", "Generated from `derivations/`; do not edit.", ""]
     for m, d in derivations.items():
         if not d.findings:
             continue
-        out += [f"## {d.title}", "", f"Source: `derivations/{m}.py`", ""]
+        out += [f"### {d.title}", "", f"Source: `derivations/{m}.py`", ""]
         for label, text in d.findings:
             out.append(f"- **{label}**: ${text}$" if "\\" in text or "=" in text else f"- **{label}**: {text}")
         out.append("")
