@@ -259,9 +259,24 @@ class Model:
                 s = float(self._scale(t, load))
                 if s != 0.0:
                     _scatter_add(data, scatter, t.hessian_values(x), s)
-        K = sp.csr_matrix((data, self._indices.copy(), self._indptr.copy()), shape=(self.n_dof, self.n_dof))
+        # the pattern arrays are shared, not copied (54 MB for a 30^3 lattice): they are read-only,
+        # so an operation that would change a returned matrix's structure in place fails loudly
+        K = sp.csr_matrix((data, self._indices_ro, self._indptr_ro), shape=(self.n_dof, self.n_dof), copy=False)
         K.has_sorted_indices = True
+        K.has_canonical_format = True
         return K
+
+    @property
+    def _indices_ro(self):
+        if self._indices.flags.writeable:
+            self._indices.flags.writeable = False
+        return self._indices
+
+    @property
+    def _indptr_ro(self):
+        if self._indptr.flags.writeable:
+            self._indptr.flags.writeable = False
+        return self._indptr
 
     def energy(self, x, load: float = 1.0):
         """Total potential energy (J), or None when a term is non-conservative."""
