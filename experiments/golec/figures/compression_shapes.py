@@ -1,32 +1,21 @@
 """Golec Fig. 2 (1-2): the 5 cm cube compressed by 10 % (clamped faces), side view (xz plane)."""
 
 import argparse
+import sys
+from pathlib import Path
 
 import numpy as np
-import xarray as xr
 
 from msslib import plotting
 from msslib.io import read_result
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from wrinkle_states import positions_dataset, study_state  # noqa: E402,F401
 
 R = "results/golec/compression"
 INPUTS = ["results/golec/compression/clamped__mss_classical.nc", "results/golec/compression/clamped__golec.nc",
           "results/golec/compression/clamped__golec_published.nc", "results/golec/compression/clamped__fem.nc",
           "results/golec/studies/wrinkles.nc"]
-
-
-def positions_dataset(rest, x, cells):
-    """A minimal result-like dataset (rest_position, displacement, cells) for msslib.plotting."""
-    ds = xr.Dataset({"rest_position": (("node", "axis"), np.asarray(rest)),
-                     "displacement": (("node", "axis"), np.asarray(x) - np.asarray(rest)),
-                     "cells": (("cell", "cell_node"), np.asarray(cells))})
-    ds["cells"].attrs["cell_type"] = "hexahedron"
-    return ds
-
-
-def study_state(ds, experiment, state):
-    """The rest and deformed node positions of the no-face-diagonal MSS stored by the wrinkles study."""
-    return positions_dataset(ds[f"{experiment}_rest"].values, ds[f"{experiment}_{state}"].values,
-                             ds[f"{experiment}_cells"].values)
 
 
 def main():
