@@ -200,11 +200,16 @@ class Model:
         diag_pos = pos_all[-nn:].astype(np.int32)
         fills = []
         start = 0
-        for (t, _, _), size in zip(self._hessian_terms, owners):
+        for (t, _, _), size, k in zip(self._hessian_terms, owners, keys):
             pos = pos_all[start:start + size].astype(np.int32)
             start += size
             if isinstance(t, Springs) and dim == 3:
-                fills.append(("springs", pos, None))
+                # "exact": these springs alone write every block of the pattern exactly once
+                # (every node row, no repeated pair, no block of another term), so a refill may
+                # overwrite instead of zeroing and adding
+                rows_covered = len(t.symmetric_layout()[1]) - 1 == nn
+                exact = rows_covered and size + nn == len(unique) and len(np.unique(k)) == size
+                fills.append(("springs", pos, exact))
             else:
                 nv = t.conn.shape[1]
                 fills.append(("blocks", pos.reshape(-1, nv, nv), None))
@@ -238,29 +243,57 @@ class Model:
         """Load-proportional force at ``x0`` (dead loads plus load-dependent corrections)."""
         return self.force(self.x0, load) - self.force(self.x0, 0.0)
 
-    def stiffness(self, x, load: float = 1.0) -> sp.csr_matrix:
-        """Tangent stiffness ``-d force / dx`` (CSR, fixed pattern incl. the full diagonal)."""
+    def stiffness(self, x, load: float = 1.0, out: sp.csr_matrix | None = None) -> sp.csr_matrix:
+        """Tangent stiffness ``-d force / dx`` (CSR, fixed pattern incl. the full diagonal).
+
+        ``out``: a matrix returned by an earlier call of this model's ``stiffness``, whose
+        values are overwritten in place and which is returned (no allocation: for Newton loops
+        that no longer need the previous tangent)."""
         x = np.asarray(x, dtype=float).ravel()
-        data = np.zeros(self._nnz)
+        if out is not None:
+            if (out.data.shape != (self._nnz,) or out.indices.shape != self._indices.shape
+                    or not np.may_share_memory(out.indices, self._indices)):
+                raise ValueError("out must be a matrix returned by this model's stiffness()")
+            data = out.data
+        else:
+            data = None
         if self._block is not None:
             nptr, diag_pos, fills = self._block
-            for (t, _, _), (kind, p, q) in zip(self._hessian_terms, fills):
-                s = float(self._scale(t, load))
+            scales = [float(self._scale(t, load)) for t, _, _ in self._hessian_terms]
+            first = next((i for i, (f, s) in enumerate(zip(fills, scales)) if f[0] == "springs" and f[2] and s != 0.0),
+                         None)
+            if first is None:
+                if data is None:
+                    data = np.zeros(self._nnz)
+                else:
+                    data[:] = 0.0
+            elif data is None:
+                data = np.empty(self._nnz)  # every entry is written by the exact spring term
+            order = ([first] if first is not None else []) + [i for i in range(len(fills)) if i != first]
+            xc = np.ascontiguousarray(x)
+            for i in order:
+                (t, _, _), (kind, p, q), s = self._hessian_terms[i], fills[i], scales[i]
                 if s == 0.0:
                     continue
                 if kind == "springs":
                     _, rowptr, nb, k, L0 = t.symmetric_layout()
-                    _spring3d_hessian_csr(np.ascontiguousarray(x), rowptr, nb, k, L0, p, nptr, diag_pos, s, data)
+                    _spring3d_hessian_csr(xc, rowptr, nb, k, L0, p, nptr, diag_pos, s, i == first, data)
                 else:
                     vals = t.hessian_values(x).reshape(len(t.conn), -1)
                     _block_scatter_csr(vals, t.conn, p, nptr, self.dim, s, data)
         else:
+            if data is None:
+                data = np.zeros(self._nnz)
+            else:
+                data[:] = 0.0
             for (t, _, _), scatter in zip(self._hessian_terms, self._scatter):
                 s = float(self._scale(t, load))
                 if s != 0.0:
                     _scatter_add(data, scatter, t.hessian_values(x), s)
         # the pattern arrays are shared, not copied (54 MB for a 30^3 lattice): they are read-only,
         # so an operation that would change a returned matrix's structure in place fails loudly
+        if out is not None:
+            return out
         K = sp.csr_matrix((data, self._indices_ro, self._indptr_ro), shape=(self.n_dof, self.n_dof), copy=False)
         K.has_sorted_indices = True
         K.has_canonical_format = True

@@ -283,8 +283,10 @@ def _spring3d_energy_fast(x, rowptr, ib, k, L0):
 
 
 @_jit_fast
-def _spring3d_hessian_csr(x, rowptr, nb, k, L0, pos, nptr, diag, scale, data):
-    """Add ``scale`` times the spring Hessian to CSR ``data`` of a node-blocked pattern.
+def _spring3d_hessian_csr(x, rowptr, nb, k, L0, pos, nptr, diag, scale, assign, data):
+    """Add ``scale`` times the spring Hessian to CSR ``data`` of a node-blocked pattern (or, with
+    ``assign``, overwrite the node rows the springs cover: valid when these springs hit every
+    block of those rows exactly once, which saves zeroing and re-reading ``data``).
 
     Symmetric node layout: ``rowptr``/``nb``/``k``/``L0`` list for every node ``a`` *all* springs
     touching it (each spring twice, once from each end), so that dof rows are filled one node
@@ -292,65 +294,97 @@ def _spring3d_hessian_csr(x, rowptr, nb, k, L0, pos, nptr, diag, scale, data):
     the cache misses).  Node row ``a`` has ``deg = nptr[a + 1] - nptr[a]`` neighbour nodes
     (itself included); dof row ``3 a + i`` starts at ``9 nptr[a] + 3 i deg`` and entry
     ``(3 a + i, 3 b + j)`` sits at ``+ 3 p + j`` with ``p`` the position of ``b`` in node row
-    ``a`` (``pos`` per listed spring, ``diag`` per node)."""
+    ``a`` (``pos`` per listed spring, ``diag`` per node).
+
+    Per node row: (1) gather the differences ``d = x_a - x_b`` into a small local array,
+    (2) compute the six distinct entries of every block there (a loop over contiguous memory,
+    which the compiler vectorises: sqrt and division included), (3) write the three dof rows
+    one after the other.  With ``u = L0 / l`` the spring block is
+    ``k [(1 - u) I + u d d^T / l^2]``; the off-diagonal blocks are minus it, the diagonal block
+    the sum over the node's springs."""
+    c = np.empty((9, 64))
     for na in range(rowptr.shape[0] - 1):
         a = 3 * na
         ra = 9 * nptr[na]
         deg = 3 * (nptr[na + 1] - nptr[na])
+        s0 = rowptr[na]
+        m = rowptr[na + 1] - s0
+        if m > c.shape[1]:
+            c = np.empty((9, 2 * m))
         xa0, xa1, xa2 = x[a], x[a + 1], x[a + 2]
+        for j in range(m):
+            b = 3 * nb[s0 + j]
+            c[6, j] = xa0 - x[b]
+            c[7, j] = xa1 - x[b + 1]
+            c[8, j] = xa2 - x[b + 2]
+        kk = k[s0:s0 + m]
+        ll = L0[s0:s0 + m]
+        for j in range(m):
+            d0 = c[6, j]
+            d1 = c[7, j]
+            d2 = c[8, j]
+            il = 1.0 / np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            ks = kk[j] * scale
+            t = ks * ll[j] * il
+            c10 = t - ks
+            c14 = -t * il * il
+            c[0, j] = d0 * d0 * c14 + c10
+            c[1, j] = d0 * d1 * c14
+            c[2, j] = d0 * d2 * c14
+            c[3, j] = d1 * d1 * c14 + c10
+            c[4, j] = d1 * d2 * c14
+            c[5, j] = d2 * d2 * c14 + c10
         h00 = 0.0
         h01 = 0.0
         h02 = 0.0
         h11 = 0.0
         h12 = 0.0
         h22 = 0.0
-        for s in range(rowptr[na], rowptr[na + 1]):
-            b = 3 * nb[s]
-            d0 = xa0 - x[b]
-            d1 = xa1 - x[b + 1]
-            d2 = xa2 - x[b + 2]
-            l2 = d0 * d0 + d1 * d1 + d2 * d2
-            l = np.sqrt(l2)
-            r = L0[s] - l
-            ks = k[s] * scale
-            c14 = (r / (l2 * l) + 1.0 / l2) * ks
-            c10 = -r / l * ks
-            k00 = d0 * d0 * c14 + c10
-            k11 = d1 * d1 * c14 + c10
-            k22 = d2 * d2 * c14 + c10
-            k01 = d0 * d1 * c14
-            k02 = d0 * d2 * c14
-            k12 = d1 * d2 * c14
-            h00 += k00
-            h01 += k01
-            h02 += k02
-            h11 += k11
-            h12 += k12
-            h22 += k22
-            q = ra + 3 * pos[s]
-            data[q] -= k00
-            data[q + 1] -= k01
-            data[q + 2] -= k02
-            q += deg
-            data[q] -= k01
-            data[q + 1] -= k11
-            data[q + 2] -= k12
-            q += deg
-            data[q] -= k02
-            data[q + 1] -= k12
-            data[q + 2] -= k22
-        q = ra + 3 * diag[na]
-        data[q] += h00
-        data[q + 1] += h01
-        data[q + 2] += h02
-        q += deg
-        data[q] += h01
-        data[q + 1] += h11
-        data[q + 2] += h12
-        q += deg
-        data[q] += h02
-        data[q + 1] += h12
-        data[q + 2] += h22
+        for j in range(m):
+            h00 -= c[0, j]
+            h01 -= c[1, j]
+            h02 -= c[2, j]
+            h11 -= c[3, j]
+            h12 -= c[4, j]
+            h22 -= c[5, j]
+        for i in range(3):  # dof row 3 a + i: block row i is (c[i0], c[i1], c[i2])
+            r0 = ra + i * deg
+            i0 = i if i < 2 else 2
+            i1 = 1 if i == 0 else (3 if i == 1 else 4)
+            i2 = 2 if i == 0 else (4 if i == 1 else 5)
+            if assign:
+                for j in range(m):
+                    q = r0 + 3 * pos[s0 + j]
+                    data[q] = c[i0, j]
+                    data[q + 1] = c[i1, j]
+                    data[q + 2] = c[i2, j]
+            else:
+                for j in range(m):
+                    q = r0 + 3 * pos[s0 + j]
+                    data[q] += c[i0, j]
+                    data[q + 1] += c[i1, j]
+                    data[q + 2] += c[i2, j]
+        qd = ra + 3 * diag[na]
+        if assign:
+            data[qd] = h00
+            data[qd + 1] = h01
+            data[qd + 2] = h02
+            data[qd + deg] = h01
+            data[qd + deg + 1] = h11
+            data[qd + deg + 2] = h12
+            data[qd + 2 * deg] = h02
+            data[qd + 2 * deg + 1] = h12
+            data[qd + 2 * deg + 2] = h22
+        else:
+            data[qd] += h00
+            data[qd + 1] += h01
+            data[qd + 2] += h02
+            data[qd + deg] += h01
+            data[qd + deg + 1] += h11
+            data[qd + deg + 2] += h12
+            data[qd + 2 * deg] += h02
+            data[qd + 2 * deg + 1] += h12
+            data[qd + 2 * deg + 2] += h22
 
 
 @_jit

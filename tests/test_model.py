@@ -207,6 +207,63 @@ def test_fixed_pattern_csr_equals_coo_assembly():
     assert np.allclose(model.stiffness(x, 0.3)[:, i].toarray().ravel(), col, atol=1e-6 * np.abs(col).max())
 
 
+def _coo_reference(model, x, load=1.0):
+    K = sp.csr_matrix((model.n_dof, model.n_dof))
+    for t in model.terms:
+        if t.max_node() < 0 or not hasattr(t, "hessian_coo"):
+            continue
+        try:
+            r, c, v = t.hessian_coo(x)
+        except NotImplementedError:
+            continue
+        s = load if t.scales_with_load else 1.0
+        K = K + s * sp.coo_matrix((v, (r, c)), shape=K.shape).tocsr()
+    return K
+
+
+@pytest.mark.parametrize("case", ["exact", "duplicate_pairs", "partial_rows", "extra_term_pairs"])
+def test_block_csr_fill_paths_equal_coo_assembly(case):
+    """The springs-only overwrite path (every block written once) and the zero-and-add path
+    (repeated pairs, nodes without springs, blocks of another term) give the COO matrix, also
+    when refilling an earlier matrix in place with ``out=``."""
+    mesh = M.hex_grid(0.03, 0.02, 0.02, 3, 2, 2)
+    terms = golec_cube_springs(mesh, [(1e4, 0.3)], 1.0)
+    springs = terms[0]
+    if case == "duplicate_pairs":
+        pairs = np.concatenate([springs.conn, springs.conn[:5]])
+        springs = Springs(pairs, np.concatenate([springs.k, 2.0 * springs.k[:5]]),
+                          np.concatenate([springs.rest_length, springs.rest_length[:5]]), 3)
+        terms = [springs]
+    elif case == "partial_rows":  # the last node has no spring
+        keep = (springs.conn != mesh.n_nodes - 1).all(axis=1)
+        springs = Springs(springs.conn[keep], springs.k[keep], springs.rest_length[keep], 3)
+        terms = [springs]
+    elif case == "extra_term_pairs":  # edges only: the hex volume term adds the diagonal pairs
+        edges = np.abs(np.diff(mesh.points[springs.conn], axis=1)[:, 0]) > 1e-12
+        keep = edges.sum(axis=1) == 1
+        springs = Springs(springs.conn[keep], springs.k[keep], springs.rest_length[keep], 3)
+        terms = [springs, terms[1]]
+    else:
+        terms = [springs]
+    model = Model(mesh, terms)
+    if case == "partial_rows":  # a node outside every element: the generic dof-level path
+        assert model._block is None
+    else:
+        exact = [f[2] for f in model._block[2] if f[0] == "springs"]
+        assert exact == [case == "exact"] + [False] * (len(exact) - 1)
+    K_prev = None
+    for seed in (1, 2):
+        x = perturbed(mesh, 0.002, seed)
+        ref = _coo_reference(model, x)
+        K = model.stiffness(x, out=K_prev)
+        if K_prev is not None:
+            assert K is K_prev  # refilled in place
+        assert abs(K - ref).max() <= 1e-12 * abs(ref).max()
+        K_prev = K
+    with pytest.raises(ValueError, match="out must be a matrix returned"):
+        model.stiffness(x, out=sp.csr_matrix(K.toarray()))
+
+
 # --------------------------------------------------------------------------------------------
 # builders: summation of spring constants, validation
 # --------------------------------------------------------------------------------------------

@@ -18,10 +18,13 @@ def main():
              f"{m['threads_blas']}/{m['threads_numba']} thread(s) ({m['thread_pools']}); {m['cpu_count']} cores, "
              f"load average {m['load_average']:.1f} at the start; numpy {m['numpy']}, numba {m['numba']}, "
              f"pyamg {m['pyamg']}; {m['wall_s']:.0f} s in all." + (" Reduced sizes." if m["quick"] else ""), "",
-             "| figure | value | unit | ratio to baseline | baseline | note |", "|---|---|---|---|---|---|"]
+             "| figure | value | unit | ratio to baseline | baseline | target | met | note |",
+             "|---|---|---|---|---|---|---|---|"]
     for name, f in data["figures"].items():
         r = "-" if f["ratio_to_baseline"] is None else f"{f['ratio_to_baseline']:.3g}"
-        lines.append(f"| {name} | {f['value']:.4g} | {f['unit']} | {r} | {f['baseline'] or '-'} | {f['note']} |")
+        met = {None: "-", True: "yes", False: "**no**"}[f.get("met")]
+        lines.append(f"| {name} | {f['value']:.4g} | {f['unit']} | {r} | {f['baseline'] or '-'} | "
+                     f"{f.get('target') or '-'} | {met} | {f['note']} |")
     out = Path(a.out)
     tmp = out.with_name(f".{out.name}.tmp")
     tmp.write_text("\n".join(lines) + "\n")
