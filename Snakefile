@@ -207,13 +207,16 @@ rule stability:
 
 
 rule benchmarks:
-    """Speed figures with their baselines (reduced sizes unless --config benchmarks=full)."""
+    """Speed figures with their baselines: full sizes, with the machine to itself (all cores are
+    reserved for it, so that no other job of the workflow runs beside the timings); reduced sizes
+    with quick=1 or --config benchmarks=quick."""
     input:
         code=MSSLIB + sorted(str(p) for p in Path("benchmarks").glob("*.py")),
     output:
         "results/benchmarks.json",
+    threads: workflow.cores
     params:
-        size="" if config.get("benchmarks") == "full" else "--quick",
+        size="--quick" if QUICK or config.get("benchmarks") == "quick" else "",
     log:
         "logs/benchmarks.log",
     shell:
