@@ -88,9 +88,13 @@ __all__ = [
 ]
 
 TINY = np.finfo(float).tiny
-ITERATIVE_THRESHOLD = 8_000  # free dofs above which "auto" uses preconditioned CG for SPD systems
-# (measured crossover on lattice stiffnesses, single thread: SuperLU's fill grows like n^(4/3..2)
-# in 3D and is slower than AMG-preconditioned CG from a few thousand dofs on; see benchmarks/)
+ITERATIVE_THRESHOLD = 2_000  # free dofs above which "auto" may use preconditioned CG (symmetric)
+BAND_AUTO_COST = 1.5e8  # ... unless the banded Cholesky costs at most this n (b + 1)^2
+BAND_PLAN_MAX_DOFS = 50_000  # no bandwidth-reducing ordering is computed above this size
+# Measured on the gravity-loaded Golec cube lattice (benchmarks/statics.py), single thread, whole
+# static solves: 1944 dofs banded Cholesky 0.033 s vs AMG-CG 0.040 s; 3630 dofs SuperLU 0.44 s
+# (banded too wide) vs AMG-CG 0.083 s; 6084 dofs 1.37 s vs 0.16 s.  SuperLU's fill grows like
+# n^(4/3..2) in 3D; slender bodies keep a narrow band and stay direct.
 
 
 class ConvergenceError(RuntimeError):
@@ -139,6 +143,8 @@ class StaticResult:
     ``iterations[i]``, ``residuals[i]`` and ``loads[i]`` belong to the i-th *accepted* load step;
     ``residuals[i]`` lists the absolute free-dof residual norms, starting with the one of the
     initial guess of that step. ``force_scale`` is ``F_ref`` of the convergence criterion.
+    ``cg_iterations`` counts the preconditioned CG iterations of all linear solves (0 when only
+    direct solves were used).
     """
 
     x: np.ndarray
@@ -152,6 +158,7 @@ class StaticResult:
     force_scale: float
     line_search_merit: str
     messages: list[str] = field(default_factory=list)
+    cg_iterations: int = 0
 
     @property
     def total_iterations(self) -> int:
@@ -217,12 +224,87 @@ def _is_conservative(problem, x, load) -> bool:
     return _energy_or_none(problem, x, load) is not None
 
 
+# Free-dof extraction plans, kept across calls (Newton iterations, time steps, repeated solves of
+# the same problem): the positions in ``K.data`` of the free-free entries of a given sparsity
+# pattern.  An entry is reused only for the very same pattern (the same index arrays, or equal
+# ones) and free mask; it holds references to the pattern arrays, so their ids cannot be recycled.
+_PLAN_CACHE: list = []
+_PLAN_CACHE_SIZE = 4
+
+
+def _same_readonly(a, b):
+    """True when ``a`` and ``b`` are the same read-only memory (scipy wraps index arrays passed
+    with ``copy=False`` in new views, so ``is`` is not enough).  The cache keeps ``a`` alive, so
+    its address cannot be recycled; read-only memory cannot be changed behind our back."""
+    return a is b or (not a.flags.writeable and not b.flags.writeable and a.dtype == b.dtype
+                      and a.shape == b.shape and a.strides == b.strides
+                      and a.__array_interface__["data"][0] == b.__array_interface__["data"][0])
+
+
+def _pattern_key_matches(entry, K, free):
+    if entry["shape"] != K.shape or entry["free_n"] != free.size:
+        return False
+    if _same_readonly(entry["indptr"], K.indptr) and _same_readonly(entry["indices"], K.indices):
+        same = True
+    else:
+        same = (entry["indptr"].shape == K.indptr.shape and entry["indices"].shape == K.indices.shape
+                and np.array_equal(entry["indptr"], K.indptr) and np.array_equal(entry["indices"], K.indices))
+        if same:  # remember the new arrays: the next call is then an identity check
+            entry["indptr"], entry["indices"] = K.indptr, K.indices
+    return same and np.array_equal(entry["free"], free)
+
+
+def _submatrix_plan(K, free):
+    for i, entry in enumerate(_PLAN_CACHE):
+        if _pattern_key_matches(entry, K, free):
+            if i:
+                _PLAN_CACHE.insert(0, _PLAN_CACHE.pop(i))
+            return entry
+    n_free = int(free.sum())
+    counts = np.diff(K.indptr)
+    row_free = np.repeat(free, counts)
+    keep = row_free & free[K.indices]
+    del row_free
+    sel = np.flatnonzero(keep)
+    del keep
+    idx_t = np.int32 if K.nnz < 2**31 else np.int64
+    sel = sel.astype(idx_t)
+    new_index = (np.cumsum(free) - 1).astype(idx_t)  # increasing: sorted rows stay sorted
+    sub_indices = new_index[K.indices[sel]]
+    # kept entries lie in free rows only: a free row starts after the kept entries before it
+    sub_indptr = np.empty(n_free + 1, dtype=idx_t)
+    sub_indptr[:-1] = np.searchsorted(sel, K.indptr[:-1][free])
+    sub_indptr[-1] = len(sel)
+    entry = {"shape": K.shape, "free_n": free.size, "free": free.copy(), "indptr": K.indptr,
+             "indices": K.indices, "sel": sel, "sub_indptr": sub_indptr, "sub_indices": sub_indices,
+             "sub_shape": (n_free, n_free)}
+    entry["sub_indptr"].flags.writeable = False
+    entry["sub_indices"].flags.writeable = False
+    _PLAN_CACHE.insert(0, entry)
+    del _PLAN_CACHE[_PLAN_CACHE_SIZE:]
+    return entry
+
+
 def _submatrix(K, free):
-    K = sp.csr_matrix(K)
+    """Free-free block of ``K`` (CSR, sorted indices).  For a canonical CSR input the positions
+    of the free entries are computed once per sparsity pattern and reused (a gather of the data),
+    and the returned matrices share their (read-only) index arrays."""
+    if not (sp.issparse(K) and K.format == "csr"):
+        K = sp.csr_matrix(K)
     if free.all():
         return K
-    idx = np.flatnonzero(free)
-    return K[idx][:, idx]
+    if not K.has_canonical_format:
+        K = K.copy()
+        K.sum_duplicates()
+    if K.shape[0] != K.shape[1]:
+        idx = np.flatnonzero(free)
+        return sp.csr_matrix(K[idx][:, idx])
+    plan = _submatrix_plan(K, free)
+    A = sp.csr_matrix((K.data[plan["sel"]], plan["sub_indices"], plan["sub_indptr"]),
+                      shape=plan["sub_shape"], copy=False)
+    A.has_sorted_indices = True
+    A.has_canonical_format = True
+    return A
 
 
 def _cg(A, b, M, rtol, maxiter):
@@ -358,11 +440,20 @@ def _amg_preconditioner(A, context):
     coords = context.get("coords") if context else None
     if dim and coords is not None and A.shape[0] == dim * len(coords) and len(coords) > 0:
         A = A.tobsr(blocksize=(dim, dim))
+        # prolongation smoothing weighted by the inverse diagonal blocks (no eigenvalue estimate:
+        # the set-up is ~2x faster and CG needs the same iterations on the lattices);
+        # one forward block Gauss-Seidel sweep before and one backward sweep after the coarse
+        # correction: a symmetric V-cycle (CG needs it) at half the cost of symmetric sweeps;
+        # the coarsest level by sparse LU (pyamg's default dense pseudo-inverse costs O(n^3)
+        # and took minutes on the ~10^4-unknown coarse levels of 10^5-dof lattices)
         ml = pyamg.smoothed_aggregation_solver(
             A, B=_rigid_body_modes(coords, dim), strength=("symmetric", {"theta": 0.0}),
-            smooth=("jacobi", {"omega": 4.0 / 3.0}), improve_candidates=None, max_coarse=500)
+            smooth=("jacobi", {"omega": 4.0 / 3.0, "weighting": "block"}), improve_candidates=None, max_coarse=500,
+            coarse_solver="splu",
+            presmoother=("block_gauss_seidel", {"sweep": "forward", "iterations": 1}),
+            postsmoother=("block_gauss_seidel", {"sweep": "backward", "iterations": 1}))
     else:
-        ml = pyamg.smoothed_aggregation_solver(A)
+        ml = pyamg.smoothed_aggregation_solver(A, max_coarse=500, coarse_solver="splu")
     return ml.aspreconditioner(cycle="V")
 
 
@@ -373,20 +464,126 @@ def _preconditioner(A, context=None):
         return _ic0_preconditioner(A)
 
 
-def _direct_solve(A, b, symmetric):
-    """SuperLU; for symmetric matrices with the minimum-degree ordering of A^T + A, which fills
-    less than the default COLAMD on lattice stiffnesses.  Non-symmetric: COLAMD."""
+BAND_COST_MAX = 4e8  # n * (bandwidth + 1)^2 above which the banded Cholesky is not tried
+_BAND_CACHE: list = []
+
+
+def _bandwidth(A, perm):
+    inv = np.empty_like(perm)
+    inv[perm] = np.arange(len(perm))
+    rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+    return int(np.max(np.abs(inv[rows] - inv[A.indices]))) if A.nnz else 0
+
+
+def _band_plan(A, context):
+    """Ordering and scatter map of the banded (LAPACK ``pbtrf``) Cholesky of a symmetric CSR
+    matrix with sorted indices, computed once per sparsity pattern.  Candidate orderings:
+    reverse Cuthill-McKee, and, for node-aligned dofs with known coordinates, slices across the
+    longest side of the bounding box (node by node, dofs of a node together).  The one with the
+    smallest bandwidth wins.  Returns None when the estimated cost ``n (b + 1)^2`` exceeds
+    ``BAND_COST_MAX``."""
+    for entry in _BAND_CACHE:
+        if _same_readonly(entry["indices"], A.indices) and _same_readonly(entry["indptr"], A.indptr):
+            return entry["plan"]
+        if (entry["indices"].shape == A.indices.shape and entry["indptr"].shape == A.indptr.shape
+                and np.array_equal(entry["indices"], A.indices) and np.array_equal(entry["indptr"], A.indptr)):
+            return entry["plan"]
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    n = A.shape[0]
+    pattern = sp.csr_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape)
+    candidates = [np.asarray(reverse_cuthill_mckee(pattern, symmetric_mode=True), dtype=np.int64)]
+    dim = context.get("dim") if context else None
+    coords = context.get("coords") if context else None
+    if dim and coords is not None and n == dim * len(coords) and len(coords):
+        ext = np.ptp(coords, axis=0)
+        axes = np.argsort(ext)  # shortest first: lexsort's last key is the primary one
+        nodes = np.lexsort(tuple(np.round(coords[:, a] / max(ext.max(), TINY), 9) for a in axes))
+        candidates.append((dim * nodes[:, None] + np.arange(dim)).ravel())
+    widths = [_bandwidth(A, p) for p in candidates]
+    k = int(np.argmin(widths))
+    perm, bw = candidates[k], widths[k]
+    plan = None
+    if n * (bw + 1.0) ** 2 <= BAND_COST_MAX:
+        inv = np.empty_like(perm)
+        inv[perm] = np.arange(n)
+        rows = inv[np.repeat(np.arange(n), np.diff(A.indptr))]
+        cols = inv[A.indices]
+        lower = np.flatnonzero(rows >= cols)
+        # LAPACK lower band storage: ab[i - j, j] = A[i, j] (i, j in the permuted numbering);
+        # general band storage (for the LU fallback): ab[bw + i - j, j] = A[i, j]
+        plan = {"perm": perm, "bw": bw, "src": lower,
+                "dst": (rows[lower] - cols[lower]) * n + cols[lower],
+                "dst_full": (bw + rows - cols) * n + cols}
+    _BAND_CACHE.insert(0, {"indices": A.indices, "indptr": A.indptr, "plan": plan})
+    del _BAND_CACHE[_PLAN_CACHE_SIZE:]
+    return plan
+
+
+def _band_is_cheap(A, context):
+    if A.shape[0] > BAND_PLAN_MAX_DOFS or not (sp.issparse(A) and A.format == "csr" and A.has_canonical_format):
+        return False
+    plan = _band_plan(A, context)
+    return plan is not None and A.shape[0] * (plan["bw"] + 1.0) ** 2 <= BAND_AUTO_COST
+
+
+def _banded_cholesky_solve(A, b, context):
+    """Solve with the banded Cholesky of ``A`` (symmetric, CSR); None when ``A`` is not
+    positive definite or its bandwidth is too large (the caller then uses SuperLU)."""
+    from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded, solve_banded
+
+    if A.shape[0] > BAND_PLAN_MAX_DOFS or not (sp.issparse(A) and A.format == "csr" and A.has_canonical_format):
+        return None
+    plan = _band_plan(A, context)
+    if plan is None:
+        return None
+    n, bw, perm = A.shape[0], plan["bw"], plan["perm"]
+    bp = np.asarray(b, dtype=float)[perm]
+    y = None
+    state = context if context is not None else {}
+    if not state.get("band_indefinite"):
+        ab = np.zeros((bw + 1) * n)
+        ab[plan["dst"]] = A.data[plan["src"]]
+        try:
+            cb = cholesky_banded(ab.reshape(bw + 1, n), lower=True, overwrite_ab=True, check_finite=False)
+            y = cho_solve_banded((cb, True), bp, check_finite=False)
+        except LinAlgError:  # not positive definite: banded LU (partial pivoting) from now on
+            state["band_indefinite"] = True
+    if y is None:
+        if 2.0 * n * (bw + 1.0) * (2 * bw + 1.0) > 2 * BAND_COST_MAX:
+            return None
+        ab = np.zeros((2 * bw + 1) * n)
+        ab[plan["dst_full"]] = A.data
+        try:
+            y = solve_banded((bw, bw), ab.reshape(2 * bw + 1, n), bp, overwrite_ab=True, check_finite=False)
+        except (LinAlgError, ValueError):  # exactly singular
+            return None
+    x = np.empty(n)
+    x[perm] = y
+    return x if np.all(np.isfinite(x)) else None
+
+
+def _direct_solve(A, b, symmetric, context=None):
+    """Symmetric: banded Cholesky in a bandwidth-reducing ordering when it is cheap and the matrix
+    is positive definite; otherwise SuperLU with the minimum-degree ordering of A^T + A (less fill
+    than the default COLAMD on lattice stiffnesses).  Non-symmetric: SuperLU with COLAMD."""
+    if symmetric:
+        x = _banded_cholesky_solve(A, b, context)
+        if x is not None:
+            return x
     spec = "MMD_AT_PLUS_A" if symmetric else "COLAMD"
     return spla.splu(sp.csc_matrix(A), permc_spec=spec).solve(np.asarray(b, dtype=float))
 
 
-def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10):
+def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10, truncate=False):
     """Solve ``A x = b``; raise _NewtonFailure when the matrix is singular or the solve fails.
 
     ``context`` (optional dict) holds ``dim`` and ``coords`` (free nodes) for the AMG near-null
     space and a ``cache`` where the AMG hierarchy is kept and reused for the next matrices of the
     same solve (Newton iterations, time steps) as long as CG converges fast with it.  ``rtol`` is
-    the CG tolerance (relative to ``||b||``)."""
+    the CG tolerance (relative to ``||b||``).  With ``truncate``, a CG run that meets negative
+    curvature returns its last iterate (truncated Newton: used under an energy line search)
+    instead of falling back to sparse LU."""
     if callable(method):
         x = np.asarray(method(A, b), dtype=float)
         if not np.all(np.isfinite(x)):
@@ -395,7 +592,8 @@ def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10):
     if method not in ("auto", "direct", "cg"):
         raise ValueError(f"linear_solver must be 'auto', 'direct', 'cg' or a callable, got {method!r}")
     n = A.shape[0]
-    use_cg = method == "cg" or (method == "auto" and symmetric and n > ITERATIVE_THRESHOLD)
+    use_cg = method == "cg" or (method == "auto" and symmetric and n > ITERATIVE_THRESHOLD
+                                and not _band_is_cheap(A, context))
     if use_cg:
         cache = context.setdefault("cache", {}) if context is not None else {}
         try:
@@ -406,36 +604,84 @@ def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10):
                 reused = M is not None
                 if M is None:
                     M = _preconditioner(A, context)
-                count = [0]
-
-                def _count(_xk):
-                    count[0] += 1
-
-                x, info = _cg_counted(A, b, M, rtol, maxiter, _count)
-                if reused and (info != 0 or count[0] > 2 * cache.get("iterations", maxiter) + 10):
+                x, info, its = _pcg(A, b, M, rtol, maxiter)
+                total = its
+                # iterations per decade of residual reduction: comparable across tolerances
+                decades = max(1.0, -np.log10(max(rtol, 1e-300)))
+                if reused and (info > 0 or its > 2.0 * cache.get("per_decade", maxiter) * decades + 10):
                     # the kept hierarchy no longer fits the matrix: rebuild it and solve again
                     M = _preconditioner(A, context)
                     reused = False
-                    count[0] = 0
-                    x, info = _cg_counted(A, b, M, rtol, maxiter, _count)
-                if not reused:
-                    cache.update(M=M, shape=A.shape, iterations=count[0])
-            if info == 0 and np.all(np.isfinite(x)):
-                return x
+                    x, info, its = _pcg(A, b, M, rtol, maxiter)
+                    total += its
+                if not reused and info == 0:
+                    cache.update(M=M, shape=A.shape, per_decade=its / decades)
+                if context is not None:
+                    context["cg_iterations"] = context.get("cg_iterations", 0) + total
+            if np.all(np.isfinite(x)):
+                if info == 0:
+                    return x
+                if info < 0 and truncate:
+                    # negative curvature: the CG iterate reached so far (a descent direction of
+                    # the energy); the line search and the Newton test decide what it is worth
+                    if context is not None:
+                        context["negative_curvature"] = context.get("negative_curvature", 0) + 1
+                    return x
             cache.clear()
-            messages.append(f"CG did not converge (info={info}); falling back to sparse LU")
+            what = "met negative curvature" if info < 0 else f"did not converge in {maxiter} iterations"
+            messages.append(f"CG {what}; falling back to sparse LU")
         except (RuntimeError, ValueError, ArithmeticError) as exc:
             cache.clear()
             messages.append(f"preconditioned CG failed ({exc}); falling back to sparse LU")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            x = _direct_solve(A, b, symmetric)
+            x = _direct_solve(A, b, symmetric, context)
     except RuntimeError as exc:  # "Factor is exactly singular"
         raise _NewtonFailure(f"singular stiffness matrix ({exc})") from None
     if not np.all(np.isfinite(x)):
         raise _NewtonFailure("linear solve produced non-finite values (singular stiffness?)")
     return x
+
+
+def _pcg(A, b, M, rtol, maxiter):
+    """Preconditioned conjugate gradients from zero, stopping at ``||b - A x|| <= rtol ||b||``.
+
+    Returns ``(x, info, iterations)``: ``info`` 0 when converged, 1 when ``maxiter`` was reached,
+    -1 when a search direction of non-positive curvature ``p.A p <= 0`` was met (``A`` or the
+    preconditioner is not positive definite); ``x`` is then the last iterate, or the
+    preconditioned residual direction scaled by ``r.z / |p.A p|`` if that happens at the first
+    iteration (for an SPD preconditioner, both are descent directions of ``x.A x / 2 - b.x``)."""
+    b = np.asarray(b, dtype=float)
+    n = b.shape[0]
+    x = np.zeros(n)
+    bnorm = float(np.linalg.norm(b))
+    if bnorm == 0.0:
+        return x, 0, 0
+    tol = rtol * bnorm
+    r = b.copy()
+    z = np.asarray(M @ r, dtype=float).ravel()
+    rz = float(r @ z)
+    p = z.copy()
+    for k in range(1, maxiter + 1):
+        Ap = np.asarray(A @ p, dtype=float).ravel()
+        pAp = float(p @ Ap)
+        if not (pAp > 0.0 and rz > 0.0):
+            if k == 1:
+                scale = rz / abs(pAp) if pAp != 0.0 and np.isfinite(pAp) and rz > 0 else 1.0
+                x = p * scale
+            return x, -1, k
+        alpha = rz / pAp
+        x += alpha * p
+        r -= alpha * Ap
+        if float(np.linalg.norm(r)) <= tol:
+            return x, 0, k
+        z = np.asarray(M @ r, dtype=float).ravel()
+        rz_new = float(r @ z)
+        p *= rz_new / rz
+        p += z
+        rz = rz_new
+    return x, 1, maxiter
 
 
 def _cg_counted(A, b, M, rtol, maxiter, callback):
@@ -522,6 +768,30 @@ def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy):
     raise _NewtonFailure(f"line search failed (no sufficient decrease down to step length {2 * alpha:.1e})")
 
 
+_ETA_MAX = 0.1  # loosest relative tolerance of the iterative linear solves (first iterations)
+_ETA_GAMMA = 0.9
+
+
+def _forcing_term(rnorm, rnorm_prev, eta_prev, threshold):
+    """Relative tolerance of the iterative linear solve of a Newton step (inexact Newton,
+    Eisenstat & Walker's second choice): ``eta = 0.9 (|r_k| / |r_k-1|)^2``, kept above
+    ``0.9 eta_k-1^2`` when that is not small (so that it does not drop too fast), at most
+    ``_ETA_MAX``; and never tighter than what brings the linear part of the next residual 10x
+    below the convergence threshold (no over-solving), nor than 1e-10.  Loose while far from the
+    solution, tight near it; it does not change the convergence test of the Newton iteration.
+    Direct solvers ignore it."""
+    if not rnorm > 0:
+        return 1e-10
+    if rnorm_prev is None or not rnorm_prev > 0:
+        eta = _ETA_MAX
+    else:
+        eta = _ETA_GAMMA * (rnorm / rnorm_prev) ** 2
+        if eta_prev is not None and _ETA_GAMMA * eta_prev**2 > 0.1:
+            eta = max(eta, _ETA_GAMMA * eta_prev**2)
+    eta = min(eta, _ETA_MAX)
+    return float(min(_ETA_MAX, max(eta, 0.1 * threshold / rnorm, 1e-10)))
+
+
 def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_solver,
             symmetric, use_energy, messages, progress, step_index, solver_context=None):
     """Newton iteration at a fixed load. Returns (x, iterations, residual history).
@@ -534,6 +804,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
     context = _solver_context(problem, x, free) if solver_context is None else solver_context
     e = _energy_or_none(problem, x, load) if (line_search and use_energy) else None
     it = 0
+    rnorm_prev = eta_prev = None
 
     def fail(reason):
         exc = _NewtonFailure(reason)
@@ -550,10 +821,10 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         with np.errstate(all="ignore"):
             K = _submatrix(problem.stiffness(x, load), free)
         try:
-            # CG tolerance: 1e-10, but never much tighter than needed to bring the linear part of
-            # the next residual 10x below the convergence threshold (no over-solving)
-            rtol = min(1e-6, max(1e-10, 0.1 * threshold / rnorm)) if rnorm > 0 else 1e-10
-            dx = _linear_solve(K, r, linear_solver, symmetric, messages, context, rtol)
+            rtol = _forcing_term(rnorm, rnorm_prev, eta_prev, threshold)
+            eta_prev, rnorm_prev = rtol, rnorm
+            dx = _linear_solve(K, r, linear_solver, symmetric, messages, context, rtol,
+                               truncate=bool(line_search and use_energy))
         except _NewtonFailure as exc:
             raise fail(str(exc)) from None
         if line_search:
@@ -591,12 +862,18 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
     max_iter : Newton iterations allowed per load step before the step counts as failed.
     line_search : backtracking with the Armijo condition on the energy when ``problem.energy``
         returns a number and the Newton direction descends it, otherwise on ``||force[free]||^2``.
-    linear_solver : ``"auto"`` (sparse LU — minimum-degree ordering for symmetric systems — up to
-        ``ITERATIVE_THRESHOLD`` = 8 000 free dofs; above, for symmetric systems, CG preconditioned
-        by pyamg smoothed aggregation if installed (node blocks and rigid-body modes when the free
-        dofs are whole nodes; the hierarchy is reused across Newton iterations) or else by
-        incomplete Cholesky IC(0), falling back to LU), ``"direct"``,
-        ``"cg"``, or a callable ``(K_free, rhs) -> dx``.
+    linear_solver : ``"auto"``, ``"direct"``, ``"cg"``, or a callable ``(K_free, rhs) -> dx``.
+        ``"direct"``: for symmetric systems a banded Cholesky in a bandwidth-reducing ordering
+        (computed once per sparsity pattern) when it is cheap, banded LU when the tangent is
+        indefinite, else sparse LU (minimum-degree ordering); non-symmetric: sparse LU.
+        ``"cg"``: CG preconditioned by pyamg smoothed aggregation if installed (node blocks and
+        rigid-body modes when the free dofs are whole nodes; the hierarchy is reused across
+        Newton iterations) or else by incomplete Cholesky IC(0), falling back to LU; the CG
+        tolerance follows an inexact-Newton forcing term (loose far from the solution, tight
+        near it; the Newton convergence test is unchanged), and a CG run that meets negative
+        curvature returns its last iterate under the energy line search (truncated Newton).
+        ``"auto"``: direct up to ``ITERATIVE_THRESHOLD`` = 2 000 free dofs or while the banded
+        Cholesky is cheap (``n (b + 1)^2 <= BAND_AUTO_COST``), else CG for symmetric systems.
     progress : optional callable receiving a dict ``{load_step, load, iteration, residual,
         threshold}`` after each Newton iteration.
     max_cuts : how many times a failing load increment may be halved (in total, for one step).
@@ -670,6 +947,7 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
         x=x, converged=True, iterations=iterations, residuals=residuals, loads=loads,
         wall_time=time.perf_counter() - t_start, n_load_steps=len(loads), n_cuts=n_cuts,
         force_scale=scale, line_search_merit=merit, messages=messages,
+        cg_iterations=int(solver_context.get("cg_iterations", 0)),
     )
 
 

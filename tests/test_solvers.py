@@ -390,3 +390,114 @@ def test_implicit_euler_stable_at_same_step():
                     save_every=50)
     assert np.all(np.isfinite(res.x)) and np.all(np.isfinite(res.v))
     assert np.max(np.abs(res.x_final - prob.x0())) < 0.05
+
+
+# ---------------------------------------------------------------------------------------------
+# linear algebra of the static solver: free-dof extraction, banded direct, CG, forcing term
+# ---------------------------------------------------------------------------------------------
+
+
+def lattice_block(nx, ny, nz, *, k3=2.0, g=0.05):
+    """3D lattice of nodes joined to their 26 neighbours (springs), bottom layer fixed, a uniform
+    downward load; dofs interleaved by node (``dim = 3``), so the AMG path sees node blocks."""
+    idx = np.arange(nx * ny * nz).reshape(nx, ny, nz)
+    pts = np.stack(np.meshgrid(np.arange(nx), np.arange(ny), np.arange(nz), indexing="ij"), -1).reshape(-1, 3)
+    edges = []
+    for di in (0, 1):
+        for dj in (-1, 0, 1):
+            for dk in (-1, 0, 1):
+                if (di, dj, dk) <= (0, 0, 0):
+                    continue
+                a = idx[max(0, -di):nx - max(0, di), max(0, -dj):ny - max(0, dj), max(0, -dk):nz - max(0, dk)]
+                b = idx[max(0, di):nx - max(0, -di) or None, max(0, dj):ny - max(0, -dj) or None,
+                        max(0, dk):nz - max(0, -dk) or None]
+                edges.append(np.column_stack([a.ravel(), b.ravel()]))
+    edges = np.concatenate(edges)
+    f = np.zeros(pts.size)
+    f[2::3] = -g
+    fixed = np.flatnonzero(pts[:, 2] == 0)
+    return SpringNetwork(pts.astype(float), edges, 1.0, k3=k3, fixed_nodes=fixed, f_ext=f)
+
+
+def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
+    from msslib.solvers import _submatrix
+
+    rng = np.random.default_rng(4)
+    for t in range(30):
+        K = sp.random(40, 40, 0.08, random_state=t, format="csr") + (sp.eye(40) if t % 2 else 0)
+        K = sp.csr_matrix(K)
+        K.sum_duplicates()
+        free = rng.random(40) < 0.7
+        idx = np.flatnonzero(free)
+        for _ in range(2):  # the second call goes through the cached plan
+            A = _submatrix(K, free)
+            A.check_format(full_check=True)
+            assert A.shape == (len(idx), len(idx))
+            assert abs(A - K[idx][:, idx]).max() == 0 if A.nnz else K[idx][:, idx].nnz == 0
+        K2 = K.copy()
+        K2.data = rng.standard_normal(K2.nnz)  # same pattern, new values
+        assert abs(_submatrix(K2, free) - K2[idx][:, idx]).max() == 0 if K2[idx][:, idx].nnz else True
+
+
+@pytest.mark.parametrize("shift", [0.0, -0.5])  # SPD (banded Cholesky) and indefinite (banded LU)
+def test_banded_direct_solve_matches_dense(shift):
+    from msslib.solvers import _direct_solve, _solver_context
+
+    prob = lattice_block(3, 3, 6)
+    x = prob.x0()
+    free = prob.free
+    from msslib.solvers import _submatrix
+
+    A = _submatrix(prob.stiffness(x) + shift * sp.eye(prob.n_dof, format="csr"), free)
+    A = sp.csr_matrix(A)
+    A.sum_duplicates()
+    b = np.random.default_rng(0).standard_normal(A.shape[0])
+    ctx = _solver_context(prob, x, free)
+    sol = _direct_solve(A, b, True, ctx)
+    ref = np.linalg.solve(A.toarray(), b)
+    np.testing.assert_allclose(sol, ref, rtol=1e-8, atol=1e-10 * np.abs(ref).max())
+    assert bool(ctx.get("band_indefinite")) == (np.linalg.eigvalsh(A.toarray()).min() < 0)
+
+
+def test_pcg_converges_and_detects_negative_curvature():
+    from msslib.solvers import _pcg
+
+    n = 100
+    K = sp.diags([-np.ones(n - 1), 2.05 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")
+    b = np.random.default_rng(2).standard_normal(n)
+    identity = sp.eye(n, format="csr")
+    x, info, its = _pcg(K, b, identity, 1e-10, 1000)
+    assert info == 0 and 0 < its <= n and np.linalg.norm(K @ x - b) <= 1e-10 * np.linalg.norm(b)
+    # indefinite: a negative-curvature direction is reported, and what is returned still descends
+    # the quadratic model 1/2 x.A x - b.x (direction of positive b.x)
+    Kn = K - 1.0 * identity
+    x, info, its = _pcg(Kn, b, identity, 1e-10, 1000)
+    assert info == -1 and np.all(np.isfinite(x)) and float(b @ x) > 0
+
+
+def test_forcing_term_loose_far_tight_near():
+    from msslib.solvers import _ETA_MAX, _forcing_term
+
+    threshold = 1e-8
+    assert _forcing_term(1.0, None, None, threshold) == _ETA_MAX
+    # quadratic convergence phase: eta follows (r_k / r_k-1)^2
+    assert _forcing_term(1e-3, 1e-1, 1e-2, threshold) == pytest.approx(0.9e-4)
+    # close to the threshold it never asks more than needed (0.1 threshold / r), nor < 1e-10
+    assert _forcing_term(1e-6, 1e-3, 1e-4, threshold) == pytest.approx(1e-3)
+    assert _forcing_term(1e-20, 1e-3, 1e-4, 1e-30) == 1e-10
+
+
+def test_static_solve_cg_and_direct_agree_on_a_nonlinear_lattice():
+    prob = lattice_block(4, 4, 7)
+    x0 = prob.x0()
+    direct = static_solve(prob, x0, linear_solver="direct", tol=1e-10)
+    iterative = static_solve(prob, x0, linear_solver="cg", tol=1e-10)
+    assert direct.cg_iterations == 0 and iterative.cg_iterations > 0
+    for r in (direct, iterative):
+        assert r.residuals[-1][-1] <= 1e-10 * r.force_scale
+        assert np.linalg.norm(prob.force(r.x)[prob.free]) <= 1e-10 * r.force_scale
+    u = direct.x - x0
+    assert np.abs(u).max() > 0.05  # a genuinely deformed state
+    np.testing.assert_allclose(iterative.x, direct.x, rtol=0, atol=1e-7 * np.abs(u).max())
+    # the inexact Newton (loose CG early on) does not cost many more Newton iterations
+    assert iterative.total_iterations <= direct.total_iterations + 3
