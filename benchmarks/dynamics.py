@@ -131,7 +131,7 @@ def run(res, quick: bool):
             f"{t_end:g} s simulated, nu = 0.3, E = 20 kPa, 1 cm cubes, gravity, alpha = {alpha:g}/s, {n_steps} "
             f"steps of {h:.3g} s (0.9 x dt_crit), symplectic Euler, structured-lattice SIMD kernels "
             f"(msslib.fastexplicit), 1 thread; median of {repeats} (min {min(walls):.3g} s, max "
-            f"{max(walls):.3g} s), load average {load:.1f}; target <= {0.029 * t_end:.3g} s")
+            f"{max(walls):.3g} s), load average {load:.1f}", target=("<=", 0.029 * t_end, "value"))
     res.add("golec_sample_explicit_wall_generic", wall_gen, "s", paper / wall_gen,
             "Golec et al. 2.88 s per 10 s on 8 cores",
             f"before: same run with the generic scalar kernels (terms._spring3d_gradient_fast + "

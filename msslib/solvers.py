@@ -76,6 +76,7 @@ from typing import Callable
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from numba import njit
 
 __all__ = [
     "ConvergenceError",
@@ -254,6 +255,54 @@ def _pattern_key_matches(entry, K, free):
     return same and np.array_equal(entry["free"], free)
 
 
+def _accepts_out(problem) -> bool:
+    """Whether ``problem.stiffness`` takes ``out=`` (refill a matrix it returned earlier)."""
+    import inspect
+
+    try:
+        return "out" in inspect.signature(problem.stiffness).parameters
+    except (TypeError, ValueError):
+        return False
+
+
+@njit(cache=True, nogil=True)
+def _plan_count(indptr, indices, free, sub_indptr):
+    """Row pointers of the free-free block; returns its number of entries."""
+    r = 0
+    n = 0
+    sub_indptr[0] = 0
+    for i in range(indptr.shape[0] - 1):
+        if not free[i]:
+            continue
+        for p in range(indptr[i], indptr[i + 1]):
+            if free[indices[p]]:
+                n += 1
+        r += 1
+        sub_indptr[r] = n
+    return n
+
+
+@njit(cache=True, nogil=True)
+def _plan_fill(indptr, indices, free, new_index, sel, sub_indices):
+    """Positions in ``K.data`` of the free-free entries and their new column indices."""
+    n = 0
+    for i in range(indptr.shape[0] - 1):
+        if not free[i]:
+            continue
+        for p in range(indptr[i], indptr[i + 1]):
+            j = indices[p]
+            if free[j]:
+                sel[n] = p
+                sub_indices[n] = new_index[j]
+                n += 1
+
+
+@njit(cache=True, nogil=True)
+def _gather(data, sel, out):
+    for i in range(sel.shape[0]):
+        out[i] = data[sel[i]]
+
+
 def _submatrix_plan(K, free):
     for i, entry in enumerate(_PLAN_CACHE):
         if _pattern_key_matches(entry, K, free):
@@ -261,20 +310,13 @@ def _submatrix_plan(K, free):
                 _PLAN_CACHE.insert(0, _PLAN_CACHE.pop(i))
             return entry
     n_free = int(free.sum())
-    counts = np.diff(K.indptr)
-    row_free = np.repeat(free, counts)
-    keep = row_free & free[K.indices]
-    del row_free
-    sel = np.flatnonzero(keep)
-    del keep
     idx_t = np.int32 if K.nnz < 2**31 else np.int64
-    sel = sel.astype(idx_t)
     new_index = (np.cumsum(free) - 1).astype(idx_t)  # increasing: sorted rows stay sorted
-    sub_indices = new_index[K.indices[sel]]
-    # kept entries lie in free rows only: a free row starts after the kept entries before it
     sub_indptr = np.empty(n_free + 1, dtype=idx_t)
-    sub_indptr[:-1] = np.searchsorted(sel, K.indptr[:-1][free])
-    sub_indptr[-1] = len(sel)
+    n_keep = _plan_count(K.indptr, K.indices, free, sub_indptr)
+    sel = np.empty(n_keep, dtype=idx_t)
+    sub_indices = np.empty(n_keep, dtype=idx_t)
+    _plan_fill(K.indptr, K.indices, free, new_index, sel, sub_indices)
     entry = {"shape": K.shape, "free_n": free.size, "free": free.copy(), "indptr": K.indptr,
              "indices": K.indices, "sel": sel, "sub_indptr": sub_indptr, "sub_indices": sub_indices,
              "sub_shape": (n_free, n_free)}
@@ -300,7 +342,9 @@ def _submatrix(K, free):
         idx = np.flatnonzero(free)
         return sp.csr_matrix(K[idx][:, idx])
     plan = _submatrix_plan(K, free)
-    A = sp.csr_matrix((K.data[plan["sel"]], plan["sub_indices"], plan["sub_indptr"]),
+    vals = np.empty(len(plan["sel"]), dtype=K.data.dtype)
+    _gather(K.data, plan["sel"], vals)
+    A = sp.csr_matrix((vals, plan["sub_indices"], plan["sub_indptr"]),
                       shape=plan["sub_shape"], copy=False)
     A.has_sorted_indices = True
     A.has_canonical_format = True
@@ -814,12 +858,17 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
 
     if not np.isfinite(rnorm):
         raise fail("non-finite force at the initial guess")
+    # the full tangent's values can be refilled in place when only its free block is passed on
+    # (the block is a copy); saves allocating (and page-faulting) a new value array per iteration
+    refill = not free.all() and _accepts_out(problem)
+    K_full = None
     while rnorm > threshold:
         if it >= max_iter:
             raise fail(f"no convergence in {max_iter} iterations")
         it += 1
         with np.errstate(all="ignore"):
-            K = _submatrix(problem.stiffness(x, load), free)
+            K_full = problem.stiffness(x, load, out=K_full) if refill else problem.stiffness(x, load)
+            K = _submatrix(K_full, free)
         try:
             rtol = _forcing_term(rnorm, rnorm_prev, eta_prev, threshold)
             eta_prev, rnorm_prev = rtol, rnorm

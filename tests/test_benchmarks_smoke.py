@@ -22,7 +22,7 @@ FIGURES = [
     "hessian_assembly_rel_error", "cantilever_static_baudet", "cantilever_static_golec",
     "golec_sample_explicit_wall", "golec_sample_step_cost", "golec_sample_error_vs_reference",
     "golec_sample_final_error_vs_reference", "golec_sample_reference_wall",
-    "static_solve_scaling_exponent", "static_solve_superlu_scaling_exponent",
+    "static_solve_scaling_exponent_warm", "static_solve_scaling_exponent_cold", "static_solve_superlu_scaling_exponent",
 ]
 
 
