@@ -48,8 +48,9 @@ def run_scaling(res, quick: bool):
     (the free-dof extraction plan, the band ordering and the AMG set-up included), and *warm*,
     a repeated solve of the same model (those plans cached, as in load stepping, time stepping
     and parameter sweeps).  Building the model (its sparsity pattern) is not timed."""
-    sizes = [6, 10, 15] if quick else [6, 10, 15, 22, 32, 46]
-    lu_sizes = [6, 10] if quick else [6, 10, 15]
+    # 7^3 cubes: 1,344 free dofs, the smallest size at or above 10^3; 46^3: 304,842
+    sizes = [7, 10, 15] if quick else [7, 10, 15, 22, 32, 46]
+    lu_sizes = [7, 10] if quick else [7, 10, 15]
     dofs, cold, warm, lu_dofs, lu_times, cg_sizes = [], [], [], [], [], []
     for n in sizes:
         rep = 3 if n <= 10 else 1
