@@ -71,7 +71,7 @@ def run(res, quick: bool):
 
     # ---- Hessian assembly
     model = MD.Model(mesh, [springs])
-    t_fill = median_time(lambda: model.stiffness(x), repeat=rep)
+    model.stiffness(x)  # warm-up (compilation)
     rows, cols = springs.hessian_pattern()
     vals = np.empty((s, 36))
 
@@ -79,18 +79,36 @@ def run(res, quick: bool):
         T._spring3d_hessian_loop(x, springs.conn, springs.k, springs.rest_length, vals)
         return sp.coo_matrix((vals.ravel(), (rows, cols)), shape=(x.size, x.size)).tocsr()
 
-    t_coo = median_time(coo, repeat=3)
+    # interleaved rounds: the baseline and the fills are timed side by side, so that a change of
+    # machine speed during the run (shared hosts) affects both alike
+    K_out = model.stiffness(x)
+    rounds = 3 if quick else 7
+    t_coo_all, t_fill_all, t_refill_all = [], [], []
+    for _ in range(rounds):
+        t_coo_all.append(median_time(coo, repeat=1, warmup=0))
+        t_fill_all.append(median_time(lambda: model.stiffness(x), repeat=3, warmup=0))
+        t_refill_all.append(median_time(lambda: model.stiffness(x, out=K_out), repeat=3, warmup=0))
+    t_coo, t_fill, t_refill = (float(np.median(t)) for t in (t_coo_all, t_fill_all, t_refill_all))
     K, Kc = model.stiffness(x), coo()
     herr = float(abs(K - Kc).max() / abs(Kc).max())
-    res.add("hessian_assembly_scipy_coo", t_coo * 1e3, "ms", 1.0, "itself", f"values + COO->CSR, nnz {Kc.nnz}")
-    K_out = model.stiffness(x)
-    t_refill = median_time(lambda: model.stiffness(x, out=K_out), repeat=rep)
+    res.add("hessian_assembly_scipy_coo", t_coo * 1e3, "ms", 1.0, "itself",
+            f"values (numba loop) + COO->CSR, nnz {Kc.nnz}; median of {rounds} rounds interleaved with the fills")
     res.add("hessian_assembly_fast", t_fill * 1e3, "ms", t_coo / t_fill, "scipy_coo",
             "Model.stiffness(x): precomputed CSR pattern, new value array (page faults of a fresh "
             f"{K.data.nbytes / 1e6:.0f} MB allocation included)")
     res.add("hessian_assembly_fast_refill", t_refill * 1e3, "ms", t_coo / t_refill, "scipy_coo",
             "Model.stiffness(x, out=K): precomputed CSR pattern, values refilled in place (as in "
             "Newton iterations)", target=(">=", 30, "ratio"))
+    # bandwidth bound of the refill: the value array written (and read for ownership), the
+    # layout arrays read once, at the copy bandwidth measured above
+    _, rowptr2, nb2, k2, L02 = springs.symmetric_layout()
+    nptr, diag_pos, fills = model._block
+    moved = 2 * K.data.nbytes + sum(a.nbytes for a in (rowptr2, nb2, k2, L02, fills[0][1], nptr, diag_pos, x))
+    t_floor = moved / bw
+    res.add("hessian_refill_bandwidth_floor", t_floor * 1e3, "ms", t_coo / t_floor, "scipy_coo",
+            f"{moved / 1e6:.0f} MB moved per refill at the copy bandwidth: the largest ratio reachable "
+            "in this run")
+    res.add("hessian_refill_fraction_of_bandwidth_limit", t_floor / t_refill, "", None, None)
     write = np.empty_like(K.data)
     t_write = median_time(lambda: write.fill(1.0), repeat=rep)
     res.add("hessian_value_array_write", t_write * 1e3, "ms", t_coo / t_write, "scipy_coo",
