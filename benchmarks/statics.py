@@ -53,7 +53,7 @@ def run_scaling(res, quick: bool):
     lu_sizes = [7, 10] if quick else [7, 10, 15]
     dofs, cold, warm, lu_dofs, lu_times, cg_sizes = [], [], [], [], [], []
     for n in sizes:
-        rep = 3 if n <= 10 else 1
+        rep = 9 if n <= 10 else (3 if n <= 15 else 1)  # cheap sizes: more repeats (their spread moves the fit)
         colds = []
         for _ in range(rep):  # cold: a new model each time
             model = cube_under_gravity(n)
@@ -76,7 +76,7 @@ def run_scaling(res, quick: bool):
         ratio = None
         if n in lu_sizes:
             t_lu = median_time(lambda: S.static_solve(model, model.x0, linear_solver=superlu_default),
-                               repeat=rep, warmup=0)
+                               repeat=3 if n <= 10 else 1, warmup=0)
             lu_dofs.append(nd)
             lu_times.append(t_lu)
             ratio = t_lu / t

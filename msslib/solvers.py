@@ -327,10 +327,11 @@ def _submatrix_plan(K, free):
     return entry
 
 
-def _submatrix(K, free):
+def _submatrix(K, free, out=None):
     """Free-free block of ``K`` (CSR, sorted indices).  For a canonical CSR input the positions
     of the free entries are computed once per sparsity pattern and reused (a gather of the data),
-    and the returned matrices share their (read-only) index arrays."""
+    and the returned matrices share their (read-only) index arrays.  ``out``: an earlier result
+    for the same pattern and mask, whose values are overwritten (and which is returned)."""
     if not (sp.issparse(K) and K.format == "csr"):
         K = sp.csr_matrix(K)
     if free.all():
@@ -342,6 +343,11 @@ def _submatrix(K, free):
         idx = np.flatnonzero(free)
         return sp.csr_matrix(K[idx][:, idx])
     plan = _submatrix_plan(K, free)
+    if (out is not None and _same_readonly(out.indices, plan["sub_indices"])
+            and out.data.shape == plan["sel"].shape and out.data.dtype == K.data.dtype
+            and out.data.flags.writeable):
+        _gather(K.data, plan["sel"], out.data)
+        return out
     vals = np.empty(len(plan["sel"]), dtype=K.data.dtype)
     _gather(K.data, plan["sel"], vals)
     A = sp.csr_matrix((vals, plan["sub_indices"], plan["sub_indptr"]),
@@ -868,7 +874,9 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         it += 1
         with np.errstate(all="ignore"):
             K_full = problem.stiffness(x, load, out=K_full) if refill else problem.stiffness(x, load)
-            K = _submatrix(K_full, free)
+            # the previous block is no longer needed (a kept AMG hierarchy is a preconditioner
+            # only): its value array is reused, which saves page-faulting a new one each iteration
+            K = _submatrix(K_full, free, out=K if refill and it > 1 else None)
         try:
             rtol = _forcing_term(rnorm, rnorm_prev, eta_prev, threshold)
             eta_prev, rnorm_prev = rtol, rnorm

@@ -439,6 +439,32 @@ def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
         assert abs(_submatrix(K2, free) - K2[idx][:, idx]).max() == 0 if K2[idx][:, idx].nnz else True
 
 
+def test_submatrix_refill_in_place_equals_fresh_extraction():
+    from msslib import mesh as M
+    from msslib.model import Model, golec_cube_springs
+    from msslib.solvers import _submatrix
+
+    mesh = M.hex_grid(0.03, 0.02, 0.02, 3, 2, 2)
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    fixed[mesh.points[:, 0] < 1e-12] = True
+    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
+    free = model.free
+    idx = np.flatnonzero(free)
+    rng = np.random.default_rng(5)
+    K = model.stiffness(model.x0)
+    A = _submatrix(K, free)
+    for _ in range(2):
+        x = model.x0 + 1e-3 * rng.standard_normal(model.n_dof)
+        K = model.stiffness(x, out=K)
+        A2 = _submatrix(K, free, out=A)
+        assert A2 is A  # values overwritten in place
+        ref = K.tocsc()[idx][:, idx]
+        assert abs(A2 - ref).max() == 0.0
+    # a matrix of another pattern is not reused
+    other = sp.csr_matrix(np.eye(len(idx)))
+    assert _submatrix(K, free, out=other) is not other
+
+
 @pytest.mark.parametrize("shift", [0.0, -0.5])  # SPD (banded Cholesky) and indefinite (banded LU)
 def test_banded_direct_solve_matches_dense(shift):
     from msslib.solvers import _direct_solve, _solver_context
