@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -96,6 +98,17 @@ def run_scaling(res, quick: bool):
         if not quick:
             res.add(f"static_solve_largest_{label}", times[-1], "s", None, None, f"{label} solve{big}",
                     target=("<=", 20.0, "value"))
+    # what "cold" pays beyond "warm" at large sizes is mostly memory touched for the first time:
+    # measure the cost of a page on first touch in a fresh process and once memory is recycled
+    code = ("import numpy as np, time\n"
+            "for _ in range(2):\n"
+            "    t = time.perf_counter(); a = np.ones(1 << 25); dt = time.perf_counter() - t\n"
+            "    print(dt / (a.nbytes / 4096) * 1e6); del a\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    first, again = float(out[0]), float(out[1])
+    res.add("page_first_touch_cost", first, "us per 4 KiB page", None, None,
+            f"256 MB of new memory in a fresh process; {again:.2f} us per page for the same allocation "
+            f"repeated in that process ({first / again:.0f}x less): cold solves at large sizes pay the first")
     if len(cg_sizes) >= 2:  # the sizes where "auto" chose AMG-preconditioned CG
         d = [dofs[i] for i in cg_sizes]
         ci = float(np.polyfit(np.log(d), np.log([warm[i] for i in cg_sizes]), 1)[0])
