@@ -283,8 +283,8 @@ def _plan_count(indptr, indices, free, sub_indptr):
 
 
 @njit(cache=True, nogil=True)
-def _plan_fill(indptr, indices, free, new_index, sel, sub_indices):
-    """Positions in ``K.data`` of the free-free entries and their new column indices."""
+def _plan_fill(indptr, indices, free, new_index, sub_indices):
+    """New column indices of the free-free entries."""
     n = 0
     for i in range(indptr.shape[0] - 1):
         if not free[i]:
@@ -292,15 +292,22 @@ def _plan_fill(indptr, indices, free, new_index, sel, sub_indices):
         for p in range(indptr[i], indptr[i + 1]):
             j = indices[p]
             if free[j]:
-                sel[n] = p
                 sub_indices[n] = new_index[j]
                 n += 1
 
 
 @njit(cache=True, nogil=True)
-def _gather(data, sel, out):
-    for i in range(sel.shape[0]):
-        out[i] = data[sel[i]]
+def _gather_free(indptr, indices, data, free, out):
+    """Values of the free-free entries, row by row (walks the pattern with the free mask rather
+    than storing their positions: one array fewer to allocate and touch per pattern)."""
+    n = 0
+    for i in range(indptr.shape[0] - 1):
+        if not free[i]:
+            continue
+        for p in range(indptr[i], indptr[i + 1]):
+            if free[indices[p]]:
+                out[n] = data[p]
+                n += 1
 
 
 def _submatrix_plan(K, free):
@@ -314,11 +321,10 @@ def _submatrix_plan(K, free):
     new_index = (np.cumsum(free) - 1).astype(idx_t)  # increasing: sorted rows stay sorted
     sub_indptr = np.empty(n_free + 1, dtype=idx_t)
     n_keep = _plan_count(K.indptr, K.indices, free, sub_indptr)
-    sel = np.empty(n_keep, dtype=idx_t)
     sub_indices = np.empty(n_keep, dtype=idx_t)
-    _plan_fill(K.indptr, K.indices, free, new_index, sel, sub_indices)
+    _plan_fill(K.indptr, K.indices, free, new_index, sub_indices)
     entry = {"shape": K.shape, "free_n": free.size, "free": free.copy(), "indptr": K.indptr,
-             "indices": K.indices, "sel": sel, "sub_indptr": sub_indptr, "sub_indices": sub_indices,
+             "indices": K.indices, "nnz": n_keep, "sub_indptr": sub_indptr, "sub_indices": sub_indices,
              "sub_shape": (n_free, n_free)}
     entry["sub_indptr"].flags.writeable = False
     entry["sub_indices"].flags.writeable = False
@@ -328,9 +334,9 @@ def _submatrix_plan(K, free):
 
 
 def _submatrix(K, free, out=None):
-    """Free-free block of ``K`` (CSR, sorted indices).  For a canonical CSR input the positions
-    of the free entries are computed once per sparsity pattern and reused (a gather of the data),
-    and the returned matrices share their (read-only) index arrays.  ``out``: an earlier result
+    """Free-free block of ``K`` (CSR, sorted indices).  For a canonical CSR input the index arrays
+    of the block are computed once per sparsity pattern and reused (each call only gathers the
+    values), and the returned matrices share these (read-only) index arrays.  ``out``: an earlier result
     for the same pattern and mask, whose values are overwritten (and which is returned)."""
     if not (sp.issparse(K) and K.format == "csr"):
         K = sp.csr_matrix(K)
@@ -344,12 +350,12 @@ def _submatrix(K, free, out=None):
         return sp.csr_matrix(K[idx][:, idx])
     plan = _submatrix_plan(K, free)
     if (out is not None and _same_readonly(out.indices, plan["sub_indices"])
-            and out.data.shape == plan["sel"].shape and out.data.dtype == K.data.dtype
+            and out.data.shape == (plan["nnz"],) and out.data.dtype == K.data.dtype
             and out.data.flags.writeable):
-        _gather(K.data, plan["sel"], out.data)
+        _gather_free(K.indptr, K.indices, K.data, free, out.data)
         return out
-    vals = np.empty(len(plan["sel"]), dtype=K.data.dtype)
-    _gather(K.data, plan["sel"], vals)
+    vals = np.empty(plan["nnz"], dtype=K.data.dtype)
+    _gather_free(K.indptr, K.indices, K.data, free, vals)
     A = sp.csr_matrix((vals, plan["sub_indices"], plan["sub_indptr"]),
                       shape=plan["sub_shape"], copy=False)
     A.has_sorted_indices = True
