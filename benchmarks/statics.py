@@ -67,7 +67,7 @@ def run_scaling(res, quick: bool):
         def solve():
             runs.append(S.static_solve(model, model.x0))
 
-        t = median_time(solve, repeat=rep, warmup=0)
+        t = median_time(solve, repeat=max(rep, 3), warmup=0)  # warm: at least 3 (shared hosts)
         r = runs[-1]
         nd = int(model.free.sum())
         dofs.append(nd)
