@@ -10,6 +10,8 @@ import sys
 import time
 from pathlib import Path
 
+from msslib.io import write_text
+
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__)
@@ -56,9 +58,7 @@ def main(argv=None):
             "pyamg": amg, "wall_s": time.perf_counter() - t0}
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(json.dumps({"meta": meta, "figures": res.figures}, indent=2))
-    os.replace(tmp, out)  # atomic: no partial file
+    write_text(out, json.dumps({"meta": meta, "figures": res.figures}, indent=2))  # atomic: no partial file
     print(f"wrote {out} ({len(res.figures)} figures, {meta['wall_s']:.1f} s)")
     return 0
 

@@ -6,7 +6,7 @@ Runs every case for every model it applies to and records, per (case, model): wh
 whether the solver converged, the error against the neo-Hookean FEM reference on the same mesh
 where that is meaningful, the volume ratio V/V0, the smallest element volume ratio, the number of
 inverted elements and a one-line text of the outcome (how it broke).  The result is an xarray
-Dataset written atomically (temporary file in the target directory, then ``os.replace``).
+Dataset written atomically (:func:`msslib.io.write_result`).
 
 Models (dimension ``model``):
 
@@ -42,8 +42,6 @@ Cases (dimension ``case``):
 from __future__ import annotations
 
 import argparse
-import os
-import secrets
 import sys
 import time
 import warnings
@@ -57,6 +55,7 @@ from msslib import mesh as M
 from msslib import model as MD
 from msslib import parameters as P
 from msslib import solvers as S
+from msslib.io import write_result
 from msslib.terms import Gravity, NodalForces, Traction
 
 E0 = 1.0e6  # Pa
@@ -506,19 +505,6 @@ def to_dataset(cases, shape_data, quick):
         "description": (__doc__ or "").strip().split("\n\n")[0]})
 
 
-def write_atomic(path, ds):
-    """Write ``ds`` to ``path`` via a temporary file in the same directory and ``os.replace``."""
-    path = Path(path)
-    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
-    try:
-        ds.to_netcdf(tmp, mode="w", format="NETCDF4", engine="netcdf4")
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    return path
-
-
 def summary(ds) -> str:
     lines = []
     for c in ds["case"].values:
@@ -548,7 +534,7 @@ def main(argv=None):
         cases, shape_data = run_all(args.quick, log=lambda s: print(f"[{time.perf_counter() - t0:6.1f} s] {s}", file=sys.stderr))
     ds = to_dataset(cases, shape_data, args.quick)
     ds.attrs["wall_time_s"] = time.perf_counter() - t0
-    write_atomic(out, ds)
+    write_result(out, ds)
     print(summary(ds))
     print(f"-> {out} ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
     return 0

@@ -212,7 +212,7 @@ def _cmd_experiment_run_all(args) -> int:
 
 def _cmd_experiment_compare(args) -> int:
     from msslib import experiment
-    from msslib.io import read_result, write_result
+    from msslib.io import read_result, write_result, write_text
 
     exp = experiment.load_experiment(args.experiment)
     out = Path(args.out)
@@ -228,9 +228,7 @@ def _cmd_experiment_compare(args) -> int:
     if args.table:
         table = Path(args.table)
         _check_writable(table, "table")
-        tmp = table.with_name(f".{table.name}.tmp")
-        tmp.write_text(experiment.markdown_table(ds))
-        os.replace(tmp, table)
+        write_text(table, experiment.markdown_table(ds))
     return 0
 
 

@@ -110,6 +110,7 @@ __all__ = [
     "git_commit",
     "make_dataset",
     "write_result",
+    "write_text",
     "read_result",
     "mesh_from_result",
 ]
@@ -475,6 +476,24 @@ def write_result(path: str | os.PathLike, ds: xr.Dataset) -> Path:
         pass
     finally:
         os.close(dfd)
+    return path
+
+
+def write_text(path: str | os.PathLike, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically, like :func:`write_result`: a hidden
+    temporary file in the target directory renamed over ``path``; on error it is removed and
+    ``path`` is left untouched."""
+    path = Path(path)
+    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
     return path
 
 

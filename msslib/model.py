@@ -272,7 +272,7 @@ class Model:
             order = ([first] if first is not None else []) + [i for i in range(len(fills)) if i != first]
             xc = np.ascontiguousarray(x)
             for i in order:
-                (t, _, _), (kind, p, q), s = self._hessian_terms[i], fills[i], scales[i]
+                (t, _, _), (kind, p, _), s = self._hessian_terms[i], fills[i], scales[i]
                 if s == 0.0:
                     continue
                 if kind == "springs":

@@ -17,9 +17,10 @@ never a blank. ``python -m msslib paper paper/paper.md.in --out paper/build/pape
 from __future__ import annotations
 
 import html
-import os
 import re
 from pathlib import Path
+
+from msslib.io import write_text
 
 PLACEHOLDER = re.compile(r"\{\{\s*(include|figure|value)\s+(.*?)\s*\}\}", re.S)
 
@@ -103,11 +104,6 @@ def build(source, out) -> Path:
     text = expand(source.read_text(encoding="utf-8"), paper_dir, root)
     title = next((line.lstrip("# ").strip() for line in text.splitlines() if line.startswith("# ")), "msslib")
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(render_html(text, title), encoding="utf-8")
-    os.replace(tmp, out)
-    md_out = out.with_suffix(".md")
-    tmp = md_out.with_name(f".{md_out.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, md_out)
+    write_text(out, render_html(text, title))
+    write_text(out.with_suffix(".md"), text)
     return out

@@ -873,7 +873,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
     # the full tangent's values can be refilled in place when only its free block is passed on
     # (the block is a copy); saves allocating (and page-faulting) a new value array per iteration
     refill = not free.all() and _accepts_out(problem)
-    K_full = None
+    K_full = K = None
     while rnorm > threshold:
         if it >= max_iter:
             raise fail(f"no convergence in {max_iter} iterations")
@@ -882,7 +882,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
             K_full = problem.stiffness(x, load, out=K_full) if refill else problem.stiffness(x, load)
             # the previous block is no longer needed (a kept AMG hierarchy is a preconditioner
             # only): its value array is reused, which saves page-faulting a new one each iteration
-            K = _submatrix(K_full, free, out=K if refill and it > 1 else None)
+            K = _submatrix(K_full, free, out=K)
         try:
             rtol = _forcing_term(rnorm, rnorm_prev, eta_prev, threshold)
             eta_prev, rnorm_prev = rtol, rnorm

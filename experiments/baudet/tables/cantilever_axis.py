@@ -7,6 +7,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import baudet_common as C  # noqa: E402
 
+from msslib.io import write_text  # noqa: E402
+
 RES = ("4x1x1", "8x2x2", "16x4x4")
 INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]
           + ["results/baudet/cantilever/gravity__fem.nc", "results/baudet/studies/cantilever_eq10.nc"])
@@ -26,7 +28,7 @@ def main():
         _, w = C.section_deflection(C.open_result(path))
         lines.append(f"| {name} | {w[-1] * 1e3:.4g} | {100 * (w[-1] / tip - 1):+.3g} | {100 * (w[-1] / tip_s - 1):+.3g} |")
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text("\n".join(lines) + "\n")
+    write_text(args.out, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

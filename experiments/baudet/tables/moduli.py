@@ -7,6 +7,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import baudet_common as C  # noqa: E402
 
+from msslib.io import write_text  # noqa: E402
+
 INPUTS = ["results/baudet/studies/tension.nc", "results/baudet/studies/shear.nc", "results/baudet/studies/bulk.nc"]
 
 
@@ -59,7 +61,7 @@ def main():
              "|---|---|---|---|---|---|---|---|"]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text("\n".join(lines) + "\n")
+    write_text(args.out, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from msslib.io import write_result
 from msslib.mesh import hex_grid
 from msslib.metrics import mesh_volume, shear_modulus, youngs_modulus_poisson
 from msslib.model import Model, assemble_springs, golec_cube_springs
@@ -139,7 +140,7 @@ def main():
     ds.attrs.update(study="golec_isotropy", quick=int(args.quick), wall_time_s=time.perf_counter() - t0,
                     sample=f"{L} m cube, {N}^3 Golec cubes", strain=STRAIN)
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    ds.to_netcdf(args.out)
+    write_result(args.out, ds)
 
 
 if __name__ == "__main__":

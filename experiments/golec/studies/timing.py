@@ -20,7 +20,7 @@ import xarray as xr
 from msslib.metrics import mesh_volume
 from msslib.scene import load_scene, prepare, run_scene
 from msslib.solvers import explicit_stability_limit
-from msslib.io import mesh_from_result
+from msslib.io import mesh_from_result, write_result
 
 PUBLISHED_WALL = 2.88  # s, 10 s simulation, 1000 elements, 8-core processor
 PUBLISHED_CORES = 8
@@ -76,7 +76,7 @@ def main():
                      material="E = 400 kPa, nu = 0.3 (timed); E = 20 kPa, nu = 0.4999 (extrapolated)",
                      description=__doc__.strip().splitlines()[0])
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    out.to_netcdf(args.out)
+    write_result(args.out, out)
     print({k: v[0] for k, v in vals.items()})
 
 

@@ -21,7 +21,7 @@ import xarray as xr
 from scipy.optimize import minimize
 
 from msslib.experiment import load_experiment, run, scene_of
-from msslib.io import mesh_from_result
+from msslib.io import mesh_from_result, write_result
 from msslib.metrics import mesh_volume
 from msslib.scene import load_scene, prepare
 from msslib.solvers import static_solve
@@ -121,7 +121,7 @@ def main():
     ds.attrs.update(study="golec_wrinkles", quick=int(args.quick), wall_time_s=time.perf_counter() - t0,
                     description=__doc__.strip().splitlines()[0])
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    ds.to_netcdf(args.out)
+    write_result(args.out, ds)
 
 
 if __name__ == "__main__":

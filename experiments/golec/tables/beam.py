@@ -4,7 +4,7 @@ import argparse
 
 import numpy as np
 
-from msslib.io import read_result
+from msslib.io import read_result, write_text
 
 INPUTS = ["results/golec/studies/wrinkles.nc", "results/golec/beam/comparison.nc"]
 VARIANTS = {
@@ -43,8 +43,7 @@ def main():
         amp_s = "-" if not np.isfinite(amp) else f"{amp * 1e3:.2g}"
         lines.append(f"| {v} | {text} | {100 * float(r.tip_deflection):.3f} | {100 * float(r.volume_change):+.3f} | "
                      f"{em} | {ex} | {lam_s} | {amp_s} |")
-    with open(args.out, "w", encoding="utf-8") as f:
-        f.write("\n".join(lines) + "\n")
+    write_text(args.out, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@ import argparse
 
 import numpy as np
 
-from msslib.io import mesh_from_result, read_result
+from msslib.io import mesh_from_result, read_result, write_text
 from msslib.metrics import mesh_volume
 
 R = "results/golec/compression"
@@ -55,8 +55,7 @@ def main():
             lam_w = float(w.min_eigenvalue_wrinkled.sel(variant=v))
             lines.append(f"| {v} (wrinkled) | same, wrinkled equilibrium (amplitude {amp:.2g} mm) | {Vw * 1e6:.3f} | "
                          f"{100 * (Vw / V0 - 1):+.2f} | {lam_w:.3g} | {PUBLISHED[v]} |")
-    with open(args.out, "w", encoding="utf-8") as f:
-        f.write("\n".join(lines) + "\n")
+    write_text(args.out, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 
 import argparse
 
-from msslib.io import read_result
+from msslib.io import read_result, write_text
 
 INPUTS = ["results/golec/studies/isotropy.nc"]
 LABELS = {"derived": "derived (per element)", "published": "printed, used per element",
@@ -33,8 +33,7 @@ def main():
             lines.append(f"| E = {E_t / 1e3:g} kPa, nu = {nu_t:g} | {LABELS[str(c)]} | {cell(r, 'E_ratio', '.3f')} | "
                          f"{cell(r, 'nu_eff', '.4f')} | {cell(r, 'G_ratio', '.3f')} | {cell(r, 'G45_ratio', '.3f')} | "
                          f"{cell(r, 'anisotropy', '.3f')} |")
-    with open(args.out, "w", encoding="utf-8") as f:
-        f.write("\n".join(lines) + "\n")
+    write_text(args.out, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 
 import argparse
 
-from msslib.io import read_result
+from msslib.io import read_result, write_text
 
 INPUTS = ["results/golec/studies/timing.nc"]
 
@@ -23,8 +23,7 @@ def main():
              f"| ours, same, extrapolated | E = 20 kPa, nu = 0.4999 | velocity Verlet, dt = {v['incompressible_dt'] * 1e3:.3g} ms | "
              f"{v['incompressible_simulated_time']:g} | {v['incompressible_wall_time']:.3g} | "
              f"{v['incompressible_wall_time_10s_extrapolated']:.3g} (extrapolated) | 1 |"]
-    with open(args.out, "w", encoding="utf-8") as f:
-        f.write("\n".join(lines) + "\n")
+    write_text(args.out, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

@@ -15,7 +15,6 @@ about two between them).
 from __future__ import annotations
 
 import argparse
-import os
 import warnings
 from pathlib import Path
 
@@ -24,6 +23,7 @@ import xarray as xr
 
 from msslib import fem
 from msslib import mesh as M
+from msslib.io import write_result
 from msslib.model import Model, lloyd_square_springs, lloyd_triangle_springs
 from msslib.solvers import static_solve
 from msslib.terms import NodalForces
@@ -109,9 +109,7 @@ def main(argv=None):
     )
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
-    ds.to_netcdf(tmp)
-    os.replace(tmp, out)
+    write_result(out, ds)
     for j, s in enumerate(shapes):
         print(f"{s}: slope compression {sc[j]:.4g} m/N, stretch {ss[j]:.4g} m/N, ratio {sc[j] / ss[j]:.3f}")
 

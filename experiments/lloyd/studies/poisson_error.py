@@ -14,13 +14,13 @@ nu = 1/3, where eq. 8 is exact.
 from __future__ import annotations
 
 import argparse
-import os
 import warnings
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from msslib.io import write_result
 from msslib.metrics import displacement_error
 from msslib.scene import run_scene
 
@@ -83,9 +83,7 @@ def main(argv=None):
     )
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.{os.getpid()}.tmp")
-    ds.to_netcdf(tmp)
-    os.replace(tmp, out)
+    write_result(out, ds)
     for i, c in enumerate(cases):
         print(c, "nu of smallest mean error:", best[i])
         for j, nu in enumerate(nus):

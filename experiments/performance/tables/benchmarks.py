@@ -2,8 +2,9 @@
 
 import argparse
 import json
-import os
 from pathlib import Path
+
+from msslib.io import write_text
 
 INPUTS = ["results/benchmarks.json"]
 
@@ -25,10 +26,7 @@ def main():
         met = {None: "-", True: "yes", False: "**no**"}[f.get("met")]
         lines.append(f"| {name} | {f['value']:.4g} | {f['unit']} | {r} | {f['baseline'] or '-'} | "
                      f"{f.get('target') or '-'} | {met} | {f['note']} |")
-    out = Path(a.out)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text("\n".join(lines) + "\n")
-    os.replace(tmp, out)
+    write_text(a.out, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

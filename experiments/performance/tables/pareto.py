@@ -1,12 +1,10 @@
 """The measured speed/error points and the Pareto front of each scene, as a Markdown table."""
 
 import argparse
-import os
-from pathlib import Path
 
 import numpy as np
 
-from msslib.io import read_result
+from msslib.io import read_result, write_text
 from msslib.planning import pareto
 
 SCENES = ["cantilever", "cylinder", "membrane"]
@@ -33,10 +31,7 @@ def main():
                 lines.append(f"| {m} | {lv} | {int(r.n_dofs)} | {fmt(t)} | {fmt(e, 100)} | {fmt(em, 100)} | "
                              f"{'yes' if (str(m), int(lv)) in front else ''} | {str(r.status.values)[:80]} |")
         lines.append("")
-    out = Path(a.out)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text("\n".join(lines))
-    os.replace(tmp, out)
+    write_text(a.out, "\n".join(lines))
 
 
 if __name__ == "__main__":

@@ -1,12 +1,10 @@
 """Stability table: every hard case x model, with the error, volume ratio, inverted elements and how it broke."""
 
 import argparse
-import os
-from pathlib import Path
 
 import numpy as np
 
-from msslib.io import read_result
+from msslib.io import read_result, write_text
 
 INPUTS = ["results/stability.nc"]
 
@@ -50,10 +48,7 @@ def main():
     for s in d.shape.values:
         k = d.k_lsq.sel(shape=s).values
         lines.append(f"| {s} | {float(d.k_lloyd.sel(shape=s)):.4g} | {', '.join(f'{v:.3g}' for v in k)} | {int((k < 0).sum())} |")
-    out = Path(a.out)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text("\n".join(lines) + "\n")
-    os.replace(tmp, out)
+    write_text(a.out, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

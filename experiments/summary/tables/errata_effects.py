@@ -1,10 +1,8 @@
 """How each erratum changes results: the printed formula against the derived one, in simulation."""
 
 import argparse
-import os
-from pathlib import Path
 
-from msslib.io import read_result
+from msslib.io import read_result, write_text
 
 INPUTS = ["results/golec/studies/isotropy.nc", "results/baudet/studies/tension.nc",
           "results/baudet/studies/bulk.nc", "results/lloyd/studies/poisson_error.nc",
@@ -54,10 +52,7 @@ def main():
                  "-(kappa/V0)(V - V0) dV/dP: see the volumes of the compression experiment", "results/golec/compression"))
     lines = ["| erratum | with the printed formula | with the derived formula | source |", "|---|---|---|---|"]
     lines += [f"| {a_} | {b_} | {c_} | `{d_}` |" for a_, b_, c_, d_ in rows]
-    out = Path(a.out)
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text("\n".join(lines) + "\n")
-    os.replace(tmp, out)
+    write_text(a.out, "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":
