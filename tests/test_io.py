@@ -14,6 +14,7 @@ from msslib.io import (
     mesh_from_result,
     read_result,
     write_result,
+    write_text,
 )
 from msslib.mesh import Mesh
 
@@ -241,3 +242,22 @@ def test_git_commit_unknown_outside_a_repository(tmp_path, monkeypatch):
     assert git_commit(tmp_path) == "unknown"
     monkeypatch.setenv("PATH", str(tmp_path))  # no git executable
     assert git_commit() == "unknown"
+
+
+def test_write_text_replaces_atomically_and_leaves_nothing_on_error(tmp_path):
+    out = tmp_path / "table.md"
+    out.write_text("old\n")
+    assert write_text(out, "| a |\n") == out
+    assert out.read_text() == "| a |\n"
+    assert sorted(q.name for q in tmp_path.iterdir()) == ["table.md"]
+
+    class Boom:  # not a str: the write fails after the temporary file is opened
+        pass
+
+    with pytest.raises(TypeError):
+        write_text(out, Boom())
+    assert out.read_text() == "| a |\n"  # untouched
+    assert sorted(q.name for q in tmp_path.iterdir()) == ["table.md"]
+    with pytest.raises(FileNotFoundError):
+        write_text(tmp_path / "missing" / "t.md", "x")
+    assert sorted(q.name for q in tmp_path.iterdir()) == ["table.md"]
