@@ -310,9 +310,132 @@ def _gather_free(indptr, indices, data, free, out):
                 n += 1
 
 
+_U = np.uint64  # unsigned indices: numba then skips its wraparound test of negative ones
+
+
+@njit(cache=True, nogil=True)
+def _is_node_blocked(indptr, indices, dim):
+    """Whether a CSR pattern (sorted indices) is made of whole ``dim x dim`` node blocks: the
+    ``dim`` rows of every node have the same columns, which come in whole nodes."""
+    n_nodes = (indptr.shape[0] - 1) // dim
+    if n_nodes * dim != indptr.shape[0] - 1:
+        return False
+    for a in range(n_nodes):
+        r0 = indptr[_U(dim * a)]
+        L = indptr[_U(dim * a + 1)] - r0
+        if L % dim != 0:
+            return False
+        for i in range(1, dim):
+            if indptr[_U(dim * a + i + 1)] - indptr[_U(dim * a + i)] != L or indptr[_U(dim * a + i)] != r0 + i * L:
+                return False
+        for t in range(0, L, dim):
+            c0 = indices[_U(r0 + t)]
+            if c0 % dim != 0:
+                return False
+            for i in range(dim):
+                for j in range(dim):
+                    if indices[_U(r0 + i * L + t + j)] != c0 + j:
+                        return False
+    return True
+
+
+@njit(cache=True, nogil=True)
+def _bsr_plan(indptr, indices, node_free, new_node, dim, bptr, bind):
+    """Block row pointers and block column indices of the free-free node blocks (``bind`` is
+    filled when it is long enough); returns the number of blocks."""
+    nb = 0
+    r = 0
+    bptr[0] = 0
+    for a in range(node_free.shape[0]):
+        if not node_free[a]:
+            continue
+        r0 = indptr[_U(dim * a)]
+        L = indptr[_U(dim * a + 1)] - r0
+        for t in range(0, L, dim):
+            b = indices[_U(r0 + t)] // dim
+            if node_free[_U(b)]:
+                if nb < bind.shape[0]:
+                    bind[_U(nb)] = new_node[_U(b)]
+                nb += 1
+        r += 1
+        bptr[r] = nb
+    return nb
+
+
+@njit(cache=True, nogil=True)
+def _gather_free_bsr(indptr, indices, data, node_free, dim, out):
+    """Values of the free-free node blocks, block-major (BSR), from a node-blocked CSR."""
+    k = 0
+    for a in range(node_free.shape[0]):
+        if not node_free[a]:
+            continue
+        r0 = indptr[_U(dim * a)]
+        L = indptr[_U(dim * a + 1)] - r0
+        for t in range(0, L, dim):
+            if node_free[_U(indices[_U(r0 + t)] // dim)]:
+                for i in range(dim):
+                    q = r0 + i * L + t
+                    for j in range(dim):
+                        out[_U(k), _U(i), _U(j)] = data[_U(q + j)]
+                k += 1
+
+
+def _submatrix_bsr(K, node_free, dim, out=None):
+    """Free-free block of a node-blocked CSR ``K`` (sorted indices, canonical) as a BSR matrix
+    of ``dim x dim`` blocks, or None when ``K`` is not node-blocked.
+
+    The block index arrays are computed once per pattern and node mask.  AMG works on the node
+    blocks anyway: gathering them straight from ``K`` skips the free-free CSR (values and
+    indices) and its conversion to BSR (three arrays of the size of ``K`` fewer to allocate and
+    fill per solve).  ``out``: an earlier result for the same pattern and mask, whose values are
+    overwritten (and which is returned)."""
+    if not (sp.issparse(K) and K.format == "csr" and K.has_canonical_format) or K.shape[0] != K.shape[1]:
+        return None
+    node_free = np.asarray(node_free, dtype=bool)
+    if K.shape[0] != dim * node_free.size:
+        return None
+    key = ("bsr", dim)
+    entry = None
+    for i, e in enumerate(_PLAN_CACHE):
+        if e.get("kind") == key and _pattern_key_matches(e, K, node_free):
+            entry = e
+            break
+    if entry is None:
+        if not _is_node_blocked(K.indptr, K.indices, dim):
+            entry = {"kind": key, "shape": K.shape, "free_n": node_free.size, "free": node_free.copy(),
+                     "indptr": K.indptr, "indices": K.indices, "blocked": False}
+        else:
+            idx_t = np.int32 if K.nnz < 2**31 else np.int64
+            new_node = (np.cumsum(node_free) - 1).astype(idx_t)
+            n_free = int(node_free.sum())
+            bptr = np.empty(n_free + 1, dtype=idx_t)
+            nb = _bsr_plan(K.indptr, K.indices, node_free, new_node, dim, bptr, np.empty(0, dtype=idx_t))
+            bind = np.empty(nb, dtype=idx_t)
+            _bsr_plan(K.indptr, K.indices, node_free, new_node, dim, bptr, bind)
+            bptr.flags.writeable = False
+            bind.flags.writeable = False
+            entry = {"kind": key, "shape": K.shape, "free_n": node_free.size, "free": node_free.copy(),
+                     "indptr": K.indptr, "indices": K.indices, "blocked": True, "bptr": bptr,
+                     "bind": bind, "nblocks": nb, "sub_shape": (dim * n_free, dim * n_free)}
+        _PLAN_CACHE.insert(0, entry)
+        del _PLAN_CACHE[_PLAN_CACHE_SIZE:]
+    if not entry["blocked"]:
+        return None
+    if (out is not None and sp.issparse(out) and out.format == "bsr"
+            and _same_readonly(out.indices, entry["bind"]) and out.data.shape == (entry["nblocks"], dim, dim)
+            and out.data.dtype == K.data.dtype and out.data.flags.writeable):
+        _gather_free_bsr(K.indptr, K.indices, K.data, node_free, dim, out.data)
+        return out
+    vals = np.empty((entry["nblocks"], dim, dim), dtype=K.data.dtype)
+    _gather_free_bsr(K.indptr, K.indices, K.data, node_free, dim, vals)
+    A = sp.bsr_matrix((vals, entry["bind"], entry["bptr"]), shape=entry["sub_shape"], copy=False)
+    A.has_sorted_indices = True
+    return A
+
+
 def _submatrix_plan(K, free):
     for i, entry in enumerate(_PLAN_CACHE):
-        if _pattern_key_matches(entry, K, free):
+        if entry.get("kind") is None and _pattern_key_matches(entry, K, free):
             if i:
                 _PLAN_CACHE.insert(0, _PLAN_CACHE.pop(i))
             return entry
@@ -491,11 +614,12 @@ def _amg_preconditioner(A, context):
     with the constant vector.  Raises ImportError without pyamg."""
     import pyamg  # optional
 
-    A = sp.csr_matrix(A)
     dim = context.get("dim") if context else None
     coords = context.get("coords") if context else None
+    if not (sp.issparse(A) and A.format == "bsr" and dim and A.blocksize == (dim, dim)):
+        A = sp.csr_matrix(A)
     if dim and coords is not None and A.shape[0] == dim * len(coords) and len(coords) > 0:
-        A = A.tobsr(blocksize=(dim, dim))
+        A = A.tobsr(blocksize=(dim, dim))  # no copy when it already is
         # prolongation smoothing weighted by the inverse diagonal blocks (no eigenvalue estimate:
         # the set-up is ~2x faster and CG needs the same iterations on the lattices);
         # one forward block Gauss-Seidel sweep before and one backward sweep after the coarse
@@ -848,6 +972,18 @@ def _forcing_term(rnorm, rnorm_prev, eta_prev, threshold):
     return float(min(_ETA_MAX, max(eta, 0.1 * threshold / rnorm, 1e-10)))
 
 
+def _wants_blocks(K_full, free, method, symmetric, context):
+    """Whether the Newton systems go to AMG-CG as BSR node blocks: symmetric, whole free nodes,
+    and CG chosen (``"cg"``, or ``"auto"`` above the size where the banded Cholesky is tried,
+    or between ``ITERATIVE_THRESHOLD`` and it when the band is too wide)."""
+    if not (symmetric and method in ("auto", "cg") and context.get("dim") and "node_free" in context):
+        return False
+    n = int(free.sum())
+    if method == "cg" or n > BAND_PLAN_MAX_DOFS:
+        return True
+    return n > ITERATIVE_THRESHOLD and not _band_is_cheap(_submatrix(K_full, free), context)
+
+
 def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_solver,
             symmetric, use_energy, messages, progress, step_index, solver_context=None):
     """Newton iteration at a fixed load. Returns (x, iterations, residual history).
@@ -874,6 +1010,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
     # (the block is a copy); saves allocating (and page-faulting) a new value array per iteration
     refill = not free.all() and _accepts_out(problem)
     K_full = K = None
+    blocks = context.get("blocks")  # None: not decided yet; True: BSR node blocks; False: CSR
     while rnorm > threshold:
         if it >= max_iter:
             raise fail(f"no convergence in {max_iter} iterations")
@@ -882,7 +1019,12 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
             K_full = problem.stiffness(x, load, out=K_full) if refill else problem.stiffness(x, load)
             # the previous block is no longer needed (a kept AMG hierarchy is a preconditioner
             # only): its value array is reused, which saves page-faulting a new one each iteration
-            K = _submatrix(K_full, free, out=K)
+            if blocks is None:
+                blocks = context["blocks"] = _wants_blocks(K_full, free, linear_solver, symmetric, context)
+            Kb = _submatrix_bsr(K_full, context["node_free"], context["dim"], out=K) if blocks else None
+            if blocks and Kb is None:  # not made of node blocks: CSR from now on
+                blocks = context["blocks"] = False
+            K = Kb if blocks else _submatrix(K_full, free, out=K)
         try:
             rtol = _forcing_term(rnorm, rnorm_prev, eta_prev, threshold)
             eta_prev, rnorm_prev = rtol, rnorm

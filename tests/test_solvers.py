@@ -527,3 +527,57 @@ def test_static_solve_cg_and_direct_agree_on_a_nonlinear_lattice():
     np.testing.assert_allclose(iterative.x, direct.x, rtol=0, atol=1e-7 * np.abs(u).max())
     # the inexact Newton (loose CG early on) does not cost many more Newton iterations
     assert iterative.total_iterations <= direct.total_iterations + 3
+
+
+def test_free_node_blocks_as_bsr_equal_the_csr_block_and_refill_in_place():
+    from msslib import mesh as M
+    from msslib.model import Model, golec_cube_springs
+    from msslib.solvers import _is_node_blocked, _solver_context, _submatrix_bsr
+
+    mesh = M.hex_grid(0.03, 0.02, 0.02, 3, 2, 2)
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    fixed[mesh.points[:, 0] < 1e-12] = True
+    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
+    free = model.free
+    idx = np.flatnonzero(free)
+    ctx = _solver_context(model, model.x0, free)
+    rng = np.random.default_rng(6)
+    K = model.stiffness(model.x0)
+    B = _submatrix_bsr(K, ctx["node_free"], 3)
+    assert B.format == "bsr" and B.blocksize == (3, 3)
+    B.check_format(full_check=True)
+    for _ in range(2):
+        K = model.stiffness(model.x0 + 1e-3 * rng.standard_normal(model.n_dof), out=K)
+        B2 = _submatrix_bsr(K, ctx["node_free"], 3, out=B)
+        assert B2 is B  # values overwritten in place
+        np.testing.assert_array_equal(B2.toarray(), K.toarray()[np.ix_(idx, idx)])
+    # patterns that are not whole node blocks are refused (the caller then extracts a CSR block)
+    assert not _is_node_blocked(sp.csr_matrix(np.eye(6)).indptr, sp.csr_matrix(np.eye(6)).indices, 3)
+    assert _submatrix_bsr(sp.csr_matrix(np.eye(6)), np.ones(2, dtype=bool), 3) is None
+    full = sp.csr_matrix(np.ones((6, 6)))
+    assert _is_node_blocked(full.indptr, full.indices, 3)
+    holed = sp.csr_matrix(np.ones((6, 6)) - np.eye(6)[::-1])  # one entry missing per row
+    assert _submatrix_bsr(holed, np.ones(2, dtype=bool), 3) is None
+    assert _submatrix_bsr(full, np.ones(3, dtype=bool), 3) is None  # mask of the wrong size
+
+
+def test_cg_newton_systems_go_through_node_blocks(monkeypatch):
+    import msslib.solvers as S
+
+    prob = lattice_block(4, 4, 7)
+    x0 = prob.x0()
+    calls = []
+    real = S._submatrix_bsr
+
+    def spy(*a, **kw):
+        out = real(*a, **kw)
+        calls.append(None if out is None else out.format)
+        return out
+
+    monkeypatch.setattr(S, "_submatrix_bsr", spy)
+    iterative = static_solve(prob, x0, linear_solver="cg", tol=1e-10)
+    assert calls and set(calls) == {"bsr"}
+    direct = static_solve(prob, x0, linear_solver="direct", tol=1e-10)
+    assert len(calls) == iterative.total_iterations  # the direct solver keeps the CSR block
+    u = direct.x - x0
+    np.testing.assert_allclose(iterative.x, direct.x, rtol=0, atol=1e-7 * np.abs(u).max())
