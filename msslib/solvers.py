@@ -391,6 +391,26 @@ def _submatrix_bsr(K, node_free, dim, out=None):
     overwritten (and which is returned)."""
     if not (sp.issparse(K) and K.format == "csr" and K.has_canonical_format) or K.shape[0] != K.shape[1]:
         return None
+    entry = _bsr_entry(K, node_free, dim)
+    if entry is None:
+        return None
+    node_free = entry["free"]
+    if (out is not None and sp.issparse(out) and out.format == "bsr"
+            and _same_readonly(out.indices, entry["bind"]) and out.data.shape == (entry["nblocks"], dim, dim)
+            and out.data.dtype == K.data.dtype and out.data.flags.writeable):
+        _gather_free_bsr(K.indptr, K.indices, K.data, node_free, dim, out.data)
+        return out
+    vals = np.empty((entry["nblocks"], dim, dim), dtype=K.data.dtype)
+    _gather_free_bsr(K.indptr, K.indices, K.data, node_free, dim, vals)
+    A = sp.bsr_matrix((vals, entry["bind"], entry["bptr"]), shape=entry["sub_shape"], copy=False)
+    A.has_sorted_indices = True
+    return A
+
+
+def _bsr_entry(K, node_free, dim):
+    """The cached free-node block plan of ``K`` (see :func:`_submatrix_bsr`), or None."""
+    if not (sp.issparse(K) and K.format == "csr" and K.has_canonical_format) or K.shape[0] != K.shape[1]:
+        return None
     node_free = np.asarray(node_free, dtype=bool)
     if K.shape[0] != dim * node_free.size:
         return None
@@ -419,18 +439,47 @@ def _submatrix_bsr(K, node_free, dim, out=None):
                      "bind": bind, "nblocks": nb, "sub_shape": (dim * n_free, dim * n_free)}
         _PLAN_CACHE.insert(0, entry)
         del _PLAN_CACHE[_PLAN_CACHE_SIZE:]
-    if not entry["blocked"]:
-        return None
-    if (out is not None and sp.issparse(out) and out.format == "bsr"
-            and _same_readonly(out.indices, entry["bind"]) and out.data.shape == (entry["nblocks"], dim, dim)
-            and out.data.dtype == K.data.dtype and out.data.flags.writeable):
-        _gather_free_bsr(K.indptr, K.indices, K.data, node_free, dim, out.data)
-        return out
-    vals = np.empty((entry["nblocks"], dim, dim), dtype=K.data.dtype)
-    _gather_free_bsr(K.indptr, K.indices, K.data, node_free, dim, vals)
-    A = sp.bsr_matrix((vals, entry["bind"], entry["bptr"]), shape=entry["sub_shape"], copy=False)
-    A.has_sorted_indices = True
-    return A
+    return entry if entry["blocked"] else None
+
+
+@njit(cache=True, nogil=True)
+def _eccentricity(ptr, ind):
+    """Largest breadth-first distance from node 0 of the graph ``(ptr, ind)``; -1 when some
+    node is not reached."""
+    n = ptr.shape[0] - 1
+    if n == 0:
+        return 0
+    depth = np.full(n, -1, dtype=np.int64)
+    queue = np.empty(n, dtype=np.int64)
+    depth[0] = 0
+    queue[0] = 0
+    head, tail = 0, 1
+    while head < tail:
+        a = queue[head]
+        head += 1
+        for p in range(ptr[a], ptr[a + 1]):
+            b = ind[p]
+            if depth[b] < 0:
+                depth[b] = depth[a] + 1
+                queue[tail] = b
+                tail += 1
+    if tail < n:
+        return -1
+    return depth[queue[tail - 1]]
+
+
+def _band_surely_wide(entry, dim) -> bool:
+    """True when no ordering can make the banded Cholesky cheap, from a bound that costs one
+    breadth-first search: a graph of ``n`` vertices and diameter ``D`` has bandwidth at least
+    ``(n - 1) / D``, and ``D <= 2 e`` for the eccentricity ``e`` of any vertex (the dofs of a
+    node are neighbours, so the dof graph has the diameter of the node graph).  Spares compact
+    bodies the bandwidth-reducing orderings, which cost more than the whole solve there."""
+    e = int(_eccentricity(entry["bptr"], entry["bind"]))
+    if e <= 0:
+        return False
+    n = dim * (len(entry["bptr"]) - 1)
+    b = (n - 1) / (2.0 * e)
+    return n * (b + 1.0) ** 2 > BAND_AUTO_COST
 
 
 def _submatrix_plan(K, free):
@@ -607,11 +656,163 @@ def _rigid_body_modes(coords, dim):
     return B
 
 
+_SA_SMOOTHERS = (("block_gauss_seidel", {"sweep": "forward", "iterations": 1}),
+                 ("block_gauss_seidel", {"sweep": "backward", "iterations": 1}))
+_SA_OPTIONS = dict(strength=("symmetric", {"theta": 0.0}),
+                   smooth=("jacobi", {"omega": 4.0 / 3.0, "weighting": "block"}), improve_candidates=None,
+                   max_coarse=500, coarse_solver="splu", presmoother=_SA_SMOOTHERS[0],
+                   postsmoother=_SA_SMOOTHERS[1])
+
+
+@njit(cache=True, nogil=True)
+def _block_diag_inverse(indptr, indices, data):
+    """Inverses of the diagonal blocks of a square BSR matrix, ``(n_block_rows, d, d)``."""
+    n = indptr.shape[0] - 1
+    d = data.shape[1]
+    out = np.zeros((n, d, d))
+    for i in range(n):
+        for p in range(indptr[i], indptr[i + 1]):
+            if indices[p] == i:
+                out[i] = np.linalg.inv(data[p])
+                break
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _block_rows_times(dinv, v):
+    """``D^-1 v`` for block-diagonal ``dinv`` ``(n, d, d)``."""
+    n, d, _ = dinv.shape
+    out = np.empty(n * d)
+    for i in range(n):
+        for r in range(d):
+            s = 0.0
+            for q in range(d):
+                s += dinv[i, r, q] * v[i * d + q]
+            out[i * d + r] = s
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _smooth_tentative(ap_ptr, ap_ind, ap_data, dinv, t_ptr, t_ind, t_data, scale):
+    """``AT <- T + scale D^-1 AT`` in place, block row by block row: ``AT = A T`` (BSR blocks
+    ``(d, m)``), ``dinv`` the inverse diagonal blocks of ``A``, ``T`` the tentative prolongator
+    (at most one block per block row, whose column ``AT`` has since ``A`` has its diagonal).
+    Returns False if a block of ``T`` has no place in ``AT``."""
+    d = ap_data.shape[1]
+    m = ap_data.shape[2]
+    tmp = np.empty((d, m))
+    for i in range(ap_ptr.shape[0] - 1):
+        for p in range(ap_ptr[i], ap_ptr[i + 1]):
+            for r in range(d):
+                for c in range(m):
+                    s = 0.0
+                    for q in range(d):
+                        s += dinv[i, r, q] * ap_data[p, q, c]
+                    tmp[r, c] = s
+            for r in range(d):
+                for c in range(m):
+                    ap_data[p, r, c] = scale * tmp[r, c]
+        for pt in range(t_ptr[i], t_ptr[i + 1]):
+            found = False
+            for p in range(ap_ptr[i], ap_ptr[i + 1]):
+                if ap_ind[p] == t_ind[pt]:
+                    ap_data[p] += t_data[pt]
+                    found = True
+                    break
+            if not found:
+                return False
+    return True
+
+
+def _block_jacobi_radius(A, dinv, steps: int = 15, seed: int = 0) -> float:
+    """Largest eigenvalue of ``D^-1 A`` (``D`` the block diagonal of the SPD ``A``) by Lanczos
+    in the ``D`` inner product, where ``D^-1 A`` is self-adjoint: the largest Ritz value after
+    ``steps`` matrix-vector products (a slight underestimate, as pyamg's Arnoldi estimate)."""
+    n = A.shape[0]
+    v = np.random.default_rng(seed).standard_normal(n)
+    dblocks = np.linalg.inv(dinv)  # D itself, for the D inner product
+    d = dinv.shape[1]
+
+    def dmul(w):
+        return np.einsum("nij,nj->ni", dblocks, w.reshape(-1, d)).ravel()
+
+    v /= np.sqrt(v @ dmul(v))
+    v_prev = np.zeros(n)
+    beta = 0.0
+    alphas, betas = [], []
+    for _ in range(min(steps, n)):
+        u = A @ v
+        alpha = float(v @ u)
+        w = _block_rows_times(dinv, u) - alpha * v - beta * v_prev
+        beta = float(np.sqrt(max(w @ dmul(w), 0.0)))
+        alphas.append(alpha)
+        if beta <= 1e-12 * abs(alpha):
+            break
+        betas.append(beta)
+        v_prev, v = v, w / beta
+    k = len(alphas)
+    Tk = np.diag(alphas) + np.diag(betas[:k - 1], 1) + np.diag(betas[:k - 1], -1)
+    return float(np.linalg.eigvalsh(Tk)[-1])
+
+
+def _sa_solver(A, B, dim):
+    """pyamg smoothed aggregation on the BSR ``A`` (``dim x dim`` blocks) with near-null space
+    ``B``, as ``pyamg.smoothed_aggregation_solver(A, B, **_SA_OPTIONS)`` builds it, except that
+    the finest level (by far the largest) is built here with less memory and time: the
+    prolongator ``P = T - (omega / rho) D^-1 A T`` is smoothed in place in ``A T`` (pyamg forms
+    ``D^-1 A`` and its scaled copy, two more matrices of the size of ``A``), and ``rho`` comes
+    from Lanczos in the ``D`` inner product (15 products with ``A``, instead of Arnoldi on
+    ``D^-1 A``).  Coarser levels are pyamg's.  Returns None when ``A`` does not fit (pyamg is then
+    used as is)."""
+    from pyamg.aggregation import fit_candidates, standard_aggregation
+    from pyamg.multilevel import MultilevelSolver
+    from pyamg.relaxation.smoothing import change_smoothers
+    from pyamg.strength import symmetric_strength_of_connection
+    import pyamg
+
+    if A.shape[0] // dim <= _SA_OPTIONS["max_coarse"]:
+        return None
+    C = symmetric_strength_of_connection(A, theta=_SA_OPTIONS["strength"][1]["theta"])
+    AggOp, _ = standard_aggregation(C)
+    T, B_c = fit_candidates(AggOp, B)
+    T = T.tobsr(blocksize=(dim, B.shape[1]))
+    dinv = _block_diag_inverse(A.indptr, A.indices, A.data)
+    if not np.all(np.isfinite(dinv)):
+        return None
+    rho = _block_jacobi_radius(A, dinv)
+    if not (np.isfinite(rho) and rho > 0):
+        return None
+    P = A @ T
+    if P.format != "bsr" or P.blocksize != (dim, B.shape[1]):
+        P = P.tobsr(blocksize=(dim, B.shape[1]))
+    omega = _SA_OPTIONS["smooth"][1]["omega"]
+    if not _smooth_tentative(P.indptr, P.indices, P.data, dinv, T.indptr, T.indices, T.data, -omega / rho):
+        return None
+    R = P.T
+    A_c = R @ (A @ P)
+    A_c.symmetry = "symmetric"
+    coarse = pyamg.smoothed_aggregation_solver(A_c.tobsr(blocksize=(B.shape[1], B.shape[1])), B=B_c, **_SA_OPTIONS)
+    top = MultilevelSolver.Level()
+    top.A, top.B, top.P, top.R = A, B, P, R
+    ml = MultilevelSolver([top] + coarse.levels, coarse_solver=_SA_OPTIONS["coarse_solver"])
+    pre, post = _SA_SMOOTHERS
+    change_smoothers(ml, [(pre[0], dict(pre[1], Dinv=dinv))] + [pre] * (len(ml.levels) - 2),
+                     [(post[0], dict(post[1], Dinv=dinv))] + [post] * (len(ml.levels) - 2))
+    return ml
+
+
 def _amg_preconditioner(A, context):
     """pyamg smoothed aggregation; with node-aligned free dofs (``context['dim']`` and
     ``context['coords']`` of the free nodes) it works on dim x dim blocks (BSR) with the rigid
     body modes as near-null space, which is what makes it scale on elasticity; otherwise scalar
-    with the constant vector.  Raises ImportError without pyamg."""
+    with the constant vector.  Raises ImportError without pyamg.
+
+    Options (``_SA_OPTIONS``): prolongation smoothing weighted by the inverse diagonal blocks;
+    one forward block Gauss-Seidel sweep before and one backward sweep after the coarse
+    correction, a symmetric V-cycle (CG needs it) at half the cost of symmetric sweeps; the
+    coarsest level by sparse LU (pyamg's default dense pseudo-inverse costs O(n^3) and took
+    minutes on the ~10^4-unknown coarse levels of 10^5-dof lattices).  The finest level of the
+    block case is built by :func:`_sa_solver`."""
     import pyamg  # optional
 
     dim = context.get("dim") if context else None
@@ -620,18 +821,10 @@ def _amg_preconditioner(A, context):
         A = sp.csr_matrix(A)
     if dim and coords is not None and A.shape[0] == dim * len(coords) and len(coords) > 0:
         A = A.tobsr(blocksize=(dim, dim))  # no copy when it already is
-        # prolongation smoothing weighted by the inverse diagonal blocks (no eigenvalue estimate:
-        # the set-up is ~2x faster and CG needs the same iterations on the lattices);
-        # one forward block Gauss-Seidel sweep before and one backward sweep after the coarse
-        # correction: a symmetric V-cycle (CG needs it) at half the cost of symmetric sweeps;
-        # the coarsest level by sparse LU (pyamg's default dense pseudo-inverse costs O(n^3)
-        # and took minutes on the ~10^4-unknown coarse levels of 10^5-dof lattices)
-        ml = pyamg.smoothed_aggregation_solver(
-            A, B=_rigid_body_modes(coords, dim), strength=("symmetric", {"theta": 0.0}),
-            smooth=("jacobi", {"omega": 4.0 / 3.0, "weighting": "block"}), improve_candidates=None, max_coarse=500,
-            coarse_solver="splu",
-            presmoother=("block_gauss_seidel", {"sweep": "forward", "iterations": 1}),
-            postsmoother=("block_gauss_seidel", {"sweep": "backward", "iterations": 1}))
+        B = _rigid_body_modes(coords, dim)
+        ml = _sa_solver(A, B, dim)
+        if ml is None:
+            ml = pyamg.smoothed_aggregation_solver(A, B=B, **_SA_OPTIONS)
     else:
         ml = pyamg.smoothed_aggregation_solver(A, max_coarse=500, coarse_solver="splu")
     return ml.aspreconditioner(cycle="V")
@@ -981,7 +1174,12 @@ def _wants_blocks(K_full, free, method, symmetric, context):
     n = int(free.sum())
     if method == "cg" or n > BAND_PLAN_MAX_DOFS:
         return True
-    return n > ITERATIVE_THRESHOLD and not _band_is_cheap(_submatrix(K_full, free), context)
+    if n <= ITERATIVE_THRESHOLD:
+        return False
+    entry = _bsr_entry(K_full, context["node_free"], context["dim"])
+    if entry is not None and _band_surely_wide(entry, context["dim"]):
+        return True
+    return not _band_is_cheap(_submatrix(K_full, free), context)
 
 
 def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_solver,

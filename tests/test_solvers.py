@@ -581,3 +581,100 @@ def test_cg_newton_systems_go_through_node_blocks(monkeypatch):
     assert len(calls) == iterative.total_iterations  # the direct solver keeps the CSR block
     u = direct.x - x0
     np.testing.assert_allclose(iterative.x, direct.x, rtol=0, atol=1e-7 * np.abs(u).max())
+
+
+@pytest.mark.parametrize("shape", [(16, 4, 4), (12, 12, 12), (30, 2, 2), (8, 8, 3)])
+def test_band_width_bound_never_exceeds_the_bandwidth_found(shape, monkeypatch):
+    """The breadth-first bound that skips the band orderings is a lower bound of the bandwidth
+    of every ordering, so it never rejects a body the banded Cholesky would take."""
+    from msslib import mesh as M
+    from msslib.model import Model, golec_cube_springs
+    from msslib.solvers import (BAND_AUTO_COST, _band_plan, _band_surely_wide, _bsr_entry,
+                                _eccentricity, _solver_context, _submatrix)
+
+    nx, ny, nz = shape
+    mesh = M.hex_grid(0.01 * nx, 0.01 * ny, 0.01 * nz, nx, ny, nz)
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    fixed[mesh.points[:, 0] < 1e-12] = True
+    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
+    K = model.stiffness(model.x0)
+    ctx = _solver_context(model, model.x0, model.free)
+    entry = _bsr_entry(K, ctx["node_free"], 3)
+    e = _eccentricity(entry["bptr"], entry["bind"])
+    # 26-neighbour lattice: Chebyshev distance from the first free node (a corner of layer x = 1)
+    assert e == max(nx - 1, ny, nz)
+    A = _submatrix(K, model.free)
+    import msslib.solvers as S
+
+    monkeypatch.setattr(S, "BAND_COST_MAX", float("inf"))  # a plan whatever the bandwidth
+    plan = _band_plan(sp.csr_matrix(A.toarray()), ctx)
+    n = A.shape[0]
+    assert plan["bw"] >= (n - 1) / (2.0 * e)
+    cheap = n * (plan["bw"] + 1.0) ** 2 <= BAND_AUTO_COST
+    assert not (cheap and _band_surely_wide(entry, 3))
+    if shape == (12, 12, 12):
+        assert _band_surely_wide(entry, 3)
+    if shape in ((16, 4, 4), (30, 2, 2)):
+        assert cheap and not _band_surely_wide(entry, 3)
+
+
+def _lattice_system(n=8):
+    from msslib import mesh as M
+    from msslib.model import Model, golec_cube_springs
+    from msslib.solvers import _rigid_body_modes, _solver_context, _submatrix_bsr
+
+    mesh = M.hex_grid(0.01 * n, 0.01 * n, 0.01 * n, n, n, n)
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    fixed[mesh.points[:, 2] < 1e-12] = True
+    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
+    x = model.x0 + 2e-4 * np.random.default_rng(7).standard_normal(model.n_dof)
+    ctx = _solver_context(model, x, model.free)
+    A = _submatrix_bsr(model.stiffness(x), ctx["node_free"], 3)
+    return A, _rigid_body_modes(ctx["coords"], 3), ctx
+
+
+def test_block_jacobi_radius_is_the_largest_eigenvalue():
+    from scipy.linalg import eigh
+
+    from msslib.solvers import _block_diag_inverse, _block_jacobi_radius
+
+    A, _, _ = _lattice_system(5)
+    dinv = _block_diag_inverse(A.indptr, A.indices, A.data)
+    D = sp.block_diag(list(np.linalg.inv(dinv))).toarray()
+    lam = eigh(A.toarray(), D, eigvals_only=True)[-1]
+    rho = _block_jacobi_radius(A, dinv)
+    assert 0.97 * lam <= rho <= lam * (1 + 1e-10)  # a Ritz value: from below, close
+
+
+def test_finest_level_prolongator_is_the_jacobi_smoothed_tentative_one():
+    from pyamg.aggregation import fit_candidates, standard_aggregation
+    from pyamg.strength import symmetric_strength_of_connection
+
+    from msslib.solvers import _SA_OPTIONS, _block_diag_inverse, _block_jacobi_radius, _sa_solver
+
+    A, B, _ = _lattice_system(8)
+    ml = _sa_solver(A, B, 3)
+    assert ml is not None and len(ml.levels) >= 2
+    T, _ = fit_candidates(standard_aggregation(symmetric_strength_of_connection(A, 0.0))[0], B)
+    dinv = _block_diag_inverse(A.indptr, A.indices, A.data)
+    Dinv = sp.block_diag(list(dinv)).toarray()
+    omega = _SA_OPTIONS["smooth"][1]["omega"]
+    P_ref = T.toarray() - omega / _block_jacobi_radius(A, dinv) * Dinv @ A.toarray() @ T.toarray()
+    np.testing.assert_allclose(ml.levels[0].P.toarray(), P_ref, rtol=0, atol=1e-12 * np.abs(P_ref).max())
+    A_c = ml.levels[1].A.toarray()
+    np.testing.assert_allclose(A_c, P_ref.T @ A.toarray() @ P_ref, rtol=0, atol=1e-10 * np.abs(A_c).max())
+
+
+def test_own_finest_level_preconditions_as_well_as_pyamg():
+    import pyamg
+
+    from msslib.solvers import _SA_OPTIONS, _pcg, _sa_solver
+
+    A, B, _ = _lattice_system(9)
+    b = np.random.default_rng(8).standard_normal(A.shape[0])
+    its = {}
+    for name, ml in (("own", _sa_solver(A, B, 3)), ("pyamg", pyamg.smoothed_aggregation_solver(A, B=B, **_SA_OPTIONS))):
+        x, info, its[name] = _pcg(A, b, ml.aspreconditioner(cycle="V"), 1e-10, 500)
+        assert info == 0
+        assert np.linalg.norm(A @ x - b) <= 1e-10 * np.linalg.norm(b) * 1.0001
+    assert its["own"] <= its["pyamg"] + 1
