@@ -678,3 +678,30 @@ def test_own_finest_level_preconditions_as_well_as_pyamg():
         assert info == 0
         assert np.linalg.norm(A @ x - b) <= 1e-10 * np.linalg.norm(b) * 1.0001
     assert its["own"] <= its["pyamg"] + 1
+
+
+@pytest.mark.parametrize("d", [3, 6])
+def test_compiled_block_gauss_seidel_sweeps_equal_pyamg(d):
+    from pyamg.relaxation.relaxation import block_gauss_seidel
+
+    from msslib.solvers import _block_diag_inverse, _BlockGaussSeidel
+
+    rng = np.random.default_rng(d)
+    nb = 40
+    pattern = sp.random(nb, nb, 0.15, random_state=d, format="csr") + sp.eye(nb)
+    pattern = (pattern + pattern.T).tocsr()
+    M = sp.kron(pattern, np.ones((d, d))).toarray() * rng.standard_normal((nb * d, nb * d))
+    M = M + M.T + 4 * d * np.eye(nb * d)  # symmetric, blocks on a symmetric node pattern
+    A = sp.bsr_matrix(M, blocksize=(d, d))
+    A.sort_indices()
+    dinv = _block_diag_inverse(A.indptr, A.indices, A.data)
+    np.testing.assert_allclose(dinv[3], np.linalg.inv(M[3 * d:4 * d, 3 * d:4 * d]), rtol=1e-12, atol=1e-14)
+    b = rng.standard_normal(nb * d)
+    for forward, sweep in ((True, "forward"), (False, "backward")):
+        x0 = rng.standard_normal(nb * d)
+        x_ref, x = x0.copy(), x0.copy()
+        block_gauss_seidel(A, x_ref, b, iterations=1, sweep=sweep, blocksize=d, Dinv=dinv)
+        _BlockGaussSeidel(dinv, forward)(A, x, b)
+        np.testing.assert_allclose(x, x_ref, rtol=1e-12, atol=1e-12 * np.abs(x_ref).max())
+    with pytest.raises(TypeError):
+        _BlockGaussSeidel(dinv, True)(A, np.zeros((nb * d, 1)), b)
