@@ -36,9 +36,11 @@ from msslib.terms import (
     Springs,
     Term,
     TetVolume,
+    _block_scatter_bsr,
     _block_scatter_csr,
     _ElementTerm,
     _scatter_add,
+    _spring3d_hessian_bsr,
     _spring3d_hessian_csr,
     sum_external_forces,
 )
@@ -214,6 +216,8 @@ class Model:
                 nv = t.conn.shape[1]
                 fills.append(("blocks", pos.reshape(-1, nv, nv), None))
         self._block = (nptr, diag_pos, fills)
+        self._block_cols = ucol.astype(idx_t)  # node column of every node block, row by row
+        self._block_plans = []
         self._scatter = None
     @property
     def nnz(self) -> int:
@@ -298,6 +302,84 @@ class Model:
         K.has_sorted_indices = True
         K.has_canonical_format = True
         return K
+
+    def stiffness_blocks(self, x, load: float = 1.0, out: sp.bsr_matrix | None = None,
+                         node_free=None) -> sp.bsr_matrix | None:
+        """Tangent stiffness restricted to the nodes ``node_free`` (rows and columns), as a BSR
+        matrix of ``dim x dim`` node blocks: the free-free block of :meth:`stiffness`, filled
+        directly (the full matrix is neither formed nor copied), for block solvers (AMG).
+
+        ``node_free``: bool ``(n_nodes,)``; default the nodes whose dofs are all free.  ``out``:
+        a matrix returned by an earlier call with the same mask, refilled in place.  Returns None
+        when the model has no node-block pattern (a term without dense node blocks)."""
+        if self._block is None:
+            return None
+        if node_free is None:
+            f = self.free.reshape(-1, self.dim)
+            if not np.array_equal(f.all(axis=1), f.any(axis=1)):
+                return None
+            node_free = f.all(axis=1)
+        node_free = np.asarray(node_free, dtype=bool)
+        if node_free.shape != (self.n_nodes,):
+            raise ValueError(f"node_free must have shape ({self.n_nodes},), got {node_free.shape}")
+        plan = self._block_plan(node_free)
+        bmap, bind, bptr, shape = plan
+        dim = self.dim
+        x = np.ascontiguousarray(np.asarray(x, dtype=float).ravel())
+        if (out is not None and sp.issparse(out) and out.format == "bsr" and out.shape == shape
+                and out.data.shape == (len(bind), dim, dim) and np.may_share_memory(out.indices, bind)):
+            data = out.data
+        else:
+            out = None
+            data = None
+        nptr, diag_pos, fills = self._block
+        scales = [float(self._scale(t, load)) for t, _, _ in self._hessian_terms]
+        first = next((i for i, (f, s) in enumerate(zip(fills, scales)) if f[0] == "springs" and f[2] and s != 0.0),
+                     None)
+        if data is None:
+            data = np.empty((len(bind), dim, dim)) if first is not None else np.zeros((len(bind), dim, dim))
+        elif first is None:
+            data[:] = 0.0
+        order = ([first] if first is not None else []) + [i for i in range(len(fills)) if i != first]
+        for i in order:
+            (t, _, _), (kind, p, _), s = self._hessian_terms[i], fills[i], scales[i]
+            if s == 0.0:
+                continue
+            if kind == "springs":
+                _, rowptr, nb, k, L0 = t.symmetric_layout()
+                _spring3d_hessian_bsr(x, rowptr, nb, k, L0, p, nptr, diag_pos, bmap, s, i == first, data)
+            else:
+                vals = t.hessian_values(x).reshape(len(t.conn), -1)
+                _block_scatter_bsr(vals, t.conn, p, nptr, bmap, s, data)
+        if out is not None:
+            return out
+        K = sp.bsr_matrix((data, bind, bptr), shape=shape, copy=False)
+        K.has_sorted_indices = True
+        return K
+
+    def _block_plan(self, node_free):
+        """Kept node blocks for a node mask: ``bmap`` (position of every block of the node
+        pattern in the restricted matrix, -1 if dropped) and the BSR index arrays; cached."""
+        for entry in self._block_plans:
+            if np.array_equal(entry[0], node_free):
+                return entry[1]
+        nptr = self._block[0]
+        idx_t = self._block_cols.dtype
+        rows = np.repeat(np.arange(self.n_nodes, dtype=idx_t), np.diff(nptr))
+        keep = node_free[rows] & node_free[self._block_cols]
+        bmap = np.full(len(keep), -1, dtype=np.int64 if len(keep) >= 2**31 else np.int32)
+        bmap[keep] = np.arange(int(keep.sum()), dtype=bmap.dtype)
+        new_node = (np.cumsum(node_free) - 1).astype(idx_t)
+        bind = new_node[self._block_cols[keep]]  # increasing in every row: sorted blocks
+        bptr = np.zeros(int(node_free.sum()) + 1, dtype=idx_t)
+        np.cumsum(np.bincount(new_node[rows[keep]], minlength=len(bptr) - 1), out=bptr[1:])
+        for a in (bind, bptr):
+            a.flags.writeable = False
+        nf = self.dim * (len(bptr) - 1)
+        plan = (bmap, bind, bptr, (nf, nf))
+        self._block_plans.insert(0, (node_free.copy(), plan))
+        del self._block_plans[2:]
+        return plan
 
     @property
     def _indices_ro(self):

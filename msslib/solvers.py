@@ -1239,10 +1239,11 @@ def _forcing_term(rnorm, rnorm_prev, eta_prev, threshold):
     return float(min(_ETA_MAX, max(eta, 0.1 * threshold / rnorm, 1e-10)))
 
 
-def _wants_blocks(K_full, free, method, symmetric, context):
+def _wants_blocks(full_tangent, free, method, symmetric, context):
     """Whether the Newton systems go to AMG-CG as BSR node blocks: symmetric, whole free nodes,
     and CG chosen (``"cg"``, or ``"auto"`` above the size where the banded Cholesky is tried,
-    or between ``ITERATIVE_THRESHOLD`` and it when the band is too wide)."""
+    or between ``ITERATIVE_THRESHOLD`` and it when the band is too wide).  ``full_tangent()``
+    gives the full stiffness when the decision needs its pattern (mid sizes only)."""
     if not (symmetric and method in ("auto", "cg") and context.get("dim") and "node_free" in context):
         return False
     n = int(free.sum())
@@ -1250,6 +1251,7 @@ def _wants_blocks(K_full, free, method, symmetric, context):
         return True
     if n <= ITERATIVE_THRESHOLD:
         return False
+    K_full = full_tangent()
     entry = _bsr_entry(K_full, context["node_free"], context["dim"])
     if entry is not None and _band_surely_wide(entry, context["dim"]):
         return True
@@ -1283,20 +1285,34 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
     refill = not free.all() and _accepts_out(problem)
     K_full = K = None
     blocks = context.get("blocks")  # None: not decided yet; True: BSR node blocks; False: CSR
+    # a problem that fills the free node blocks itself (Model.stiffness_blocks) spares forming
+    # the full tangent and copying its free block out of it
+    direct_blocks = context.get("direct_blocks", callable(getattr(problem, "stiffness_blocks", None)))
     while rnorm > threshold:
         if it >= max_iter:
             raise fail(f"no convergence in {max_iter} iterations")
         it += 1
         with np.errstate(all="ignore"):
-            K_full = problem.stiffness(x, load, out=K_full) if refill else problem.stiffness(x, load)
-            # the previous block is no longer needed (a kept AMG hierarchy is a preconditioner
-            # only): its value array is reused, which saves page-faulting a new one each iteration
             if blocks is None:
-                blocks = context["blocks"] = _wants_blocks(K_full, free, linear_solver, symmetric, context)
-            Kb = _submatrix_bsr(K_full, context["node_free"], context["dim"], out=K) if blocks else None
-            if blocks and Kb is None:  # not made of node blocks: CSR from now on
-                blocks = context["blocks"] = False
-            K = Kb if blocks else _submatrix(K_full, free, out=K)
+                blocks = context["blocks"] = _wants_blocks(lambda: problem.stiffness(x, load), free,
+                                                           linear_solver, symmetric, context)
+            K_new = None
+            if blocks and direct_blocks:
+                K_new = problem.stiffness_blocks(x, load, out=K, node_free=context["node_free"])
+                if K_new is None:
+                    direct_blocks = context["direct_blocks"] = False
+            if K_new is None:
+                K_full = problem.stiffness(x, load, out=K_full) if refill else problem.stiffness(x, load)
+                # the previous block is no longer needed (a kept AMG hierarchy is a preconditioner
+                # only): its value array is reused, which saves page-faulting a new one each
+                # iteration
+                if blocks:
+                    K_new = _submatrix_bsr(K_full, context["node_free"], context["dim"], out=K)
+                    if K_new is None:  # not made of node blocks: CSR from now on
+                        blocks = context["blocks"] = False
+                if not blocks:
+                    K_new = _submatrix(K_full, free, out=K)
+            K = K_new
         try:
             rtol = _forcing_term(rnorm, rnorm_prev, eta_prev, threshold)
             eta_prev, rnorm_prev = rtol, rnorm

@@ -391,6 +391,127 @@ def _spring3d_hessian_csr(x, rowptr, nb, k, L0, pos, nptr, diag, scale, assign, 
             data[_U(qd + 2 * deg + 2)] += h22
 
 
+@_jit_fast
+def _spring3d_hessian_bsr(x, rowptr, nb, k, L0, pos, nptr, diag, bmap, scale, assign, data):
+    """:func:`_spring3d_hessian_csr` into the ``(n_blocks, 3, 3)`` values of a BSR matrix that
+    keeps some of the node blocks: block ``p`` of node row ``a`` of the full node pattern goes
+    to ``data[bmap[nptr[a] + p]]``, or nowhere when that is negative (rows and columns of
+    constrained nodes); a row whose diagonal block is not kept is skipped whole."""
+    c = np.empty((9, 64))
+    for na in range(rowptr.shape[0] - 1):
+        q0 = nptr[na]
+        td = bmap[_U(q0 + diag[na])]
+        if td < 0:
+            continue
+        a = 3 * na
+        s0 = rowptr[na]
+        m = rowptr[na + 1] - s0
+        if m > c.shape[1]:
+            c = np.empty((9, 2 * m))
+        xa0, xa1, xa2 = x[a], x[a + 1], x[a + 2]
+        for j in range(m):
+            b = 3 * nb[_U(s0 + j)]
+            c[6, j] = xa0 - x[_U(b)]
+            c[7, j] = xa1 - x[_U(b + 1)]
+            c[8, j] = xa2 - x[_U(b + 2)]
+        kk = k[s0:s0 + m]
+        ll = L0[s0:s0 + m]
+        for j in range(m):
+            d0 = c[6, j]
+            d1 = c[7, j]
+            d2 = c[8, j]
+            il = 1.0 / np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            ks = kk[j] * scale
+            t = ks * ll[j] * il
+            c10 = t - ks
+            c14 = -t * il * il
+            c[0, j] = d0 * d0 * c14 + c10
+            c[1, j] = d0 * d1 * c14
+            c[2, j] = d0 * d2 * c14
+            c[3, j] = d1 * d1 * c14 + c10
+            c[4, j] = d1 * d2 * c14
+            c[5, j] = d2 * d2 * c14 + c10
+        h00 = 0.0
+        h01 = 0.0
+        h02 = 0.0
+        h11 = 0.0
+        h12 = 0.0
+        h22 = 0.0
+        for j in range(m):
+            h00 -= c[0, j]
+            h01 -= c[1, j]
+            h02 -= c[2, j]
+            h11 -= c[3, j]
+            h12 -= c[4, j]
+            h22 -= c[5, j]
+        for j in range(m):
+            tb = bmap[_U(q0 + pos[_U(s0 + j)])]
+            if tb < 0:
+                continue
+            u = _U(tb)
+            if assign:
+                data[u, 0, 0] = c[0, j]
+                data[u, 0, 1] = c[1, j]
+                data[u, 0, 2] = c[2, j]
+                data[u, 1, 0] = c[1, j]
+                data[u, 1, 1] = c[3, j]
+                data[u, 1, 2] = c[4, j]
+                data[u, 2, 0] = c[2, j]
+                data[u, 2, 1] = c[4, j]
+                data[u, 2, 2] = c[5, j]
+            else:
+                data[u, 0, 0] += c[0, j]
+                data[u, 0, 1] += c[1, j]
+                data[u, 0, 2] += c[2, j]
+                data[u, 1, 0] += c[1, j]
+                data[u, 1, 1] += c[3, j]
+                data[u, 1, 2] += c[4, j]
+                data[u, 2, 0] += c[2, j]
+                data[u, 2, 1] += c[4, j]
+                data[u, 2, 2] += c[5, j]
+        u = _U(td)
+        if assign:
+            data[u, 0, 0] = h00
+            data[u, 0, 1] = h01
+            data[u, 0, 2] = h02
+            data[u, 1, 0] = h01
+            data[u, 1, 1] = h11
+            data[u, 1, 2] = h12
+            data[u, 2, 0] = h02
+            data[u, 2, 1] = h12
+            data[u, 2, 2] = h22
+        else:
+            data[u, 0, 0] += h00
+            data[u, 0, 1] += h01
+            data[u, 0, 2] += h02
+            data[u, 1, 0] += h01
+            data[u, 1, 1] += h11
+            data[u, 1, 2] += h12
+            data[u, 2, 0] += h02
+            data[u, 2, 1] += h12
+            data[u, 2, 2] += h22
+
+
+@_jit
+def _block_scatter_bsr(vals, conn, pos, nptr, bmap, scale, data):
+    """:func:`_block_scatter_csr` into the ``(n_blocks, dim, dim)`` values of a BSR matrix that
+    keeps some of the node blocks (``bmap``: see :func:`_spring3d_hessian_bsr`)."""
+    m, nv = conn.shape
+    dim = data.shape[1]
+    n_loc = nv * dim
+    for e in range(m):
+        for p in range(nv):
+            q0 = nptr[conn[e, p]]
+            for q in range(nv):
+                tb = bmap[_U(q0 + pos[e, p, q])]
+                if tb < 0:
+                    continue
+                for i in range(dim):
+                    off = (p * dim + i) * n_loc + q * dim
+                    for j in range(dim):
+                        data[_U(tb), i, j] += scale * vals[e, off + j]
+
+
 @_jit
 def _block_scatter_csr(vals, conn, pos, nptr, dim, scale, data):
     """Add ``scale`` times dense element blocks ``vals`` (m, (nv dim)^2, row-major) to CSR ``data``

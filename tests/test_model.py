@@ -221,11 +221,12 @@ def _coo_reference(model, x, load=1.0):
     return K
 
 
-@pytest.mark.parametrize("case", ["exact", "duplicate_pairs", "partial_rows", "extra_term_pairs"])
-def test_block_csr_fill_paths_equal_coo_assembly(case):
-    """The springs-only overwrite path (every block written once) and the zero-and-add path
-    (repeated pairs, nodes without springs, blocks of another term) give the COO matrix, also
-    when refilling an earlier matrix in place with ``out=``."""
+FILL_CASES = ["exact", "duplicate_pairs", "partial_rows", "extra_term_pairs"]
+
+
+def _fill_case_model(case, **kw):
+    """Models exercising the block fill paths: every block written once by the springs
+    ("exact"), repeated pairs, a node without springs, blocks added by another term."""
     mesh = M.hex_grid(0.03, 0.02, 0.02, 3, 2, 2)
     terms = golec_cube_springs(mesh, [(1e4, 0.3)], 1.0)
     springs = terms[0]
@@ -245,7 +246,15 @@ def test_block_csr_fill_paths_equal_coo_assembly(case):
         terms = [springs, terms[1]]
     else:
         terms = [springs]
-    model = Model(mesh, terms)
+    return mesh, Model(mesh, terms, **kw)
+
+
+@pytest.mark.parametrize("case", FILL_CASES)
+def test_block_csr_fill_paths_equal_coo_assembly(case):
+    """The springs-only overwrite path (every block written once) and the zero-and-add path
+    (repeated pairs, nodes without springs, blocks of another term) give the COO matrix, also
+    when refilling an earlier matrix in place with ``out=``."""
+    mesh, model = _fill_case_model(case)
     if case == "partial_rows":  # a node outside every element: the generic dof-level path
         assert model._block is None
     else:
@@ -262,6 +271,44 @@ def test_block_csr_fill_paths_equal_coo_assembly(case):
         K_prev = K
     with pytest.raises(ValueError, match="out must be a matrix returned"):
         model.stiffness(x, out=sp.csr_matrix(K.toarray()))
+
+
+@pytest.mark.parametrize("case", FILL_CASES)
+def test_free_node_blocks_filled_directly_equal_the_coo_free_block(case):
+    """``Model.stiffness_blocks``: the free-free node blocks (BSR), written straight from the
+    terms, equal the free block of the COO matrix on every fill path, also refilled in place;
+    None where there is no node-block pattern."""
+    mesh = M.hex_grid(0.03, 0.02, 0.02, 3, 2, 2)
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    fixed[mesh.points[:, 0] < 1e-12] = True  # a clamped face: rows and columns dropped
+    mesh, model = _fill_case_model(case, fixed=fixed)
+    if case == "partial_rows":
+        assert model.stiffness_blocks(model.x0) is None
+        return
+    idx = np.flatnonzero(model.free)
+    B_prev = None
+    for seed in (1, 2):
+        x = perturbed(mesh, 0.002, seed)
+        ref = _coo_reference(model, x).toarray()[np.ix_(idx, idx)]
+        B = model.stiffness_blocks(x, out=B_prev)
+        assert B.format == "bsr" and B.blocksize == (3, 3)
+        B.check_format(full_check=True)
+        if B_prev is not None:
+            assert B is B_prev  # refilled in place
+        assert np.abs(B.toarray() - ref).max() <= 1e-12 * np.abs(ref).max()
+        B_prev = B
+    # another node mask: its own pattern
+    node_free = ~fixed.any(axis=1)
+    node_free[-1] = False
+    keep = np.repeat(node_free, 3)
+    B = model.stiffness_blocks(x, node_free=node_free)
+    np.testing.assert_allclose(B.toarray(), model.stiffness(x).toarray()[np.ix_(keep, keep)], rtol=0,
+                               atol=1e-12 * np.abs(B.data).max())
+    with pytest.raises(ValueError, match="node_free must have shape"):
+        model.stiffness_blocks(x, node_free=node_free[:-1])
+    # a fixed mask that splits a node's dofs has no node blocks
+    part = Model(mesh, model.terms, fixed=np.r_[True, np.zeros(model.n_dof - 1, dtype=bool)])
+    assert part.stiffness_blocks(x) is None
 
 
 # --------------------------------------------------------------------------------------------

@@ -705,3 +705,36 @@ def test_compiled_block_gauss_seidel_sweeps_equal_pyamg(d):
         np.testing.assert_allclose(x, x_ref, rtol=1e-12, atol=1e-12 * np.abs(x_ref).max())
     with pytest.raises(TypeError):
         _BlockGaussSeidel(dinv, True)(A, np.zeros((nb * d, 1)), b)
+
+
+def test_model_newton_systems_filled_as_free_node_blocks(monkeypatch):
+    """With CG, a Model's Newton systems come from ``stiffness_blocks`` (no full tangent is
+    formed); the solution equals the direct solve's."""
+    from msslib import mesh as M
+    from msslib import terms as T
+    from msslib.model import Model, golec_cube_springs
+
+    mesh = M.hex_grid(0.05, 0.02, 0.02, 5, 2, 2)
+    masses = M.lumped_masses(mesh, 1000.0)
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    fixed[mesh.points[:, 0] < 1e-12] = True
+    model = Model(mesh, golec_cube_springs(mesh, [(1e3, 0.3)], 1.0) + [T.Gravity(masses, [0, 0, -9.81])],
+                  fixed=fixed)
+    calls = {"blocks": 0, "full": 0}
+    blocks, full = model.stiffness_blocks, model.stiffness
+
+    def count(name, fn):
+        def wrapped(*a, **kw):
+            calls[name] += 1
+            return fn(*a, **kw)
+        return wrapped
+
+    monkeypatch.setattr(model, "stiffness_blocks", count("blocks", blocks))
+    monkeypatch.setattr(model, "stiffness", count("full", full))
+    iterative = static_solve(model, model.x0, linear_solver="cg", tol=1e-10)
+    assert calls == {"blocks": iterative.total_iterations, "full": 0}
+    direct = static_solve(model, model.x0, linear_solver="direct", tol=1e-10)
+    assert calls["blocks"] == iterative.total_iterations and calls["full"] == direct.total_iterations
+    u = direct.x - model.x0
+    assert np.abs(u).max() > 1e-3
+    np.testing.assert_allclose(iterative.x, direct.x, rtol=0, atol=1e-7 * np.abs(u).max())
