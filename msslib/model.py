@@ -262,26 +262,20 @@ class Model:
         else:
             data = None
         if self._block is not None:
-            nptr, diag_pos, fills = self._block
-            scales = [float(self._scale(t, load)) for t, _, _ in self._hessian_terms]
-            first = next((i for i, (f, s) in enumerate(zip(fills, scales)) if f[0] == "springs" and f[2] and s != 0.0),
-                         None)
-            if first is None:
+            nptr, diag_pos, _ = self._block
+            exact, steps = self._fill_steps(load)
+            if not exact:
                 if data is None:
                     data = np.zeros(self._nnz)
                 else:
                     data[:] = 0.0
             elif data is None:
                 data = np.empty(self._nnz)  # every entry is written by the exact spring term
-            order = ([first] if first is not None else []) + [i for i in range(len(fills)) if i != first]
             xc = np.ascontiguousarray(x)
-            for i in order:
-                (t, _, _), (kind, p, _), s = self._hessian_terms[i], fills[i], scales[i]
-                if s == 0.0:
-                    continue
+            for t, kind, p, s, assign in steps:
                 if kind == "springs":
                     _, rowptr, nb, k, L0 = t.symmetric_layout()
-                    _spring3d_hessian_csr(xc, rowptr, nb, k, L0, p, nptr, diag_pos, s, i == first, data)
+                    _spring3d_hessian_csr(xc, rowptr, nb, k, L0, p, nptr, diag_pos, s, assign, data)
                 else:
                     vals = t.hessian_values(x).reshape(len(t.conn), -1)
                     _block_scatter_csr(vals, t.conn, p, nptr, self.dim, s, data)
@@ -332,22 +326,16 @@ class Model:
         else:
             out = None
             data = None
-        nptr, diag_pos, fills = self._block
-        scales = [float(self._scale(t, load)) for t, _, _ in self._hessian_terms]
-        first = next((i for i, (f, s) in enumerate(zip(fills, scales)) if f[0] == "springs" and f[2] and s != 0.0),
-                     None)
+        nptr, diag_pos, _ = self._block
+        exact, steps = self._fill_steps(load)
         if data is None:
-            data = np.empty((len(bind), dim, dim)) if first is not None else np.zeros((len(bind), dim, dim))
-        elif first is None:
+            data = np.empty((len(bind), dim, dim)) if exact else np.zeros((len(bind), dim, dim))
+        elif not exact:
             data[:] = 0.0
-        order = ([first] if first is not None else []) + [i for i in range(len(fills)) if i != first]
-        for i in order:
-            (t, _, _), (kind, p, _), s = self._hessian_terms[i], fills[i], scales[i]
-            if s == 0.0:
-                continue
+        for t, kind, p, s, assign in steps:
             if kind == "springs":
                 _, rowptr, nb, k, L0 = t.symmetric_layout()
-                _spring3d_hessian_bsr(x, rowptr, nb, k, L0, p, nptr, diag_pos, bmap, s, i == first, data)
+                _spring3d_hessian_bsr(x, rowptr, nb, k, L0, p, nptr, diag_pos, bmap, s, assign, data)
             else:
                 vals = t.hessian_values(x).reshape(len(t.conn), -1)
                 _block_scatter_bsr(vals, t.conn, p, nptr, bmap, s, data)
@@ -356,6 +344,19 @@ class Model:
         K = sp.bsr_matrix((data, bind, bptr), shape=shape, copy=False)
         K.has_sorted_indices = True
         return K
+
+    def _fill_steps(self, load):
+        """How the node-block fills run at ``load``: ``(exact, steps)``, ``steps`` the terms to
+        add as ``(term, kind, positions, scale, assign)``, an exact spring term first (it
+        overwrites every entry: ``exact``, no zeroing needed), terms of zero scale left out."""
+        fills = self._block[2]
+        scales = [float(self._scale(t, load)) for t, _, _ in self._hessian_terms]
+        first = next((i for i, (f, s) in enumerate(zip(fills, scales)) if f[0] == "springs" and f[2] and s != 0.0),
+                     None)
+        order = ([first] if first is not None else []) + [i for i in range(len(fills)) if i != first]
+        steps = [(self._hessian_terms[i][0], fills[i][0], fills[i][1], scales[i], i == first)
+                 for i in order if scales[i] != 0.0]
+        return first is not None, steps
 
     def _block_plan(self, node_free):
         """Kept node blocks for a node mask: ``bmap`` (position of every block of the node

@@ -13,7 +13,12 @@ Problem protocol
     forces may contain non-conservative terms that depend on ``load`` (follower or circulatory
     forces), so the result depends on ``load`` and not only on ``x``.
 ``stiffness(x, load=1.0)`` -> scipy.sparse matrix ``(n_dof, n_dof)``
-    Tangent stiffness ``K = -d force / d x`` at the same load. May be non-symmetric.
+    Tangent stiffness ``K = -d force / d x`` at the same load. May be non-symmetric. Optionally
+    with ``out=``: refill a matrix returned by an earlier call in place.
+``stiffness_blocks(x, load=1.0, out=None, node_free=None)`` -> BSR matrix or None, optional
+    The rows and columns of ``K`` of the nodes ``node_free`` as ``dim x dim`` node blocks. When
+    present (and not None), Newton systems solved by AMG-preconditioned CG are taken from it and
+    the full tangent is not formed.
 ``energy(x, load=1.0)`` -> float or None
     Total potential energy (internal energy minus ``load`` times the work of the external forces),
     so that ``force = -grad energy``. Return ``None`` when the system is not conservative; the
@@ -33,7 +38,8 @@ Problem protocol
     Default damping for :func:`integrate`: a scalar is a mass-proportional coefficient ``alpha``;
     a pair is Rayleigh damping ``C = alpha * M + beta * K``.
 ``dim`` : int, optional
-    Spatial dimension, used only to measure the bounding box in the divergence check.
+    Spatial dimension: the bounding box of the divergence check, and the node blocks (with the
+    rigid-body modes) of the AMG preconditioner when the free dofs are whole nodes.
 
 Static solution
 ---------------

@@ -439,15 +439,21 @@ def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
         assert abs(_submatrix(K2, free) - K2[idx][:, idx]).max() == 0 if K2[idx][:, idx].nnz else True
 
 
-def test_submatrix_refill_in_place_equals_fresh_extraction():
+def clamped_golec_block(nx, ny, nz, nu=0.3):
+    """Golec cube lattice of nx x ny x nz 1 cm cells, clamped at x = 0."""
     from msslib import mesh as M
     from msslib.model import Model, golec_cube_springs
-    from msslib.solvers import _submatrix
 
-    mesh = M.hex_grid(0.03, 0.02, 0.02, 3, 2, 2)
+    mesh = M.hex_grid(0.01 * nx, 0.01 * ny, 0.01 * nz, nx, ny, nz)
     fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
     fixed[mesh.points[:, 0] < 1e-12] = True
-    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
+    return Model(mesh, golec_cube_springs(mesh, [(1e4, nu)], 1.0), fixed=fixed)
+
+
+def test_submatrix_refill_in_place_equals_fresh_extraction():
+    from msslib.solvers import _submatrix
+
+    model = clamped_golec_block(3, 2, 2)
     free = model.free
     idx = np.flatnonzero(free)
     rng = np.random.default_rng(5)
@@ -530,14 +536,9 @@ def test_static_solve_cg_and_direct_agree_on_a_nonlinear_lattice():
 
 
 def test_free_node_blocks_as_bsr_equal_the_csr_block_and_refill_in_place():
-    from msslib import mesh as M
-    from msslib.model import Model, golec_cube_springs
     from msslib.solvers import _is_node_blocked, _solver_context, _submatrix_bsr
 
-    mesh = M.hex_grid(0.03, 0.02, 0.02, 3, 2, 2)
-    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
-    fixed[mesh.points[:, 0] < 1e-12] = True
-    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
+    model = clamped_golec_block(3, 2, 2)
     free = model.free
     idx = np.flatnonzero(free)
     ctx = _solver_context(model, model.x0, free)
@@ -587,16 +588,11 @@ def test_cg_newton_systems_go_through_node_blocks(monkeypatch):
 def test_band_width_bound_never_exceeds_the_bandwidth_found(shape, monkeypatch):
     """The breadth-first bound that skips the band orderings is a lower bound of the bandwidth
     of every ordering, so it never rejects a body the banded Cholesky would take."""
-    from msslib import mesh as M
-    from msslib.model import Model, golec_cube_springs
     from msslib.solvers import (BAND_AUTO_COST, _band_plan, _band_surely_wide, _bsr_entry,
                                 _eccentricity, _solver_context, _submatrix)
 
     nx, ny, nz = shape
-    mesh = M.hex_grid(0.01 * nx, 0.01 * ny, 0.01 * nz, nx, ny, nz)
-    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
-    fixed[mesh.points[:, 0] < 1e-12] = True
-    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
+    model = clamped_golec_block(nx, ny, nz)
     K = model.stiffness(model.x0)
     ctx = _solver_context(model, model.x0, model.free)
     entry = _bsr_entry(K, ctx["node_free"], 3)
