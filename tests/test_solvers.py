@@ -734,3 +734,17 @@ def test_model_newton_systems_filled_as_free_node_blocks(monkeypatch):
     u = direct.x - model.x0
     assert np.abs(u).max() > 1e-3
     np.testing.assert_allclose(iterative.x, direct.x, rtol=0, atol=1e-7 * np.abs(u).max())
+
+
+@pytest.mark.parametrize("chunk_nnz", [10**9, 20000, 2000])  # one slice, several, many
+def test_galerkin_product_in_slices_equals_the_whole(chunk_nnz, monkeypatch):
+    import msslib.solvers as S
+
+    A, B, _ = _lattice_system(8)
+    ml = S._sa_solver(A, B, 3)
+    P = ml.levels[0].P
+    monkeypatch.setattr(S, "GALERKIN_CHUNK_NNZ", chunk_nnz)
+    A_c = S._galerkin(A, P)
+    assert A_c.format == "bsr" and A_c.blocksize == (B.shape[1], B.shape[1])
+    ref = (P.T @ A @ P).toarray()
+    np.testing.assert_allclose(A_c.toarray(), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
