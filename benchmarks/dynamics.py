@@ -2,21 +2,24 @@
 
 Scheme: explicit symplectic Euler (the scheme of ``solvers.integrate(method="symplectic_euler")``)
 with mass-proportional damping, at 0.9 x the stability limit 2/omega_max, every step in numba.
-Explicit because with a diagonal mass matrix a step costs one force evaluation (~30 us here),
+Explicit because with a diagonal mass matrix a step costs one force evaluation (20-70 us here),
 while any implicit step needs a sparse solve of ~3,600 dofs (>= 1 ms with SuperLU/banded
 Cholesky, even with the factorisation reused) and would have to take > 30x longer steps to win.
 
-Two kernels, same scheme and physics:
+Three kernels, same scheme and physics:
 
-* "after": :class:`msslib.fastexplicit.LatticeExplicit`, structured-lattice kernels
-  (structure-of-arrays state, springs grouped by the 13 lattice directions as shifted contiguous
-  slices, hexahedron volume term over the cell slots, all loops SIMD-vectorised);
+* :class:`msslib.fastexplicit.LatticeExplicit`, structured-lattice kernels (structure-of-arrays
+  state, springs grouped by the 13 lattice directions as shifted contiguous slices, hexahedron
+  volume term over the cell slots, all loops SIMD-vectorised), with the forces in single
+  precision (the state and the update in double) -- the figure with the target -- and in double
+  precision throughout;
 * "before": the generic path, msslib's node-ordered scalar spring kernel and the hexahedron
-  volume loop on the interleaved state.
+  volume loop on the interleaved state, double precision.
 
-Accuracy: the same scheme with a 10x smaller step (same saved times) is the reference; the error
-is the largest nodal position difference over the saved trajectory relative to the largest
-displacement.  The two kernels are also compared with each other (round-off only).
+Accuracy: the same scheme in double precision with a 10x smaller step (same saved times) is the
+reference; the error is the largest nodal position difference over the saved trajectory relative
+to the largest displacement.  The kernels are also compared with each other: double against
+generic (round-off only), single against double (the rounding of the forces).
 """
 
 from __future__ import annotations
@@ -80,7 +83,7 @@ def simulate_generic(model, terms, h, n_steps, save_every, alpha):
 
 
 def simulate_fast(fast, model, h, n_steps, save_every, alpha):
-    """The "after" path: structured-lattice kernels.  Returns (wall, saved states)."""
+    """The structured-lattice path.  Returns (wall, saved states)."""
     x0 = model.x0
     v0 = np.zeros_like(x0)
     t = time.perf_counter()
@@ -92,7 +95,7 @@ def run(res, quick: bool):
     t_end = 1.0 if quick else 10.0
     alpha = 5.0  # mass-proportional damping (1/s): the sample settles under gravity
     model, terms = sample()
-    fast = LatticeExplicit(model)
+    fast = {p: LatticeExplicit(model, precision=p) for p in ("single", "double")}
     dt_crit = S.explicit_stability_limit(model, model.x0)
     h = 0.9 * dt_crit
     n_steps = int(round(t_end / h))
@@ -101,52 +104,74 @@ def run(res, quick: bool):
     paper = 2.88 * t_end / 10.0
 
     # warm up (compile or load the numba caches)
-    simulate_fast(fast, model, h, 10, 1, alpha)
+    for f in fast.values():
+        simulate_fast(f, model, h, 10, 1, alpha)
     simulate_generic(model, terms, h, 10, 1, alpha)
 
+    # interleaved rounds: a change of the shared host's speed affects every variant alike
     repeats = 5
-    runs = [simulate_fast(fast, model, h, n_steps, save_every, alpha) for _ in range(repeats)]
-    walls = [r[0] for r in runs]
-    wall = float(np.median(walls))
-    traj = runs[0][1]
-    gen = [simulate_generic(model, terms, h, n_steps, save_every, alpha) for _ in range(3)]
-    wall_gen = float(np.median([r[0] for r in gen]))
-    traj_gen = gen[0][1]
+    walls = {p: [] for p in fast}
+    walls["generic"] = []
+    traj = {}
+    for r in range(repeats):
+        for p, f in fast.items():
+            w, traj[p] = simulate_fast(f, model, h, n_steps, save_every, alpha)
+            walls[p].append(w)
+        if r < 3:
+            w, traj["generic"] = simulate_generic(model, terms, h, n_steps, save_every, alpha)
+            walls["generic"].append(w)
+    wall = {p: float(np.median(w)) for p, w in walls.items()}
     load = os.getloadavg()[0]
 
-    # reference: same scheme, 10x smaller step, saved at the same times (every 10 save_every steps)
-    wall_ref, traj_ref = simulate_fast(fast, model, h / 10, 10 * n_steps, 10 * save_every, alpha)
+    # reference: double precision, 10x smaller step, saved at the same times (every 10 save_every steps)
+    wall_ref, traj_ref = simulate_fast(fast["double"], model, h / 10, 10 * n_steps, 10 * save_every, alpha)
     disp = np.abs(traj_ref - model.x0).max()
-    err = float(np.abs(traj - traj_ref).max() / disp)
-    final_err = float(np.abs(traj[-1] - traj_ref[-1]).max() / disp)
-    kernel_diff = float(np.abs(traj - traj_gen).max() / disp)
+    err = {p: float(np.abs(traj[p] - traj_ref).max() / disp) for p in fast}
+    final_err = float(np.abs(traj["single"][-1] - traj_ref[-1]).max() / disp)
+    kernel_diff = float(np.abs(traj["double"] - traj["generic"]).max() / disp)
+    prec_diff = float(np.abs(traj["single"] - traj["double"]).max() / disp)
 
     # one force evaluation (called from Python: includes ~1 us of dispatch)
-    P = fast.to_lattice(model.x0 + 1e-3 * np.random.default_rng(0).standard_normal(model.n_dof))
-    G = np.empty_like(P)
-    fast.gradient_lattice(P, G)
-    t_force = np.median([_t(lambda: [fast.gradient_lattice(P, G) for _ in range(200)]) / 200 for _ in range(7)])
+    t_force = {}
+    for p, f in fast.items():
+        P = f.to_lattice(model.x0 + 1e-3 * np.random.default_rng(0).standard_normal(model.n_dof))
+        G = f.gradient_lattice(P)
+        t_force[p] = np.median([_t(lambda: [f.gradient_lattice(P, G) for _ in range(200)]) / 200 for _ in range(7)])
 
-    res.add("golec_sample_explicit_wall", wall, "s", paper / wall, "Golec et al. 2.88 s per 10 s on 8 cores",
-            f"{t_end:g} s simulated, nu = 0.3, E = 20 kPa, 1 cm cubes, gravity, alpha = {alpha:g}/s, {n_steps} "
-            f"steps of {h:.3g} s (0.9 x dt_crit), symplectic Euler, structured-lattice SIMD kernels "
-            f"(msslib.fastexplicit), 1 thread; median of {repeats} (min {min(walls):.3g} s, max "
-            f"{max(walls):.3g} s), load average {load:.1f}", target=("<=", 0.029 * t_end, "value"))
-    res.add("golec_sample_explicit_wall_generic", wall_gen, "s", paper / wall_gen,
+    common = (f"{t_end:g} s simulated, nu = 0.3, E = 20 kPa, 1 cm cubes, gravity, alpha = {alpha:g}/s, {n_steps} "
+              f"steps of {h:.3g} s (0.9 x dt_crit), symplectic Euler, structured-lattice SIMD kernels "
+              f"(msslib.fastexplicit), 1 thread")
+    spread = {p: f"median of {len(w)} (min {min(w):.3g} s, max {max(w):.3g} s)" for p, w in walls.items()}
+    res.add("golec_sample_explicit_wall", wall["single"], "s", paper / wall["single"],
+            "Golec et al. 2.88 s per 10 s on 8 cores",
+            f"{common}; single-precision force kernels, double-precision state and update "
+            f"(LatticeExplicit(precision='single')); {spread['single']}, load average {load:.1f}",
+            target=("<=", 0.029 * t_end, "value"))
+    res.add("golec_sample_explicit_wall_double", wall["double"], "s", paper / wall["double"],
+            "Golec et al. 2.88 s per 10 s on 8 cores",
+            f"the same in double precision throughout (the default); {spread['double']}; "
+            f"single is {wall['double'] / wall['single']:.2f}x faster")
+    res.add("golec_sample_explicit_wall_generic", wall["generic"], "s", paper / wall["generic"],
             "Golec et al. 2.88 s per 10 s on 8 cores",
             f"before: same run with the generic scalar kernels (terms._spring3d_gradient_fast + "
-            f"_hex_gradient_loop), median of 3; after/before speed-up {wall_gen / wall:.2f}x")
-    res.add("golec_sample_step_cost", wall / n_steps * 1e6, "us/step", None, None,
-            f"after; before {wall_gen / n_steps * 1e6:.0f} us/step; one force evaluation (springs + hex volume) "
-            f"{t_force * 1e6:.1f} us called from Python")
-    res.add("golec_sample_error_vs_reference", err, "", None, None,
-            "max |x - x_ref| over the 100 saved states / max displacement; reference: same scheme, dt/10, same "
-            "saved times (first-order scheme: the error against the exact solution is ~1.1x this)")
+            f"_hex_gradient_loop), double precision, {spread['generic']}; speed-up to single "
+            f"{wall['generic'] / wall['single']:.2f}x, to double {wall['generic'] / wall['double']:.2f}x")
+    res.add("golec_sample_step_cost", wall["single"] / n_steps * 1e6, "us/step", None, None,
+            f"single; double {wall['double'] / n_steps * 1e6:.0f} us/step; generic {wall['generic'] / n_steps * 1e6:.0f} "
+            f"us/step; one force evaluation (springs + hex volume) {t_force['single'] * 1e6:.1f} us single, "
+            f"{t_force['double'] * 1e6:.1f} us double, called from Python")
+    res.add("golec_sample_error_vs_reference", err["single"], "", None, None,
+            f"single; max |x - x_ref| over the 100 saved states / max displacement; reference: double precision, "
+            f"same scheme, dt/10, same saved times (first-order scheme: the error against the exact solution is "
+            f"~1.1x this); double: {err['double']:.4g}")
     res.add("golec_sample_final_error_vs_reference", final_err, "", None, None,
-            f"at t = {n_steps * h:.4g} s, relative to the max displacement")
+            f"single, at t = {n_steps * h:.4g} s, relative to the max displacement")
+    res.add("golec_sample_single_vs_double", prec_diff, "", None, None,
+            "max |x_single - x_double| over the trajectory / max displacement (rounding of the forces to "
+            "single precision: far below the time-discretisation error)")
     res.add("golec_sample_kernel_difference", kernel_diff, "", None, None,
-            "max |x_after - x_before| over the trajectory / max displacement (round-off: same scheme and forces)")
-    res.add("golec_sample_reference_wall", wall_ref, "s", None, None, "dt/10 reference run (fast kernels)")
+            "max |x_double - x_generic| over the trajectory / max displacement (round-off: same scheme and forces)")
+    res.add("golec_sample_reference_wall", wall_ref, "s", None, None, "dt/10 reference run (double-precision kernels)")
 
 
 def _t(fn):

@@ -23,8 +23,10 @@ are gathered from the neighbouring cells.
 :meth:`LatticeExplicit.run` is the symplectic Euler loop of
 ``msslib.solvers.integrate(..., method="symplectic_euler")`` with mass-proportional damping,
 entirely in numba: ``v += h (f(x) - alpha M v) / M`` on the free dofs, then ``x += h v``.
-Results agree with the model to round-off (summation order differs); see
-``tests/test_fastexplicit.py``.
+In double precision (the default) results agree with the model to round-off (summation order
+differs); with ``precision="single"`` the force kernels run in single precision on a copy of
+the positions (state and update stay double), about twice as fast, with forces within about
+1e-5 of the double ones; see ``tests/test_fastexplicit.py``.
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ import os
 
 import numpy as np
 from numba import njit
+from numba.core import types as _types
+from numba.extending import overload as _overload
 
 from msslib.terms import ExternalForce, HexVolume, Springs, Term
 
@@ -123,17 +127,45 @@ def lattice_index(points, rtol: float = 1e-9):
 # --------------------------------------------------------------------------------------------
 
 
+def _tiny(x):
+    """A positive number far below any squared spring length, in the precision of ``x``."""
+    return 1e-300
+
+
+@_overload(_tiny)
+def _tiny_impl(x):
+    if isinstance(x, _types.Float) and x.bitwidth == 32:
+        return lambda x: np.float32(1e-30)
+    return lambda x: 1e-300
+
+
+def _as(x, v):
+    """The constant ``v`` in the precision of ``x`` (a float64 literal would promote
+    single-precision arithmetic to double)."""
+    return v
+
+
+@_overload(_as)
+def _as_impl(x, v):
+    if isinstance(x, _types.Float) and x.bitwidth == 32:
+        return lambda x, v: np.float32(v)
+    return lambda x, v: np.float64(v)
+
+
 @_jit
 def _spring_direction(X, Y, Z, o, n, k, L0, FX, FY, FZ):
-    """Forces ``(x_p - x_{p+o}) k (L0 - l) / l`` of the springs ``(p, p + o)``, p < n, into F[p]
-    (zero for n <= p < len(F): the buffers are shared by the directions)."""
+    """Forces ``(x_p - x_{p+o}) k (L0 - l) / l = (x_p - x_{p+o}) k (L0 / l - 1)`` of the springs
+    ``(p, p + o)``, p < n, into F[p] (zero for n <= p < len(F): the buffers are shared by the
+    directions)."""
     Xb, Yb, Zb = X[o:], Y[o:], Z[o:]
+    tiny = _tiny(X[0])  # empty slots (k = 0) stay finite
+    one = _as(X[0], 1.0)
     for q in range(n):
         d0 = X[q] - Xb[q]
         d1 = Y[q] - Yb[q]
         d2 = Z[q] - Zb[q]
-        l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2 + 1e-300)  # tiny: empty slots (k = 0) never divide by 0
-        c = k[q] * (L0[q] - l) / l
+        r = one / np.sqrt(d0 * d0 + d1 * d1 + d2 * d2 + tiny)  # single: estimate + Newton step
+        c = k[q] * (L0[q] * r - one)
         FX[q] = d0 * c
         FY[q] = d1 * c
         FZ[q] = d2 * c
@@ -178,6 +210,7 @@ def _hex_component(X, Y, Z, ncell, NX, S, kv, V0, comp, W0, W1, W2, W3):
     X1, X2, X3, X4, X5, X6, X7 = X[o1:], X[o2:], X[o3:], X[o4:], X[o5:], X[o6:], X[o7:]
     Y1, Y2, Y3, Y4, Y5, Y6, Y7 = Y[o1:], Y[o2:], Y[o3:], Y[o4:], Y[o5:], Y[o6:], Y[o7:]
     Z1, Z2, Z3, Z4, Z5, Z6, Z7 = Z[o1:], Z[o2:], Z[o3:], Z[o4:], Z[o5:], Z[o6:], Z[o7:]
+    sixtyfourth = _as(X[0], 1.0 / 64.0)
     for q in range(ncell):
         x0, x1, x2, x3, x4, x5, x6, x7 = X[q], X1[q], X2[q], X3[q], X4[q], X5[q], X6[q], X7[q]
         y0, y1, y2, y3, y4, y5, y6, y7 = Y[q], Y1[q], Y2[q], Y3[q], Y4[q], Y5[q], Y6[q], Y7[q]
@@ -194,7 +227,7 @@ def _hex_component(X, Y, Z, ncell, NX, S, kv, V0, comp, W0, W1, W2, W3):
         ax = eyy * ezz - eyz * ezy
         ay = eyz * ezx - eyx * ezz
         az = eyx * ezy - eyy * ezx
-        V = (exx * ax + exy * ay + exz * az) * (1.0 / 64.0)
+        V = (exx * ax + exy * ay + exz * az) * sixtyfourth
         cs = kv[q] * (V - V0[q])
         if comp == 0:
             a = ax
@@ -275,16 +308,28 @@ def _from_lattice(P, lat, x):
 
 
 @_jit
+def _cast(P, Pk):
+    """Pk = P (elementwise conversion to the kernels' precision)."""
+    for d in range(P.shape[0]):
+        a, b = P[d], Pk[d]
+        for q in range(a.shape[0]):
+            b[q] = a[q]
+
+
+@_jit
 def _run(P, Vel, h, n_steps, save_every, alpha, mass, inv_m, fext,
-         offs, nspan, K, L0, F, ncell, NX, S, kv, V0, W, pad, lat, out):
+         offs, nspan, K, L0, F, ncell, NX, S, kv, V0, W, pad, lat, out, Pk, G, copy):
     """Symplectic Euler: v += h (fext - g(x) - alpha m v) / m (free dofs: inv_m = 0 on fixed
     ones, whose velocity stays 0), x += h v.  Saves x (model layout) after every
-    ``save_every``-th step into ``out``; returns the number saved."""
+    ``save_every``-th step into ``out``; returns the number saved.  The state ``P``, ``Vel`` and
+    the update are double precision; the forces are evaluated on ``Pk``, a copy of ``P`` in the
+    kernels' precision refreshed every step when ``copy`` (``Pk is P`` in double precision)."""
     N = P.shape[1]
-    G = np.zeros((3, N))
     j = 0
     for step in range(n_steps):
-        _gradient(P, offs, nspan, K, L0, F, ncell, NX, S, kv, V0, W, pad, G)
+        if copy:
+            _cast(P, Pk)
+        _gradient(Pk, offs, nspan, K, L0, F, ncell, NX, S, kv, V0, W, pad, G)
         for d in range(3):
             x, v, g, m, im, fe = P[d], Vel[d], G[d], mass[d], inv_m[d], fext[d]
             for q in range(N):
@@ -311,6 +356,13 @@ class LatticeExplicit:
         constant external loads (anything else raises ValueError naming the term).  The lattice
         is detected from the rest positions ``model.mesh.points``.
     load : load factor of the external loads (constant during :meth:`run`).
+    precision : ``"double"`` (default) or ``"single"``: the arithmetic of the force kernels.
+        The state and the time update stay double precision either way.  Single precision
+        halves the memory the kernels stream and doubles the SIMD width; its forces differ from
+        the double ones by about 1e-5 of their size (rounding of positions to 24 bits: the
+        cancellation in ``x_a - x_b`` and ``V - V0``), far below the time-discretisation
+        error of an explicit run at the stability limit (``benchmarks/dynamics.py`` reports
+        both).  Use double for anything compared with the model to round-off.
 
     The springs of the model are stored once (spring constants, rest lengths) per direction and
     base node, ``2 x 13 x N`` floats for ``N`` lattice nodes; several springs on the same node
@@ -319,7 +371,11 @@ class LatticeExplicit:
     thread.
     """
 
-    def __init__(self, model, load: float = 1.0):
+    def __init__(self, model, load: float = 1.0, precision: str = "double"):
+        if precision not in ("double", "single"):
+            raise ValueError(f"precision must be 'double' or 'single', got {precision!r}")
+        self.precision = precision
+        self.dtype = np.dtype(np.float64 if precision == "double" else np.float32)
         if getattr(model, "dim", None) != 3:
             raise ValueError("LatticeExplicit needs a 3D model")
         (NX, NY, NZ), ijk = lattice_index(model.mesh.points)
@@ -365,9 +421,13 @@ class LatticeExplicit:
         inv[free] = 1.0 / mass[free]
         self.inv_m = self.to_lattice(inv)
         self.model = model
+        # the kernels' copies of the constants, in their precision
+        dt = self.dtype
+        self._K, self._L0 = (np.ascontiguousarray(a, dtype=dt) for a in (self.K, self.L0))
+        self._kv, self._V0 = (np.ascontiguousarray(a, dtype=dt) for a in (self.kv, self.V0))
         # scratch: separate allocations (the compiler then knows they do not overlap)
-        self._F = tuple(np.zeros(self.pad + N) for _ in range(3))
-        self._W = tuple(np.zeros(self.pad + N) for _ in range(12))
+        self._F = tuple(np.zeros(self.pad + N, dtype=dt) for _ in range(3))
+        self._W = tuple(np.zeros(self.pad + N, dtype=dt) for _ in range(12))
 
     # ---- construction ----------------------------------------------------------------------
 
@@ -457,16 +517,20 @@ class LatticeExplicit:
     # ---- forces --------------------------------------------------------------------------------
 
     def gradient_lattice(self, P, G=None) -> np.ndarray:
-        """Gradient of the internal terms (springs + hex volume) at lattice positions ``P``."""
+        """Gradient of the internal terms (springs + hex volume) at lattice positions ``P``
+        (converted to the kernels' precision, as is ``G``, which is returned)."""
+        P = np.ascontiguousarray(P, dtype=self.dtype)
         if G is None:
-            G = np.empty((3, self.N))
-        _gradient(P, self.offs, self.nspan, self.K, self.L0, self._F, self.ncell, self.NX, self.S,
-                  self.kv, self.V0, self._W, self.pad, G)
+            G = np.empty((3, self.N), dtype=self.dtype)
+        elif G.dtype != self.dtype or G.shape != (3, self.N) or not G.flags.c_contiguous:
+            raise ValueError(f"G must be a C-contiguous (3, {self.N}) array of {self.dtype}")
+        _gradient(P, self.offs, self.nspan, self._K, self._L0, self._F, self.ncell, self.NX, self.S,
+                  self._kv, self._V0, self._W, self.pad, G)
         return G
 
     def internal_gradient(self, x) -> np.ndarray:
         """Sum of the gradients of the springs and volume terms (flat, model layout)."""
-        return self.from_lattice(self.gradient_lattice(self.to_lattice(x)))
+        return self.from_lattice(self.gradient_lattice(self.to_lattice(x)).astype(float))
 
     def force(self, x) -> np.ndarray:
         """``model.force(x, load)`` (flat, model layout)."""
@@ -496,7 +560,10 @@ class LatticeExplicit:
         vv[~self.free_flat] = 0.0
         Vel = self.to_lattice(vv)
         out = np.empty((n_steps // save_every, 3 * self.N))
+        copy = self.dtype != P.dtype
+        Pk = np.empty(P.shape, dtype=self.dtype) if copy else P
+        G = np.zeros(P.shape, dtype=self.dtype)
         _run(P, Vel, float(h), int(n_steps), int(save_every), float(alpha), self.mass, self.inv_m, self.fext,
-             self.offs, self.nspan, self.K, self.L0, self._F, self.ncell, self.NX, self.S, self.kv, self.V0,
-             self._W, self.pad, self.lat, out)
+             self.offs, self.nspan, self._K, self._L0, self._F, self.ncell, self.NX, self.S, self._kv, self._V0,
+             self._W, self.pad, self.lat, out, Pk, G, copy)
         return self.from_lattice(P), self.from_lattice(Vel), out

@@ -21,7 +21,8 @@ FIGURES = [
     "spring_force_fraction_of_bandwidth_limit", "hessian_assembly_scipy_coo", "hessian_assembly_fast",
     "hessian_assembly_rel_error", "cantilever_static_baudet", "cantilever_static_golec",
     "golec_sample_explicit_wall", "golec_sample_step_cost", "golec_sample_error_vs_reference",
-    "golec_sample_final_error_vs_reference", "golec_sample_reference_wall",
+    "golec_sample_final_error_vs_reference", "golec_sample_reference_wall", "golec_sample_explicit_wall_double",
+    "golec_sample_single_vs_double",
     "static_solve_scaling_exponent_warm", "static_solve_scaling_exponent_cold", "static_solve_superlu_scaling_exponent",
 ]
 

@@ -165,3 +165,47 @@ def test_lattice_index_and_errors():
     with pytest.raises(ValueError, match="mass-proportional"):
         model.damping = (1.0, 1e-3)
         fast.run(model.x0, np.zeros(model.n_dof), 1e-4, 2)
+
+
+@pytest.mark.parametrize("make", [_golec_sample, _irregular_model])
+def test_single_precision_forces_within_rounding_of_positions(make):
+    """Single-precision kernels: the forces differ from the model's by the rounding of the
+    positions to 24 bits, which the cancellation in x_a - x_b amplifies by |x| / |x - x0|; at
+    strains of 1e-3 and more that stays below 1e-4 of the largest force."""
+    model = make()
+    fast = LatticeExplicit(model, precision="single")
+    assert fast.dtype == np.float32 and fast._K.dtype == np.float32
+    rng = np.random.default_rng(7)
+    span = np.abs(model.x0).max()
+    for strain in (1e-3, 1e-2, 1e-1):
+        x = model.x0 + strain * 0.01 * rng.standard_normal(model.n_dof) * model.free
+        f_single, f_model = fast.force(x), model.force(x)
+        rel = _rel(f_single, f_model)
+        assert rel <= 1e-4
+        # and not better than single precision can be (it does compute in single)
+        assert rel >= 0.1 * np.finfo(np.float32).eps * span / np.abs(x - model.x0).max() * 1e-3
+    # the gradient buffer must match the kernels' precision
+    with pytest.raises(ValueError, match="float32"):
+        fast.gradient_lattice(fast.to_lattice(model.x0), np.empty((3, fast.N)))
+
+
+def test_single_precision_trajectory_close_to_double():
+    model = _golec_sample(n=(3, 3, 3), alpha=5.0)
+    h = 0.9 * S.explicit_stability_limit(model, model.x0)
+    rng = np.random.default_rng(8)
+    v0 = 1e-2 * rng.standard_normal(model.n_dof)
+    xs, vs, ss = LatticeExplicit(model, precision="single").run(model.x0, v0, h, 600, None, 20)
+    xd, vd, sd = LatticeExplicit(model).run(model.x0, v0, h, 600, None, 20)
+    disp = np.abs(sd - model.x0).max()
+    assert disp > 0
+    diff = np.abs(ss - sd).max() / disp
+    # position rounding relative to the motion, eps |x| / disp, amplified modestly over 600
+    # steps: the state stays double, so rounding does not pile up step by step
+    rounding = np.finfo(np.float32).eps * np.abs(model.x0).max() / disp
+    assert 0 < diff <= 100 * rounding, (diff, rounding)
+    assert np.all(xs[model.fixed] == model.x0[model.fixed]) and np.all(vs[model.fixed] == 0)
+
+
+def test_precision_must_be_known():
+    with pytest.raises(ValueError, match="precision must be 'double' or 'single', got 'half'"):
+        LatticeExplicit(_golec_sample(n=(2, 2, 2)), precision="half")
