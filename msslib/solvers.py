@@ -1091,30 +1091,120 @@ def _block_jacobi_radius(A, dinv, steps: int = 15, seed: int = 0) -> float:
     return float(np.linalg.eigvalsh(Tk)[-1])
 
 
-def _bsr_rows(M, i0, i1):
-    """Block rows ``i0:i1`` of a BSR matrix (views of its arrays, no copy)."""
-    d = M.blocksize[0]
-    a, b = M.indptr[i0], M.indptr[i1]
-    return sp.bsr_matrix((M.data[a:b], M.indices[a:b], M.indptr[i0:i1 + 1] - a),
-                         shape=((i1 - i0) * d, M.shape[1]), copy=False)
+@njit(cache=True, nogil=True, fastmath={"contract"})
+def _galerkin_numeric(a_ptr, a_ind, a_data, p_ptr, p_ind, p_data, c_ptr, c_ind, c_data):
+    """Upper block triangle (``K >= J``) of ``C = P^T A P`` added into ``c_data``, on the
+    pattern ``(c_ptr, c_ind)`` (sorted, containing that of the product), fine block row by fine
+    block row: the row ``y = (A P)_i`` in a dense accumulator over the coarse blocks it
+    touches, then ``C_JK += P_iJ^T y_K`` for the blocks ``P_iJ`` of that row.  No ``A P`` is
+    stored; 3 x d blocks of ``A`` have unrolled loops."""
+    n = a_ptr.shape[0] - 1
+    nc = c_ptr.shape[0] - 1
+    d = a_data.shape[1]
+    m = p_data.shape[2]
+    mark = np.full(nc, -1, dtype=np.int64)
+    ks = np.empty(nc, dtype=np.int64)
+    colpos = np.zeros(nc, dtype=np.int64)
+    y = np.empty((nc, d, m))
+    for i in range(n):
+        nk = 0
+        for q in range(a_ptr[_U(i)], a_ptr[_U(i + 1)]):
+            j = a_ind[_U(q)]
+            for pp in range(p_ptr[_U(j)], p_ptr[_U(j + 1)]):
+                K = p_ind[_U(pp)]
+                if mark[_U(K)] != i:
+                    mark[_U(K)] = i
+                    ks[nk] = K
+                    nk += 1
+                    for r in range(d):
+                        for c in range(m):
+                            y[_U(K), r, c] = 0.0
+                if d == 3:
+                    Aq = a_data[_U(q)]
+                    a00, a01, a02 = Aq[0, 0], Aq[0, 1], Aq[0, 2]
+                    a10, a11, a12 = Aq[1, 0], Aq[1, 1], Aq[1, 2]
+                    a20, a21, a22 = Aq[2, 0], Aq[2, 1], Aq[2, 2]
+                    Pp = p_data[_U(pp)]
+                    Y = y[_U(K)]
+                    for c in range(m):
+                        p0, p1, p2 = Pp[0, c], Pp[1, c], Pp[2, c]
+                        Y[0, c] += a00 * p0 + a01 * p1 + a02 * p2
+                        Y[1, c] += a10 * p0 + a11 * p1 + a12 * p2
+                        Y[2, c] += a20 * p0 + a21 * p1 + a22 * p2
+                else:
+                    for r in range(d):
+                        for s in range(d):
+                            a = a_data[_U(q), r, s]
+                            for c in range(m):
+                                y[_U(K), r, c] += a * p_data[_U(pp), s, c]
+        for pp in range(p_ptr[_U(i)], p_ptr[_U(i + 1)]):
+            J = p_ind[_U(pp)]
+            for t in range(c_ptr[_U(J)], c_ptr[_U(J + 1)]):
+                colpos[_U(c_ind[_U(t)])] = t
+            for u in range(nk):
+                K = ks[u]
+                if K < J:
+                    continue
+                t = colpos[_U(K)]
+                if d == 3:
+                    Pp = p_data[_U(pp)]
+                    Y = y[_U(K)]
+                    Ct = c_data[_U(t)]
+                    for r in range(m):
+                        p0, p1, p2 = Pp[0, r], Pp[1, r], Pp[2, r]
+                        for c in range(m):
+                            Ct[r, c] += p0 * Y[0, c] + p1 * Y[1, c] + p2 * Y[2, c]
+                else:
+                    for r in range(m):
+                        for s in range(d):
+                            pv = p_data[_U(pp), s, r]
+                            for c in range(m):
+                                c_data[_U(t), r, c] += pv * y[_U(K), s, c]
 
-
-GALERKIN_CHUNK_NNZ = 2_000_000  # entries of A per slice of the Galerkin product
+@njit(cache=True, nogil=True)
+def _mirror_lower(c_ptr, c_ind, c_data):
+    """Blocks below the diagonal of a block-symmetric BSR (symmetric pattern, sorted indices)
+    set to the transposes of their mirror images above it."""
+    nc = c_ptr.shape[0] - 1
+    m = c_data.shape[1]
+    for J in range(nc):
+        for t in range(c_ptr[J], c_ptr[J + 1]):
+            K = c_ind[t]
+            if K >= J:
+                break
+            lo, hi = c_ptr[K], c_ptr[K + 1]
+            while lo < hi:
+                mid = (lo + hi) // 2
+                if c_ind[mid] < J:
+                    lo = mid + 1
+                else:
+                    hi = mid
+            for r in range(m):
+                for c in range(m):
+                    c_data[t, r, c] = c_data[lo, c, r]
 
 
 def _galerkin(A, P):
-    """Coarse matrix ``P^T A P`` (BSR), summed over slices of block rows,
-    ``sum_k P_k^T (A_k P)``, so that only a slice of ``A P`` (several times larger than ``A``'s
-    share of memory, 290 MB at 3e5 dofs) exists at a time: less memory and fewer fresh pages to
-    fault in; the slices are summed pairwise."""
-    nbr = A.indptr.shape[0] - 1
-    k = max(1, min(nbr, A.nnz // GALERKIN_CHUNK_NNZ))
-    edges = np.linspace(0, nbr, k + 1).astype(np.int64)
-    parts = [_bsr_rows(P, a, b).T @ (_bsr_rows(A, a, b) @ P) for a, b in zip(edges[:-1], edges[1:])]
-    while len(parts) > 1:
-        parts = [parts[i] + parts[i + 1] if i + 1 < len(parts) else parts[i] for i in range(0, len(parts), 2)]
-    A_c = parts[0]
-    return A_c if A_c.format == "bsr" else A_c.tobsr(blocksize=(P.blocksize[1], P.blocksize[1]))
+    """Coarse matrix ``P^T A P`` (BSR, blocks ``(m, m)``) of a symmetric BSR ``A`` (square
+    blocks, sorted indices) and a BSR prolongator ``P`` (blocks ``(d, m)``).  The block
+    pattern comes from products of the block patterns (cheap: one scalar per block); the values
+    from :func:`_galerkin_numeric`, which computes the upper block triangle only (the product
+    is symmetric) without forming ``A P`` (several times larger than ``A``: 290 MB at 3e5 dofs
+    with scipy's product), 3x faster than scipy's block products at 1e5 dofs."""
+    nb = A.indptr.shape[0] - 1
+    d, m = P.blocksize
+    nc = P.shape[1] // m
+    A.sort_indices()
+    Ab = sp.csr_matrix((np.ones(A.indices.shape[0]), A.indices, A.indptr), shape=(nb, nb))
+    Pb = sp.csr_matrix((np.ones(P.indices.shape[0]), P.indices, P.indptr), shape=(nb, nc))
+    Cb = (Pb.T.tocsr() @ (Ab @ Pb)).tocsr()
+    Cb.sort_indices()
+    data = np.zeros((Cb.indices.shape[0], m, m))
+    _galerkin_numeric(A.indptr, A.indices, A.data, P.indptr, P.indices, P.data, Cb.indptr, Cb.indices, data)
+    _mirror_lower(Cb.indptr, Cb.indices, data)
+    A_c = sp.bsr_matrix((data, Cb.indices, Cb.indptr), shape=(nc * m, nc * m), copy=False)
+    A_c.has_sorted_indices = True
+    return A_c
 
 
 def _sa_solver(A, B, dim):
@@ -1177,7 +1267,8 @@ def _amg_preconditioner(A, context):
     correction, a symmetric V-cycle (CG needs it) at half the cost of symmetric sweeps; the
     coarsest level by sparse LU (pyamg's default dense pseudo-inverse costs O(n^3) and took
     minutes on the ~10^4-unknown coarse levels of 10^5-dof lattices).  The finest level of the
-    block case is built by :func:`_sa_solver`."""
+    block case is built by :func:`_sa_solver`; the cycle is applied by :class:`_VCycle` when
+    every level fits it (pyamg's ``aspreconditioner`` otherwise)."""
     import pyamg  # optional
 
     dim = context.get("dim") if context else None
