@@ -74,8 +74,10 @@ step ``2 / omega_max`` of the explicit schemes.
 
 from __future__ import annotations
 
+import threading
 import time
 import warnings
+import weakref
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -1550,6 +1552,52 @@ def _solver_context(problem, x, free):
     return ctx
 
 
+# The linear-solver state of the last static solve of each problem (weak keys: it goes with the
+# problem): the AMG hierarchy and the matrix of the Newton systems, whose values array is then
+# refilled.  The next solve of the same problem with the same free nodes, initial coordinates
+# and linear solver starts with them, as the Newton iterations of one solve do: the hierarchy
+# is kept while CG converges fast with it (load steps, parameter sweeps and repeated solves of
+# one model keep their tangent's pattern and, largely, its values), rebuilt otherwise.
+_STATIC_CONTEXTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _static_context(problem, x, free, linear_solver):
+    """The solver context of a static solve (see :func:`_solver_context`): the one left by the
+    previous solve of ``problem`` when it is compatible and not in use (another thread), else a
+    new one, kept for the next solve.  Release it with :func:`_release_context`."""
+    ctx = _solver_context(problem, x, free)
+    if not isinstance(linear_solver, str):  # a user solver: nothing to keep
+        return ctx
+    ctx["linear_solver"] = linear_solver
+    try:
+        old = _STATIC_CONTEXTS.get(problem)
+    except TypeError:  # not weakly referable or not hashable
+        return ctx
+    if (old is not None and old.get("linear_solver") == linear_solver and old.get("dim") == ctx.get("dim")
+            and old["free"].shape == free.shape and np.array_equal(old["free"], free)
+            and np.array_equal(old.get("coords"), ctx.get("coords")) and old["lock"].acquire(blocking=False)):
+        old["cg_iterations"] = 0
+        old.pop("negative_curvature", None)
+        old.pop("band_indefinite", None)  # judged afresh by each solve
+        return old
+    if old is not None and old["lock"].locked():  # in use: this solve keeps its own
+        return ctx
+    ctx["free"] = free.copy()
+    ctx["lock"] = threading.Lock()
+    ctx["lock"].acquire()
+    try:
+        _STATIC_CONTEXTS[problem] = ctx
+    except TypeError:
+        pass
+    return ctx
+
+
+def _release_context(ctx):
+    lock = ctx.get("lock")
+    if lock is not None and lock.locked():
+        lock.release()
+
+
 def _force_scale(problem, x0, free):
     with np.errstate(all="ignore"):
         f_ext = np.asarray(problem.force(x0, 1.0), dtype=float) - np.asarray(problem.force(x0, 0.0), dtype=float)
@@ -1676,7 +1724,8 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
     # the full tangent's values can be refilled in place when only its free block is passed on
     # (the block is a copy); saves allocating (and page-faulting) a new value array per iteration
     refill = not free.all() and _accepts_out(problem)
-    K_full = K = None
+    K_full = None
+    K = context.get("K")  # an earlier solve's or load step's: its values array is refilled
     blocks = context.get("blocks")  # None: not decided yet; True: BSR node blocks; False: CSR
     # a problem that fills the free node blocks itself (Model.stiffness_blocks) spares forming
     # the full tangent and copying its free block out of it
@@ -1705,7 +1754,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
                         blocks = context["blocks"] = False
                 if not blocks:
                     K_new = _submatrix(K_full, free, out=K)
-            K = K_new
+            K = context["K"] = K_new
         try:
             rtol = _forcing_term(rnorm, rnorm_prev, eta_prev, threshold)
             eta_prev, rnorm_prev = rtol, rnorm
@@ -1754,7 +1803,9 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
         indefinite, else sparse LU (minimum-degree ordering); non-symmetric: sparse LU.
         ``"cg"``: CG preconditioned by pyamg smoothed aggregation if installed (node blocks and
         rigid-body modes when the free dofs are whole nodes; the hierarchy is reused across
-        Newton iterations) or else by incomplete Cholesky IC(0), falling back to LU; the CG
+        Newton iterations, load steps and successive solves of the same problem, from the same
+        initial coordinates and with the same ``linear_solver``, as long as CG converges fast
+        with it: the problem keeps it, weakly, with the matrix of the Newton systems) or else by incomplete Cholesky IC(0), falling back to LU; the CG
         tolerance follows an inexact-Newton forcing term (loose far from the solution, tight
         near it; the Newton convergence test is unchanged), and a CG run that meets negative
         curvature returns its last iterate under the energy line search (truncated Newton).
@@ -1789,52 +1840,56 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
     residuals: list[list[float]] = []
     loads: list[float] = []
     nominal = 1.0 / load_steps
-    solver_context = _solver_context(problem, x, free)  # AMG hierarchy kept across iterations
-    lam = 0.0
-    dlam = nominal
-    n_cuts = 0
-    cuts_this_step = 0
-    while lam < 1.0 - 1e-14:
-        target = min(1.0, lam + dlam)
-        if 1.0 - target < 1e-12:
-            target = 1.0
-        step_index = len(loads) + 1  # the load step being attempted (1-based, accepted steps + 1)
-        guess = _with_prescribed(problem, x, target)
-        try:
-            x_new, it, hist = _newton(problem, guess, free, target, threshold, max_iter, line_search,
-                                      linear_solver, symmetric, use_energy, messages, progress, step_index,
-                                      solver_context)
-        except _NewtonFailure as exc:
-            if cuts_this_step >= max_cuts:
-                raise ConvergenceError(
-                    f"static_solve did not converge: load step {step_index}, load factor {target:.6g} "
-                    f"(last converged load factor {lam:.6g}, increment {target - lam:.3g} after "
-                    f"{cuts_this_step} halvings), iteration {exc.iteration}, residual {exc.residual:.3e} "
-                    f"(threshold {threshold:.3e} = tol {tol:.1e} x F_ref {scale:.3e}): {exc}",
-                    load_step=step_index, load=target, iteration=exc.iteration, residual=exc.residual,
-                    x_last=x.copy(),
-                ) from None
-            dlam = 0.5 * (target - lam)
-            cuts_this_step += 1
-            n_cuts += 1
-            messages.append(f"load step {step_index} to load {target:.6g} failed at iteration "
-                            f"{exc.iteration} ({exc}); halving the increment to {dlam:.3g}")
-            continue
-        x = x_new
-        lam = target
-        iterations.append(it)
-        residuals.append(hist)
-        loads.append(lam)
-        if cuts_this_step:  # grow back towards the nominal increment
-            dlam = min(nominal, 2.0 * dlam)
+    # AMG hierarchy and matrix kept across iterations, load steps and solves of this problem
+    solver_context = _static_context(problem, x, free, linear_solver)
+    try:
+        lam = 0.0
+        dlam = nominal
+        n_cuts = 0
         cuts_this_step = 0
+        while lam < 1.0 - 1e-14:
+            target = min(1.0, lam + dlam)
+            if 1.0 - target < 1e-12:
+                target = 1.0
+            step_index = len(loads) + 1  # the load step being attempted (1-based, accepted steps + 1)
+            guess = _with_prescribed(problem, x, target)
+            try:
+                x_new, it, hist = _newton(problem, guess, free, target, threshold, max_iter, line_search,
+                                          linear_solver, symmetric, use_energy, messages, progress, step_index,
+                                          solver_context)
+            except _NewtonFailure as exc:
+                if cuts_this_step >= max_cuts:
+                    raise ConvergenceError(
+                        f"static_solve did not converge: load step {step_index}, load factor {target:.6g} "
+                        f"(last converged load factor {lam:.6g}, increment {target - lam:.3g} after "
+                        f"{cuts_this_step} halvings), iteration {exc.iteration}, residual {exc.residual:.3e} "
+                        f"(threshold {threshold:.3e} = tol {tol:.1e} x F_ref {scale:.3e}): {exc}",
+                        load_step=step_index, load=target, iteration=exc.iteration, residual=exc.residual,
+                        x_last=x.copy(),
+                    ) from None
+                dlam = 0.5 * (target - lam)
+                cuts_this_step += 1
+                n_cuts += 1
+                messages.append(f"load step {step_index} to load {target:.6g} failed at iteration "
+                                f"{exc.iteration} ({exc}); halving the increment to {dlam:.3g}")
+                continue
+            x = x_new
+            lam = target
+            iterations.append(it)
+            residuals.append(hist)
+            loads.append(lam)
+            if cuts_this_step:  # grow back towards the nominal increment
+                dlam = min(nominal, 2.0 * dlam)
+            cuts_this_step = 0
 
-    return StaticResult(
-        x=x, converged=True, iterations=iterations, residuals=residuals, loads=loads,
-        wall_time=time.perf_counter() - t_start, n_load_steps=len(loads), n_cuts=n_cuts,
-        force_scale=scale, line_search_merit=merit, messages=messages,
-        cg_iterations=int(solver_context.get("cg_iterations", 0)),
-    )
+        return StaticResult(
+            x=x, converged=True, iterations=iterations, residuals=residuals, loads=loads,
+            wall_time=time.perf_counter() - t_start, n_load_steps=len(loads), n_cuts=n_cuts,
+            force_scale=scale, line_search_merit=merit, messages=messages,
+            cg_iterations=int(solver_context.get("cg_iterations", 0)),
+        )
+    finally:
+        _release_context(solver_context)
 
 
 # --------------------------------------------------------------------------------------------

@@ -832,3 +832,81 @@ def test_compiled_bsr_kernels_equal_dense_products(d, m):
     x = x0.copy()
     S._prolong_add(P.indptr, P.indices, P.data, vc, x)
     np.testing.assert_allclose(x, x0 + Pd @ vc, rtol=0, atol=1e-12 * np.abs(Pd @ vc).max())
+
+
+def _gravity_cube(n, E=1e4):
+    from msslib import mesh as M
+    from msslib import terms as T
+    from msslib.model import Model, golec_cube_springs
+
+    mesh = M.hex_grid(0.1, 0.1, 0.1, n, n, n)
+    masses = M.lumped_masses(mesh, 1000.0)
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    fixed[mesh.points[:, 2] < 1e-12] = True
+    return Model(mesh, golec_cube_springs(mesh, [(E, 0.25)], 1.0) + [T.Gravity(masses, [0, 0, -9.81])],
+                 fixed=fixed, masses=masses)
+
+
+def test_repeated_solves_of_a_problem_keep_the_amg_hierarchy(monkeypatch):
+    """A second solve of the same model starts with the hierarchy and matrix left by the first
+    (no new set-up) and gives the same result; another start, another linear solver or a model
+    whose values changed still solve correctly; the state goes with the model."""
+    import gc
+
+    import msslib.solvers as S
+
+    builds = []
+    original = S._preconditioner
+
+    def counting(A, context=None):
+        builds.append(A.shape)
+        return original(A, context)
+
+    monkeypatch.setattr(S, "_preconditioner", counting)
+    model = _gravity_cube(6)
+    direct = static_solve(model, model.x0, linear_solver="direct", tol=1e-10)  # the reference
+    first = static_solve(model, model.x0, linear_solver="cg", tol=1e-10)
+    assert len(builds) == 1 and first.cg_iterations > 0
+    ctx = S._STATIC_CONTEXTS[model]
+    K = ctx["K"]
+    second = static_solve(model, model.x0, linear_solver="cg", tol=1e-10)
+    assert len(builds) == 1  # kept: CG converged as fast with it
+    assert S._STATIC_CONTEXTS[model] is ctx and ctx["K"] is K  # the matrix refilled in place
+    assert second.cg_iterations == first.cg_iterations
+    scale = np.abs(first.x - model.x0).max()
+    np.testing.assert_allclose(second.x, first.x, rtol=0, atol=1e-9 * scale)
+    np.testing.assert_allclose(second.x, direct.x, rtol=0, atol=1e-7 * scale)
+    # another initial configuration: new context (rigid-body modes of other coordinates)
+    x0 = model.x0 + 1e-4 * np.random.default_rng(1).standard_normal(model.n_dof) * model.free
+    third = static_solve(model, x0, linear_solver="cg", tol=1e-10)
+    assert len(builds) == 2
+    np.testing.assert_allclose(third.x, direct.x, rtol=0, atol=1e-6 * scale)
+    # a state left by a stiffer model's solve: still converges to the right answer
+    soft, stiff = _gravity_cube(6, E=1e4), _gravity_cube(6, E=1e6)
+    static_solve(stiff, stiff.x0, linear_solver="cg", tol=1e-10)
+    S._STATIC_CONTEXTS[soft] = S._STATIC_CONTEXTS[stiff]  # as if the values had changed
+    r = static_solve(soft, soft.x0, linear_solver="cg", tol=1e-10)
+    np.testing.assert_allclose(r.x, direct.x, rtol=0, atol=1e-7 * scale)
+    assert r.residuals[-1][-1] <= 1e-10 * r.force_scale
+    # the state goes with the model
+    n = len(S._STATIC_CONTEXTS)
+    del model, soft, stiff
+    gc.collect()
+    assert len(S._STATIC_CONTEXTS) <= n - 2
+
+
+def test_static_context_in_use_is_not_shared():
+    import msslib.solvers as S
+
+    model = _gravity_cube(3)
+    free = np.asarray(model.free, dtype=bool)
+    a = S._static_context(model, model.x0, free, "cg")
+    b = S._static_context(model, model.x0, free, "cg")  # `a` is in use (another thread)
+    assert b is not a and S._STATIC_CONTEXTS[model] is a
+    S._release_context(a)
+    S._release_context(b)
+    c = S._static_context(model, model.x0, free, "cg")
+    assert c is a
+    S._release_context(c)
+    assert S._static_context(model, model.x0, free, "direct") is not a
+    assert S._static_context(model, model.x0, free, lambda K, b: b) is not a  # user solver: never kept
