@@ -774,7 +774,7 @@ def test_compiled_v_cycle_equals_pyamg_cycle():
     deep = S._compiled_smoothers(pyamg.smoothed_aggregation_solver(A, B=B, **dict(S._SA_OPTIONS, max_coarse=8)))
     assert len(deep.levels) >= 3 and deep.levels[1].A.blocksize == (6, 6)
     for ml in (deep, S._sa_solver(A, B, 3)):
-        cycle = S._VCycle.build(ml)
+        cycle = S._VCycle.build(ml, single=False)
         assert cycle is not None
         ref = ml.aspreconditioner(cycle="V") @ b
         for _ in range(2):  # work vectors are reused: a second application gives the same
@@ -783,6 +783,29 @@ def test_compiled_v_cycle_equals_pyamg_cycle():
         # a symmetric operator (CG needs it)
         c = np.random.default_rng(4).standard_normal(A.shape[0])
         assert abs(c @ (cycle @ b) - b @ (cycle @ c)) <= 1e-10 * abs(c @ (cycle @ b))
+    # single precision on the finest level: the exact V-cycle of the rounded matrix and
+    # prolongator; after update(), of the rounded new matrix
+    ml = S._sa_solver(A, B, 3)
+    cycle = S._VCycle.build(ml, single=True)
+    assert cycle.levels[0]["a_data"].dtype == np.float32 and cycle.levels[0]["p_data"].dtype == np.float32
+    A2 = A.copy()
+    A2.data *= 1.0 + 0.1 * np.random.default_rng(5).random(A2.data.shape[0])[:, None, None]
+    approx = cycle @ b
+    assert cycle.update(A2)
+    updated = cycle @ b
+    assert not cycle.update(A.tocsr()[:30, :30].tobsr(blocksize=(3, 3)))  # another pattern: ignored
+    assert not cycle.update(sp.bsr_matrix(sp.identity(A.shape[0]), blocksize=(3, 3)))  # same shape
+    for mat, z in ((A, approx), (A2, updated)):
+        lvl = ml.levels[0]
+        keep = lvl.A, lvl.P, lvl.R
+        lvl.A = sp.bsr_matrix((mat.data.astype(np.float32).astype(float), mat.indices, mat.indptr), shape=mat.shape)
+        lvl.P = sp.bsr_matrix((keep[1].data.astype(np.float32).astype(float), keep[1].indices, keep[1].indptr),
+                              shape=keep[1].shape)
+        lvl.R = lvl.P.T.tobsr()
+        ref = ml.aspreconditioner(cycle="V") @ b
+        lvl.A, lvl.P, lvl.R = keep
+        np.testing.assert_allclose(z, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    assert np.abs(approx - S._VCycle.build(ml, single=False) @ b).max() <= 1e-5 * np.abs(approx).max()
     # the preconditioner that CG gets is the compiled cycle
     ctx = {"dim": 3, "coords": _lattice_system(8)[2]["coords"]}
     assert isinstance(S._amg_preconditioner(A, ctx), S._VCycle)
