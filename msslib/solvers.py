@@ -1398,7 +1398,7 @@ def _band_is_cheap(A, context):
 def _banded_cholesky_solve(A, b, context):
     """Solve with the banded Cholesky of ``A`` (symmetric, CSR); None when ``A`` is not
     positive definite or its bandwidth is too large (the caller then uses SuperLU)."""
-    from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded, solve_banded
+    from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded, lapack
 
     if A.shape[0] > BAND_PLAN_MAX_DOFS or not (sp.issparse(A) and A.format == "csr" and A.has_canonical_format):
         return None
@@ -1427,11 +1427,25 @@ def _banded_cholesky_solve(A, b, context):
     if y is None:
         if 2.0 * n * (bw + 1.0) * (2 * bw + 1.0) > 2 * BAND_COST_MAX:
             return None
-        ab = np.zeros((2 * bw + 1, n), order="F")
-        ab.reshape(-1, order="F")[plan["dst_full"]] = A.data
-        try:
-            y = solve_banded((bw, bw), ab, bp, overwrite_ab=True, check_finite=False)
-        except (LinAlgError, ValueError):  # exactly singular
+        # LAPACK gbtrf/gbtrs on a band array kept in the context and refilled, with the bw rows
+        # of room for the pivoting fill that gbtrf needs (solve_banded would allocate the band
+        # array and then copy it into a larger one on every call)
+        rows = 3 * bw + 1
+        ab = state.get("band_lu")
+        if ab is None or ab.shape != (rows, n):
+            ab = state["band_lu"] = np.zeros((rows, n), order="F")
+        else:
+            ab.fill(0.0)
+        dst = plan.get("dst_lu")
+        if dst is None:  # general band storage with kl extra rows: ab[2 bw + i - j, j] = A[i, j]
+            full = plan["dst_full"]
+            dst = plan["dst_lu"] = (full // (2 * bw + 1)) * rows + full % (2 * bw + 1) + bw
+        ab.reshape(-1, order="F")[dst] = A.data
+        lu, piv, info = lapack.dgbtrf(ab, bw, bw, overwrite_ab=1)
+        if info != 0:  # exactly singular (info > 0) or bad input
+            return None
+        y, info = lapack.dgbtrs(lu, bw, bw, bp, piv, overwrite_b=1)
+        if info != 0:
             return None
     x = np.empty(n)
     x[perm] = y

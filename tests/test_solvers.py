@@ -489,6 +489,14 @@ def test_banded_direct_solve_matches_dense(shift):
     ref = np.linalg.solve(A.toarray(), b)
     np.testing.assert_allclose(sol, ref, rtol=1e-8, atol=1e-10 * np.abs(ref).max())
     assert bool(ctx.get("band_indefinite")) == (np.linalg.eigvalsh(A.toarray()).min() < 0)
+    # the band arrays kept in the context are refilled for new values of the same pattern
+    A2 = A.copy()
+    A2.data *= np.random.default_rng(1).uniform(0.9, 1.1, A2.nnz)
+    A2 = sp.csr_matrix(0.5 * (A2 + A2.T))
+    A2.sum_duplicates()
+    sol2 = _direct_solve(A2, b, True, ctx)
+    ref2 = np.linalg.solve(A2.toarray(), b)
+    np.testing.assert_allclose(sol2, ref2, rtol=1e-8, atol=1e-10 * np.abs(ref2).max())
 
 
 def test_pcg_converges_and_detects_negative_curvature():
