@@ -701,35 +701,79 @@ def _block_rows_times(dinv, v):
     return out
 
 
-@njit(cache=True, nogil=True)
-def _smooth_tentative(ap_ptr, ap_ind, ap_data, dinv, t_ptr, t_ind, t_data, scale):
-    """``AT <- T + scale D^-1 AT`` in place, block row by block row: ``AT = A T`` (BSR blocks
-    ``(d, m)``), ``dinv`` the inverse diagonal blocks of ``A``, ``T`` the tentative prolongator
-    (at most one block per block row, whose column ``AT`` has since ``A`` has its diagonal).
-    Returns False if a block of ``T`` has no place in ``AT``."""
-    d = ap_data.shape[1]
-    m = ap_data.shape[2]
+@njit(cache=True, nogil=True, fastmath={"contract"})
+def _smoothed_prolongator(a_ptr, a_ind, a_data, dinv, t_ptr, t_ind, t_data, scale, nc, p_ptr, p_ind, p_data):
+    """``P = T + scale D^-1 A T`` block row by block row, with ``A`` BSR (square blocks ``d``),
+    ``dinv`` its inverse diagonal blocks and ``T`` the tentative prolongator (BSR, blocks
+    ``(d, m)``, ``nc`` block columns).  With ``p_ind`` empty, only the block row pointers
+    ``p_ptr`` are filled (the pattern of ``A T``: the coarse blocks of the rows of ``T`` that
+    row ``i`` of ``A`` reaches, sorted); then ``p_ind`` and ``p_data`` are filled.  Returns
+    False when a block of ``T`` has no place in ``A T`` (a row of ``A`` without its diagonal
+    block)."""
+    n = a_ptr.shape[0] - 1
+    d = a_data.shape[1]
+    m = t_data.shape[2]
+    fill = p_ind.shape[0] > 0
+    mark = np.full(nc, -1, dtype=np.int64)
+    slot = np.zeros(nc, dtype=np.int64)
+    ks = np.empty(nc, dtype=np.int64)
+    y = np.empty((nc, d, m))
     tmp = np.empty((d, m))
-    for i in range(ap_ptr.shape[0] - 1):
-        for p in range(ap_ptr[i], ap_ptr[i + 1]):
+    if not fill:
+        p_ptr[0] = 0
+    for i in range(n):
+        nk = 0
+        for q in range(a_ptr[i], a_ptr[i + 1]):
+            j = a_ind[q]
+            for pt in range(t_ptr[j], t_ptr[j + 1]):
+                K = t_ind[pt]
+                if mark[K] != i:
+                    mark[K] = i
+                    ks[nk] = K
+                    nk += 1
+                    if fill:
+                        y[K] = 0.0
+                if fill and d == 3:
+                    Aq = a_data[q]
+                    a00, a01, a02 = Aq[0, 0], Aq[0, 1], Aq[0, 2]
+                    a10, a11, a12 = Aq[1, 0], Aq[1, 1], Aq[1, 2]
+                    a20, a21, a22 = Aq[2, 0], Aq[2, 1], Aq[2, 2]
+                    Tp = t_data[pt]
+                    Y = y[K]
+                    for c in range(m):
+                        t0, t1, t2 = Tp[0, c], Tp[1, c], Tp[2, c]
+                        Y[0, c] += a00 * t0 + a01 * t1 + a02 * t2
+                        Y[1, c] += a10 * t0 + a11 * t1 + a12 * t2
+                        Y[2, c] += a20 * t0 + a21 * t1 + a22 * t2
+                elif fill:
+                    for r in range(d):
+                        for s in range(d):
+                            av = a_data[q, r, s]
+                            for c in range(m):
+                                y[K, r, c] += av * t_data[pt, s, c]
+        for pt in range(t_ptr[i], t_ptr[i + 1]):
+            if mark[t_ind[pt]] != i:
+                return False
+        if not fill:
+            p_ptr[i + 1] = p_ptr[i] + nk
+            continue
+        ksort = np.sort(ks[:nk])
+        base = p_ptr[i]
+        for u in range(nk):
+            K = ksort[u]
+            slot[K] = base + u
+            p_ind[base + u] = K
             for r in range(d):
                 for c in range(m):
                     s = 0.0
                     for q in range(d):
-                        s += dinv[i, r, q] * ap_data[p, q, c]
+                        s += dinv[i, r, q] * y[K, q, c]
                     tmp[r, c] = s
             for r in range(d):
                 for c in range(m):
-                    ap_data[p, r, c] = scale * tmp[r, c]
+                    p_data[base + u, r, c] = scale * tmp[r, c]
         for pt in range(t_ptr[i], t_ptr[i + 1]):
-            found = False
-            for p in range(ap_ptr[i], ap_ptr[i + 1]):
-                if ap_ind[p] == t_ind[pt]:
-                    ap_data[p] += t_data[pt]
-                    found = True
-                    break
-            if not found:
-                return False
+            p_data[slot[t_ind[pt]]] += t_data[pt]
     return True
 
 
@@ -1247,10 +1291,12 @@ def _sa_solver(A, B, dim):
     """pyamg smoothed aggregation on the BSR ``A`` (``dim x dim`` blocks) with near-null space
     ``B``, as ``pyamg.smoothed_aggregation_solver(A, B, **_SA_OPTIONS)`` builds it, except that
     the finest level (by far the largest) is built here with less memory and time: the
-    prolongator ``P = T - (omega / rho) D^-1 A T`` is smoothed in place in ``A T`` (pyamg forms
-    ``D^-1 A`` and its scaled copy, two more matrices of the size of ``A``), and ``rho`` comes
-    from Lanczos in the ``D`` inner product (15 products with ``A``, instead of Arnoldi on
-    ``D^-1 A``).  Coarser levels are pyamg's.  Returns None when ``A`` does not fit (pyamg is then
+    prolongator ``P = T - (omega / rho) D^-1 A T`` is formed block row by block row in one
+    compiled pass (:func:`_smoothed_prolongator`; pyamg forms ``D^-1 A`` and its scaled copy,
+    two more matrices of the size of ``A``, and ``A T`` with scipy's block product), ``rho``
+    comes from Lanczos in the ``D`` inner product (15 products with ``A``, instead of Arnoldi on
+    ``D^-1 A``), and the coarse matrix from the compiled :func:`_galerkin`.  Coarser levels are
+    pyamg's.  Returns None when ``A`` does not fit (pyamg is then
     used as is)."""
     from pyamg.aggregation import fit_candidates, standard_aggregation
     from pyamg.multilevel import MultilevelSolver
@@ -1273,12 +1319,17 @@ def _sa_solver(A, B, dim):
     rho = _block_jacobi_radius(A, dinv)
     if not (np.isfinite(rho) and rho > 0):
         return None
-    P = A @ T
-    if P.format != "bsr" or P.blocksize != (dim, B.shape[1]):
-        P = P.tobsr(blocksize=(dim, B.shape[1]))
     omega = _SA_OPTIONS["smooth"][1]["omega"]
-    if not _smooth_tentative(P.indptr, P.indices, P.data, dinv, T.indptr, T.indices, T.data, -omega / rho):
+    m, nc = B.shape[1], T.shape[1] // B.shape[1]
+    p_ptr = np.empty(A.indptr.shape[0], dtype=np.int64)
+    args = (A.indptr, A.indices, A.data, dinv, T.indptr, T.indices, T.data, -omega / rho, nc, p_ptr)
+    if not _smoothed_prolongator(*args, np.empty(0, dtype=np.int64), np.empty((0, dim, m))):
         return None
+    p_ind = np.empty(p_ptr[-1], dtype=A.indices.dtype)
+    p_data = np.empty((p_ptr[-1], dim, m))
+    _smoothed_prolongator(*args, p_ind, p_data)
+    P = sp.bsr_matrix((p_data, p_ind, p_ptr.astype(A.indices.dtype)), shape=(A.shape[0], T.shape[1]), copy=False)
+    P.has_sorted_indices = True
     R = P.T
     A_c = _galerkin(A, P)
     A_c.symmetry = "symmetric"

@@ -941,3 +941,35 @@ def test_static_context_in_use_is_not_shared():
     S._release_context(c)
     assert S._static_context(model, model.x0, free, "direct") is not a
     assert S._static_context(model, model.x0, free, lambda K, b: b) is not a  # user solver: never kept
+
+
+@pytest.mark.parametrize("d,m", [(3, 6), (2, 3)])
+def test_smoothed_prolongator_equals_the_dense_formula(d, m):
+    import msslib.solvers as S
+
+    rng = np.random.default_rng(d + m)
+    nb, nc = 30, 8
+    pattern = sp.random(nb, nb, 0.2, random_state=d, format="csr") + sp.eye(nb)
+    pattern = (pattern + pattern.T).tocsr()
+    M = sp.kron(pattern, np.ones((d, d))).toarray() * rng.standard_normal((nb * d, nb * d))
+    M = M + M.T + 4 * d * np.eye(nb * d)
+    A = sp.bsr_matrix(M, blocksize=(d, d))
+    A.sort_indices()
+    agg = rng.integers(0, nc, nb)
+    agg[:nc] = np.arange(nc)
+    agg[5] = -1  # a node in no aggregate: an empty row of T
+    Td = np.zeros((nb * d, nc * m))
+    for i, a in enumerate(agg):
+        if a >= 0:
+            Td[i * d:(i + 1) * d, a * m:(a + 1) * m] = rng.standard_normal((d, m))
+    T = sp.bsr_matrix(Td, blocksize=(d, m))
+    dinv = S._block_diag_inverse(A.indptr, A.indices, A.data)
+    p_ptr = np.empty(nb + 1, dtype=np.int64)
+    args = (A.indptr, A.indices, A.data, dinv, T.indptr, T.indices, T.data, -0.3, nc, p_ptr)
+    assert S._smoothed_prolongator(*args, np.empty(0, dtype=np.int64), np.empty((0, d, m)))
+    p_ind, p_data = np.empty(p_ptr[-1], dtype=np.int64), np.empty((p_ptr[-1], d, m))
+    assert S._smoothed_prolongator(*args, p_ind, p_data)
+    P = sp.bsr_matrix((p_data, p_ind, p_ptr), shape=Td.shape)
+    ref = Td - 0.3 * sp.block_diag(list(dinv)).toarray() @ M @ Td
+    np.testing.assert_allclose(P.toarray(), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    assert all(np.all(np.diff(p_ind[p_ptr[i]:p_ptr[i + 1]]) > 0) for i in range(nb))  # sorted rows
