@@ -1330,7 +1330,7 @@ def _sa_solver(A, B, dim):
     _smoothed_prolongator(*args, p_ind, p_data)
     P = sp.bsr_matrix((p_data, p_ind, p_ptr.astype(A.indices.dtype)), shape=(A.shape[0], T.shape[1]), copy=False)
     P.has_sorted_indices = True
-    R = P.T
+    R = _LazyTranspose(P)  # the compiled V-cycle needs no R; pyamg's cycle gets it on first use
     A_c = _galerkin(A, P)
     A_c.symmetry = "symmetric"
     coarse = pyamg.smoothed_aggregation_solver(A_c.tobsr(blocksize=(B.shape[1], B.shape[1])), B=B_c, **_SA_OPTIONS)
@@ -1341,6 +1341,25 @@ def _sa_solver(A, B, dim):
     change_smoothers(ml, [(pre[0], dict(pre[1], Dinv=dinv))] + [pre] * (len(ml.levels) - 2),
                      [(post[0], dict(post[1], Dinv=dinv))] + [post] * (len(ml.levels) - 2))
     return _compiled_smoothers(ml, dinv)
+
+
+class _LazyTranspose:
+    """``P^T`` as pyamg's restriction ``R``, formed on the first product (the compiled V-cycle
+    restricts with ``P`` itself: no transposed copy of the finest prolongator is made)."""
+
+    def __init__(self, P):
+        self.P = P
+        self.shape = (P.shape[1], P.shape[0])
+        self.dtype = P.dtype
+        self._T = None
+
+    def __matmul__(self, v):
+        if self._T is None:
+            self._T = self.P.T.tobsr()
+        return self._T @ v
+
+    def tocsr(self):
+        return self.P.T.tocsr()
 
 
 def _amg_preconditioner(A, context):

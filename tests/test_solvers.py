@@ -796,6 +796,8 @@ def test_compiled_v_cycle_equals_pyamg_cycle():
     ml = S._sa_solver(A, B, 3)
     cycle = S._VCycle.build(ml, single=True)
     assert cycle.levels[0]["a_data"].dtype == np.float32 and cycle.levels[0]["p_data"].dtype == np.float32
+    v = np.random.default_rng(6).standard_normal(A.shape[0])
+    np.testing.assert_allclose(ml.levels[0].R @ v, ml.levels[0].P.T @ v, rtol=1e-14, atol=0)  # lazy R
     A2 = A.copy()
     A2.data *= 1.0 + 0.1 * np.random.default_rng(5).random(A2.data.shape[0])[:, None, None]
     approx = cycle @ b
