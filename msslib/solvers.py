@@ -1800,11 +1800,13 @@ def _forcing_term(rnorm, rnorm_prev, eta_prev, threshold):
     return float(min(_ETA_MAX, max(eta, 0.1 * threshold / rnorm, 1e-10)))
 
 
-def _wants_blocks(full_tangent, free, method, symmetric, context):
+def _wants_blocks(full_tangent, free, method, symmetric, context, block_tangent=None):
     """Whether the Newton systems go to AMG-CG as BSR node blocks: symmetric, whole free nodes,
     and CG chosen (``"cg"``, or ``"auto"`` above the size where the banded Cholesky is tried,
     or between ``ITERATIVE_THRESHOLD`` and it when the band is too wide).  ``full_tangent()``
-    gives the full stiffness when the decision needs its pattern (mid sizes only)."""
+    gives the full stiffness when the decision needs its pattern (mid sizes only);
+    ``block_tangent()`` (optional) the free node blocks or None: when their graph alone shows
+    the band too wide, the full tangent is not formed."""
     if not (symmetric and method in ("auto", "cg") and context.get("dim") and "node_free" in context):
         return False
     n = int(free.sum())
@@ -1812,6 +1814,9 @@ def _wants_blocks(full_tangent, free, method, symmetric, context):
         return True
     if n <= ITERATIVE_THRESHOLD:
         return False
+    Kb = block_tangent() if block_tangent is not None else None
+    if Kb is not None and _band_surely_wide({"bptr": Kb.indptr, "bind": Kb.indices}, context["dim"]):
+        return True
     K_full = full_tangent()
     entry = _bsr_entry(K_full, context["node_free"], context["dim"])
     if entry is not None and _band_surely_wide(entry, context["dim"]):
@@ -1855,12 +1860,20 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
             raise fail(f"no convergence in {max_iter} iterations")
         it += 1
         with np.errstate(all="ignore"):
+            filled = {}
             if blocks is None:
+                def block_tangent():
+                    if direct_blocks and "node_free" in context:
+                        filled["K"] = problem.stiffness_blocks(x, load, out=K, node_free=context["node_free"])
+                    return filled.get("K")
+
                 blocks = context["blocks"] = _wants_blocks(lambda: problem.stiffness(x, load), free,
-                                                           linear_solver, symmetric, context)
+                                                           linear_solver, symmetric, context, block_tangent)
             K_new = None
             if blocks and direct_blocks:
-                K_new = problem.stiffness_blocks(x, load, out=K, node_free=context["node_free"])
+                K_new = filled.get("K")  # filled for the decision already
+                if K_new is None:
+                    K_new = problem.stiffness_blocks(x, load, out=K, node_free=context["node_free"])
                 if K_new is None:
                     direct_blocks = context["direct_blocks"] = False
             if K_new is None:

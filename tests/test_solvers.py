@@ -975,3 +975,32 @@ def test_smoothed_prolongator_equals_the_dense_formula(d, m):
     ref = Td - 0.3 * sp.block_diag(list(dinv)).toarray() @ M @ Td
     np.testing.assert_allclose(P.toarray(), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
     assert all(np.all(np.diff(p_ind[p_ptr[i]:p_ptr[i + 1]]) > 0) for i in range(nb))  # sorted rows
+
+
+def test_mid_size_decision_from_the_node_blocks_forms_no_full_tangent(monkeypatch):
+    """Between ITERATIVE_THRESHOLD and BAND_PLAN_MAX_DOFS, "auto" decides from the graph of the
+    free node blocks when that shows the band too wide: no full tangent is formed, and the
+    blocks filled for the decision are the first Newton matrix."""
+    import msslib.solvers as S
+
+    model = _gravity_cube(13)  # 7,644 free dofs: banded Cholesky surely too wide
+    n = int(model.free.sum())
+    assert S.ITERATIVE_THRESHOLD < n <= S.BAND_PLAN_MAX_DOFS
+    calls = {"blocks": 0, "full": 0}
+    blocks, full = model.stiffness_blocks, model.stiffness
+
+    def count(name, fn):
+        def wrapped(*a, **kw):
+            calls[name] += 1
+            return fn(*a, **kw)
+        return wrapped
+
+    monkeypatch.setattr(model, "stiffness_blocks", count("blocks", blocks))
+    monkeypatch.setattr(model, "stiffness", count("full", full))
+    r = static_solve(model, model.x0)
+    assert r.cg_iterations > 0
+    assert calls == {"blocks": r.total_iterations, "full": 0}
+    monkeypatch.setattr(model, "stiffness_blocks", blocks)
+    monkeypatch.setattr(model, "stiffness", full)
+    ref = static_solve(model, model.x0, linear_solver="direct")
+    np.testing.assert_allclose(r.x, ref.x, rtol=0, atol=1e-7 * np.abs(ref.x - model.x0).max())
