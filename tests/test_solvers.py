@@ -1004,3 +1004,33 @@ def test_mid_size_decision_from_the_node_blocks_forms_no_full_tangent(monkeypatc
     monkeypatch.setattr(model, "stiffness", full)
     ref = static_solve(model, model.x0, linear_solver="direct")
     np.testing.assert_allclose(r.x, ref.x, rtol=0, atol=1e-7 * np.abs(ref.x - model.x0).max())
+
+
+@pytest.mark.parametrize("d", [3, 2, 6])
+def test_block_diagonal_and_its_inverse(d):
+    import msslib.solvers as S
+
+    rng = np.random.default_rng(d)
+    nb = 12
+    blocks = rng.standard_normal((nb, d, d))
+    blocks = blocks @ blocks.transpose(0, 2, 1) + 0.1 * np.eye(d)  # SPD, some ill-conditioned
+    blocks[4] *= 1e9
+    M = sp.block_diag(list(blocks)).tolil()
+    M[0, d * 3] = 1.0  # an off-diagonal block
+    A = sp.bsr_matrix(M.tocsr(), blocksize=(d, d))
+    A.sort_indices()
+    dinv = S._block_diag_inverse(A.indptr, A.indices, A.data)
+    ref = np.linalg.inv(blocks)
+    for i in range(nb):
+        np.testing.assert_allclose(dinv[i], ref[i], rtol=1e-9 * np.linalg.cond(blocks[i]) * 1e-3,
+                                   atol=1e-12 * np.abs(ref[i]).max())
+    np.testing.assert_array_equal(S._block_diag(A.indptr, A.indices, A.data), blocks)
+    singular = blocks.copy()
+    singular[2] = np.outer(np.arange(1.0, d + 1), np.arange(1.0, d + 1))  # rank one
+    B = sp.bsr_matrix(sp.block_diag(list(singular)).tocsr(), blocksize=(d, d))
+    with pytest.raises(np.linalg.LinAlgError):
+        S._block_diag_inverse(B.indptr, B.indices, B.data)
+    # a missing diagonal block: NaN inverse, zero block
+    C = sp.bsr_matrix((blocks[:2], np.array([1, 0]), np.array([0, 1, 2])), shape=(2 * d, 2 * d))
+    assert np.isnan(S._block_diag_inverse(C.indptr, C.indices, C.data)).all()
+    assert not S._block_diag(C.indptr, C.indices, C.data).any()
