@@ -1572,8 +1572,10 @@ def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10, t
     """Solve ``A x = b``; raise _NewtonFailure when the matrix is singular or the solve fails.
 
     ``context`` (optional dict) holds ``dim`` and ``coords`` (free nodes) for the AMG near-null
-    space and a ``cache`` where the AMG hierarchy is kept and reused for the next matrices of the
-    same solve (Newton iterations, time steps) as long as CG converges fast with it.  ``rtol`` is
+    space and a ``cache`` where the AMG hierarchy is kept and reused for the next matrices
+    (Newton iterations, load steps, later static solves of the same problem, time steps) as long
+    as CG converges fast with it; a kept compiled V-cycle smooths with each new matrix's values
+    (:meth:`_VCycle.update`).  ``rtol`` is
     the CG tolerance (relative to ``||b||``).  With ``truncate``, a CG run that meets negative
     curvature returns its last iterate (truncated Newton: used under an energy line search)
     instead of falling back to sparse LU."""
