@@ -711,6 +711,22 @@ def test_compiled_block_gauss_seidel_sweeps_equal_pyamg(d):
         _BlockGaussSeidel(dinv, True)(A, np.zeros((nb * d, 1)), b)
 
 
+def _count_tangent_fills(monkeypatch, model):
+    """Count the calls of ``model.stiffness_blocks`` ("blocks") and ``model.stiffness``
+    ("full"); returns the live dict of counts."""
+    calls = {"blocks": 0, "full": 0}
+
+    def count(name, fn):
+        def wrapped(*a, **kw):
+            calls[name] += 1
+            return fn(*a, **kw)
+        return wrapped
+
+    monkeypatch.setattr(model, "stiffness_blocks", count("blocks", model.stiffness_blocks))
+    monkeypatch.setattr(model, "stiffness", count("full", model.stiffness))
+    return calls
+
+
 def test_model_newton_systems_filled_as_free_node_blocks(monkeypatch):
     """With CG, a Model's Newton systems come from ``stiffness_blocks`` (no full tangent is
     formed); the solution equals the direct solve's."""
@@ -724,17 +740,7 @@ def test_model_newton_systems_filled_as_free_node_blocks(monkeypatch):
     fixed[mesh.points[:, 0] < 1e-12] = True
     model = Model(mesh, golec_cube_springs(mesh, [(1e3, 0.3)], 1.0) + [T.Gravity(masses, [0, 0, -9.81])],
                   fixed=fixed)
-    calls = {"blocks": 0, "full": 0}
-    blocks, full = model.stiffness_blocks, model.stiffness
-
-    def count(name, fn):
-        def wrapped(*a, **kw):
-            calls[name] += 1
-            return fn(*a, **kw)
-        return wrapped
-
-    monkeypatch.setattr(model, "stiffness_blocks", count("blocks", blocks))
-    monkeypatch.setattr(model, "stiffness", count("full", full))
+    calls = _count_tangent_fills(monkeypatch, model)
     iterative = static_solve(model, model.x0, linear_solver="cg", tol=1e-10)
     assert calls == {"blocks": iterative.total_iterations, "full": 0}
     direct = static_solve(model, model.x0, linear_solver="direct", tol=1e-10)
@@ -824,18 +830,25 @@ def test_compiled_v_cycle_equals_pyamg_cycle():
     assert S._VCycle.build(plain) is None
 
 
-@pytest.mark.parametrize("d,m", [(3, 3), (3, 6), (6, 6), (2, 2)])
-def test_compiled_bsr_kernels_equal_dense_products(d, m):
-    import msslib.solvers as S
-
-    rng = np.random.default_rng(d * 10 + m)
-    nb, nc = 30, 12
+def _random_spd_bsr(nb, d, rng):
+    """A random symmetric positive definite BSR matrix of nb x nb blocks of size d (sparse block
+    pattern, sorted indices, diagonally dominant) and its dense array."""
     pattern = sp.random(nb, nb, 0.2, random_state=d, format="csr") + sp.eye(nb)
     pattern = (pattern + pattern.T).tocsr()
     M = sp.kron(pattern, np.ones((d, d))).toarray() * rng.standard_normal((nb * d, nb * d))
     M = M + M.T + 4 * d * np.eye(nb * d)
     A = sp.bsr_matrix(M, blocksize=(d, d))
     A.sort_indices()
+    return A, M
+
+
+@pytest.mark.parametrize("d,m", [(3, 3), (3, 6), (6, 6), (2, 2)])
+def test_compiled_bsr_kernels_equal_dense_products(d, m):
+    import msslib.solvers as S
+
+    rng = np.random.default_rng(d * 10 + m)
+    nb, nc = 30, 12
+    A, M = _random_spd_bsr(nb, d, rng)
     Pd = sp.kron(sp.random(nb, nc, 0.3, random_state=m, format="csr"), np.ones((d, m))).toarray()
     Pd *= rng.standard_normal(Pd.shape)
     P = sp.bsr_matrix(Pd, blocksize=(d, m))
@@ -951,12 +964,7 @@ def test_smoothed_prolongator_equals_the_dense_formula(d, m):
 
     rng = np.random.default_rng(d + m)
     nb, nc = 30, 8
-    pattern = sp.random(nb, nb, 0.2, random_state=d, format="csr") + sp.eye(nb)
-    pattern = (pattern + pattern.T).tocsr()
-    M = sp.kron(pattern, np.ones((d, d))).toarray() * rng.standard_normal((nb * d, nb * d))
-    M = M + M.T + 4 * d * np.eye(nb * d)
-    A = sp.bsr_matrix(M, blocksize=(d, d))
-    A.sort_indices()
+    A, M = _random_spd_bsr(nb, d, rng)
     agg = rng.integers(0, nc, nb)
     agg[:nc] = np.arange(nc)
     agg[5] = -1  # a node in no aggregate: an empty row of T
@@ -986,22 +994,11 @@ def test_mid_size_decision_from_the_node_blocks_forms_no_full_tangent(monkeypatc
     model = _gravity_cube(13)  # 7,644 free dofs: banded Cholesky surely too wide
     n = int(model.free.sum())
     assert S.ITERATIVE_THRESHOLD < n <= S.BAND_PLAN_MAX_DOFS
-    calls = {"blocks": 0, "full": 0}
-    blocks, full = model.stiffness_blocks, model.stiffness
-
-    def count(name, fn):
-        def wrapped(*a, **kw):
-            calls[name] += 1
-            return fn(*a, **kw)
-        return wrapped
-
-    monkeypatch.setattr(model, "stiffness_blocks", count("blocks", blocks))
-    monkeypatch.setattr(model, "stiffness", count("full", full))
+    calls = _count_tangent_fills(monkeypatch, model)
     r = static_solve(model, model.x0)
     assert r.cg_iterations > 0
     assert calls == {"blocks": r.total_iterations, "full": 0}
-    monkeypatch.setattr(model, "stiffness_blocks", blocks)
-    monkeypatch.setattr(model, "stiffness", full)
+    monkeypatch.undo()  # the model's own fills again
     ref = static_solve(model, model.x0, linear_solver="direct")
     np.testing.assert_allclose(r.x, ref.x, rtol=0, atol=1e-7 * np.abs(ref.x - model.x0).max())
 
