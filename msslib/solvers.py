@@ -735,6 +735,49 @@ def _block_rows_times(dinv, v):
     return out
 
 
+@njit(inline="always", nogil=True, fastmath={"contract"})
+def _row_times(a_ptr, a_ind, a_data, i, t_ptr, t_ind, t_data, mark, ks, y, values):
+    """Block row ``i`` of ``A T`` (``A`` BSR with square blocks ``d``, ``T`` BSR with blocks
+    ``(d, m)``) into the dense accumulator ``y[K]`` over the block columns ``K`` it reaches,
+    listed in ``ks`` (first ``nk`` entries, unsorted; ``mark[K] == i`` marks them).  Returns
+    ``nk``.  With ``values`` False only the block columns are found.  3 x 3 blocks of ``A`` have
+    unrolled loops."""
+    d = a_data.shape[1]
+    m = t_data.shape[2]
+    nk = 0
+    for q in range(a_ptr[_U(i)], a_ptr[_U(i + 1)]):
+        j = a_ind[_U(q)]
+        for pt in range(t_ptr[_U(j)], t_ptr[_U(j + 1)]):
+            K = t_ind[_U(pt)]
+            if mark[_U(K)] != i:
+                mark[_U(K)] = i
+                ks[nk] = K
+                nk += 1
+                if values:
+                    y[_U(K)] = 0.0
+            if not values:
+                continue
+            if d == 3:
+                Aq = a_data[_U(q)]
+                a00, a01, a02 = Aq[0, 0], Aq[0, 1], Aq[0, 2]
+                a10, a11, a12 = Aq[1, 0], Aq[1, 1], Aq[1, 2]
+                a20, a21, a22 = Aq[2, 0], Aq[2, 1], Aq[2, 2]
+                Tp = t_data[_U(pt)]
+                Y = y[_U(K)]
+                for c in range(m):
+                    t0, t1, t2 = Tp[0, c], Tp[1, c], Tp[2, c]
+                    Y[0, c] += a00 * t0 + a01 * t1 + a02 * t2
+                    Y[1, c] += a10 * t0 + a11 * t1 + a12 * t2
+                    Y[2, c] += a20 * t0 + a21 * t1 + a22 * t2
+            else:
+                for r in range(d):
+                    for s in range(d):
+                        av = a_data[_U(q), r, s]
+                        for c in range(m):
+                            y[_U(K), r, c] += av * t_data[_U(pt), s, c]
+    return nk
+
+
 @njit(cache=True, nogil=True, fastmath={"contract"})
 def _smoothed_prolongator(a_ptr, a_ind, a_data, dinv, t_ptr, t_ind, t_data, scale, nc, p_ptr, p_ind, p_data):
     """``P = T + scale D^-1 A T`` block row by block row, with ``A`` BSR (square blocks ``d``),
@@ -756,35 +799,7 @@ def _smoothed_prolongator(a_ptr, a_ind, a_data, dinv, t_ptr, t_ind, t_data, scal
     if not fill:
         p_ptr[0] = 0
     for i in range(n):
-        nk = 0
-        for q in range(a_ptr[i], a_ptr[i + 1]):
-            j = a_ind[q]
-            for pt in range(t_ptr[j], t_ptr[j + 1]):
-                K = t_ind[pt]
-                if mark[K] != i:
-                    mark[K] = i
-                    ks[nk] = K
-                    nk += 1
-                    if fill:
-                        y[K] = 0.0
-                if fill and d == 3:
-                    Aq = a_data[q]
-                    a00, a01, a02 = Aq[0, 0], Aq[0, 1], Aq[0, 2]
-                    a10, a11, a12 = Aq[1, 0], Aq[1, 1], Aq[1, 2]
-                    a20, a21, a22 = Aq[2, 0], Aq[2, 1], Aq[2, 2]
-                    Tp = t_data[pt]
-                    Y = y[K]
-                    for c in range(m):
-                        t0, t1, t2 = Tp[0, c], Tp[1, c], Tp[2, c]
-                        Y[0, c] += a00 * t0 + a01 * t1 + a02 * t2
-                        Y[1, c] += a10 * t0 + a11 * t1 + a12 * t2
-                        Y[2, c] += a20 * t0 + a21 * t1 + a22 * t2
-                elif fill:
-                    for r in range(d):
-                        for s in range(d):
-                            av = a_data[q, r, s]
-                            for c in range(m):
-                                y[K, r, c] += av * t_data[pt, s, c]
+        nk = _row_times(a_ptr, a_ind, a_data, i, t_ptr, t_ind, t_data, mark, ks, y, fill)
         for pt in range(t_ptr[i], t_ptr[i + 1]):
             if mark[t_ind[pt]] != i:
                 return False
@@ -1219,36 +1234,7 @@ def _galerkin_numeric(a_ptr, a_ind, a_data, p_ptr, p_ind, p_data, c_ptr, c_ind, 
     colpos = np.zeros(nc, dtype=np.int64)
     y = np.empty((nc, d, m))
     for i in range(n):
-        nk = 0
-        for q in range(a_ptr[_U(i)], a_ptr[_U(i + 1)]):
-            j = a_ind[_U(q)]
-            for pp in range(p_ptr[_U(j)], p_ptr[_U(j + 1)]):
-                K = p_ind[_U(pp)]
-                if mark[_U(K)] != i:
-                    mark[_U(K)] = i
-                    ks[nk] = K
-                    nk += 1
-                    for r in range(d):
-                        for c in range(m):
-                            y[_U(K), r, c] = 0.0
-                if d == 3:
-                    Aq = a_data[_U(q)]
-                    a00, a01, a02 = Aq[0, 0], Aq[0, 1], Aq[0, 2]
-                    a10, a11, a12 = Aq[1, 0], Aq[1, 1], Aq[1, 2]
-                    a20, a21, a22 = Aq[2, 0], Aq[2, 1], Aq[2, 2]
-                    Pp = p_data[_U(pp)]
-                    Y = y[_U(K)]
-                    for c in range(m):
-                        p0, p1, p2 = Pp[0, c], Pp[1, c], Pp[2, c]
-                        Y[0, c] += a00 * p0 + a01 * p1 + a02 * p2
-                        Y[1, c] += a10 * p0 + a11 * p1 + a12 * p2
-                        Y[2, c] += a20 * p0 + a21 * p1 + a22 * p2
-                else:
-                    for r in range(d):
-                        for s in range(d):
-                            a = a_data[_U(q), r, s]
-                            for c in range(m):
-                                y[_U(K), r, c] += a * p_data[_U(pp), s, c]
+        nk = _row_times(a_ptr, a_ind, a_data, i, p_ptr, p_ind, p_data, mark, ks, y, True)
         for pp in range(p_ptr[_U(i)], p_ptr[_U(i + 1)]):
             J = p_ind[_U(pp)]
             for t in range(c_ptr[_U(J)], c_ptr[_U(J + 1)]):
