@@ -1957,9 +1957,10 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
         rigid-body modes when the free dofs are whole nodes; the hierarchy is reused across
         Newton iterations, load steps and successive solves of the same problem, from the same
         initial coordinates and with the same ``linear_solver``, as long as CG converges fast
-        with it: the problem keeps it, weakly, with the matrix of the Newton systems) or else by incomplete Cholesky IC(0), falling back to LU; the CG
-        tolerance follows an inexact-Newton forcing term (loose far from the solution, tight
-        near it; the Newton convergence test is unchanged), and a CG run that meets negative
+        with it: the problem keeps it, weakly, with the matrix of the Newton systems) or else
+        by incomplete Cholesky IC(0), falling back to LU; the CG tolerance follows an
+        inexact-Newton forcing term (loose far from the solution, tight near it; the Newton
+        convergence test is unchanged), and a CG run that meets negative
         curvature returns its last iterate under the energy line search (truncated Newton).
         ``"auto"``: direct up to ``ITERATIVE_THRESHOLD`` = 2 000 free dofs or while the banded
         Cholesky is cheap (``n (b + 1)^2 <= BAND_AUTO_COST``), else CG for symmetric systems.
