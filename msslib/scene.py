@@ -102,12 +102,20 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     of :func:`msslib.solvers.static_solve` for MSS, :func:`msslib.fem.solve_nonlinear` for the
     non-linear FEM; ``fem_linear`` ignores them), or ``{type: dynamic, method:
     symplectic_euler | velocity_verlet | implicit_euler, dt: 1.0e-4, t_end: 0.1, damping: 0.0,
-    save_every: 1}`` (MSS only, :func:`msslib.solvers.integrate` from rest; ``damping`` is a
-    mass-proportional ``alpha`` (1/s) or a Rayleigh pair ``[alpha, beta]``).
+    save_every: 1, allow_unstable: false}`` (MSS only, :func:`msslib.solvers.integrate` from rest;
+    ``damping`` is a mass-proportional ``alpha`` (1/s) or a Rayleigh pair ``[alpha, beta]``).  An
+    explicit step above the stability limit of the model at rest is refused with both numbers
+    unless ``allow_unstable: true``.
 ``output``
     ``{vtu: false, history: true}``: ``vtu: true`` also writes a VTU file next to the NetCDF result
     (same name, suffix ``.vtu``), a string names that file (relative to the result's directory);
     ``history: false`` drops the stored states of a dynamic run.
+``checks``
+    ``{inverted: warn, coincident_nodes: merge, max_memory_gb: null}``: ``inverted: error`` turns
+    inverted or collapsed cells in the final (or a saved) state from a warning recorded in the
+    result into an error; ``coincident_nodes: error`` refuses a mesh with coincident nodes instead
+    of merging them (with a message naming them); ``max_memory_gb`` caps the memory a run may plan
+    to use (default: the memory available on the machine).
 
 Result
 ------
@@ -177,7 +185,10 @@ METHODS = ("symplectic_euler", "velocity_verlet", "implicit_euler")
 AXES = ("x", "y", "z")
 
 _TOP_KEYS = ("name", "description", "geometry", "materials", "regions", "thickness", "model", "boundary",
-             "loads", "solver", "output")
+             "loads", "solver", "output", "checks")
+
+#: what ``checks.inverted`` and ``checks.coincident_nodes`` may say
+CHECK_CHOICES = {"inverted": ("warn", "error"), "coincident_nodes": ("merge", "error")}
 
 
 # --------------------------------------------------------------------------------------------
@@ -216,6 +227,7 @@ class Scene:
     loads: list[dict] = field(default_factory=list)
     solver: dict = field(default_factory=dict)
     output: dict = field(default_factory=dict)
+    checks: dict = field(default_factory=lambda: dict(_DEFAULT_CHECKS))  # see "checks" above
     text: str = ""
     path: Path | None = None
 
@@ -619,7 +631,8 @@ def _solver(path, value, model):
             "tol": _number(f"{path}.tol", value.get("tol", 1e-8), low=0.0),
             "max_iter": _integer(f"{path}.max_iter", value.get("max_iter", 50 if model in MSS_MODELS else 30)),
         }
-    _mapping(path, value, ("type", "method", "dt", "t_end", "damping", "save_every"), required=("dt", "t_end"))
+    _mapping(path, value, ("type", "method", "dt", "t_end", "damping", "save_every", "allow_unstable"),
+             required=("dt", "t_end"))
     if model in FEM_MODELS:
         _fail(f"{path}.type", f"dynamic runs need an MSS model; {model} is static only")
     damping = value.get("damping", 0.0)
@@ -636,6 +649,7 @@ def _solver(path, value, model):
         "t_end": _number(f"{path}.t_end", value["t_end"], low=0.0),
         "damping": damping,
         "save_every": _integer(f"{path}.save_every", value.get("save_every", 1)),
+        "allow_unstable": _boolean(f"{path}.allow_unstable", value.get("allow_unstable", False)),
     }
 
 
@@ -646,6 +660,21 @@ def _output(path, value):
     if not isinstance(vtu, (bool, str)) or vtu == "":
         _fail(f"{path}.vtu", f"expected true, false or a file name, got {vtu!r}")
     return {"vtu": vtu, "history": _boolean(f"{path}.history", value.get("history", True))}
+
+
+_DEFAULT_CHECKS = {"inverted": "warn", "coincident_nodes": "merge", "max_memory_gb": None}
+
+
+def _checks(path, value):
+    value = {} if value is None else value
+    _mapping(path, value, tuple(_DEFAULT_CHECKS))
+    out = dict(_DEFAULT_CHECKS)
+    for key, choices in CHECK_CHOICES.items():
+        if key in value:
+            out[key] = _choice(f"{path}.{key}", value[key], choices, key.replace("_", " ") + " policy")
+    if value.get("max_memory_gb") is not None:
+        out["max_memory_gb"] = _number(f"{path}.max_memory_gb", value["max_memory_gb"], low=0.0)
+    return out
 
 
 def load_scene(source, *, base_dir=None) -> Scene:
@@ -697,6 +726,7 @@ def load_scene(source, *, base_dir=None) -> Scene:
     loads = _loads(f"{root}.loads", raw.get("loads"))
     solver = _solver(f"{root}.solver", raw.get("solver"), model)
     output = _output(f"{root}.output", raw.get("output"))
+    checks = _checks(f"{root}.checks", raw.get("checks"))
     needs_density = solver["type"] == "dynamic" or any(l["type"] == "gravity" for l in loads)
     if needs_density:
         for i, m in enumerate(materials):
@@ -705,7 +735,7 @@ def load_scene(source, *, base_dir=None) -> Scene:
                 _fail(f"{root}.materials[{i}].density", f"required for {why}")
     return Scene(name=name, description=description, geometry=geometry, materials=materials, model=model,
                  model_options=options, regions=regions, thickness=thickness, boundary=boundary, loads=loads,
-                 solver=solver, output=output, text=text, path=path)
+                 solver=solver, output=output, checks=checks, text=text, path=path)
 
 
 def _plain(value):
