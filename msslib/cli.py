@@ -331,15 +331,29 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     """Entry point; returns the exit code (0 ok, 1 error, 2 usage)."""
+    import warnings
+
+    from msslib.errors import MsslibWarning, UnphysicalStateError
     from msslib.solvers import ConvergenceError, DivergenceError
 
     parser = build_parser()
     args = parser.parse_args(argv)
+    previous = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, MsslibWarning):
+            print(f"msslib: warning: {_one_line(message)}", file=sys.stderr)
+        else:
+            previous(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
     try:
         return int(args.func(args) or 0)
-    except (CommandError, ValueError, OSError, ConvergenceError, DivergenceError) as exc:
+    except (CommandError, ValueError, OSError, ConvergenceError, DivergenceError, UnphysicalStateError) as exc:
         print(f"msslib: error: {_one_line(exc)}", file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("msslib: interrupted", file=sys.stderr)
         return 130
+    finally:
+        warnings.showwarning = previous
