@@ -677,6 +677,38 @@ def _checks(path, value):
     return out
 
 
+def _saved_states(solver, output) -> float:
+    """How many states a dynamic run stores (0 for statics or without history)."""
+    if solver["type"] != "dynamic" or not output["history"]:
+        return 0.0
+    n_steps = math.ceil(solver["t_end"] / solver["dt"] - 1e-9) if solver["t_end"] > 0 else 0
+    return float(n_steps // solver["save_every"] + 2)
+
+
+def _check_size(root, geometry, model, solver, output, checks, n_nodes=None, dim=None):
+    """Refuse, before anything is allocated, a run whose estimated memory exceeds the limit."""
+    from msslib import resources
+
+    if n_nodes is None:
+        n_nodes, _n_cells, dim = resources.generated_mesh_size(geometry["generator"], geometry["args"])
+        if not math.isfinite(n_nodes):
+            return
+    n_saved = _saved_states(solver, output)
+    estimate = resources.run_memory(n_nodes, dim, fem=model in FEM_MODELS, n_saved=n_saved)
+    history = resources.history_memory(n_saved, n_nodes * dim)
+    if history > 0.5 * estimate:
+        what = (f"{root}.solver: {n_saved:.3g} saved states of {n_nodes:.3g} nodes (dt = {solver['dt']:g} s, "
+                f"t_end = {solver['t_end']:g} s, save_every = {solver['save_every']})")
+        hint = "use a larger dt or save_every, or output: {history: false}"
+    else:
+        what = f"{root}.geometry"
+        if "generator" in geometry:
+            what += f" ({geometry['generator']} with {', '.join(f'{k}={v}' for k, v in geometry['args'].items())})"
+        what += f": {n_nodes:.3g} nodes"
+        hint = "use fewer elements"
+    resources.check_memory(estimate, what, hint + " (or set checks.max_memory_gb)", checks["max_memory_gb"])
+
+
 def load_scene(source, *, base_dir=None) -> Scene:
     """Read and validate a scene: a path to a YAML file or a ``dict`` with the same structure
     (a :class:`Scene` is returned unchanged).
@@ -727,6 +759,8 @@ def load_scene(source, *, base_dir=None) -> Scene:
     solver = _solver(f"{root}.solver", raw.get("solver"), model)
     output = _output(f"{root}.output", raw.get("output"))
     checks = _checks(f"{root}.checks", raw.get("checks"))
+    if "generator" in geometry:
+        _check_size(root, geometry, model, solver, output, checks)
     needs_density = solver["type"] == "dynamic" or any(l["type"] == "gravity" for l in loads)
     if needs_density:
         for i, m in enumerate(materials):
@@ -1124,8 +1158,16 @@ def run_scene(scene, progress=True):
     False/None is silent, a callable receives ``(fraction, text)``.  Raises ValueError /
     FileNotFoundError for bad scenes, :class:`msslib.solvers.ConvergenceError` when a static solve
     fails and :class:`msslib.solvers.DivergenceError` when a dynamic run blows up.
+
+    The final state, and every saved state of a dynamic run with ``output.history``, is checked
+    for inverted and collapsed cells (:func:`msslib.quality.guard`, for every model and cell type):
+    the result records ``inverted_cells``, ``collapsed_cells``, ``min_relative_jacobian``, ... (0
+    counts for a clean run) and the cell variables ``cell_state`` and ``relative_jacobian``; a
+    flagged state is one :class:`msslib.errors.MsslibWarning`, or with ``checks: {inverted:
+    error}`` an :class:`msslib.errors.UnphysicalStateError` (no dataset is returned).
     """
     from msslib.io import make_dataset
+    from msslib.quality import guard
 
     scene = load_scene(scene)
     t0 = time.perf_counter()
@@ -1150,6 +1192,10 @@ def run_scene(scene, progress=True):
         if bar is not None:
             bar.close()
     wall = time.perf_counter() - t0
+    hist = out.get("history") or {}
+    guard_attrs, guard_vars = guard(
+        setup.mesh, out["displacement"], history_displacement=hist.get("displacement"),
+        history_time=hist.get("time"), policy=scene.checks["inverted"], label=f"{scene.name} ({scene.model})")
 
     springs = k = rest = None
     if setup.model is not None:
@@ -1167,12 +1213,12 @@ def run_scene(scene, progress=True):
              "thickness": setup.thickness if setup.mesh.dim == 2 else "None",
              "model_published": scene.model_options.get("published", False),
              "model_terms": list(scene.model_options["terms"]) if scene.model_options.get("terms") else "None",
-             **out.get("extra_attrs", {})}
+             **out.get("extra_attrs", {}), **guard_attrs}
     if scene.model_options.get("A") is not None:
         attrs["model_A"] = scene.model_options["A"]
     return make_dataset(
         setup.mesh, out["displacement"], model=scene.model, E=E, nu=nu, scene=scene.text,
         springs=springs, spring_constant=k, rest_length=rest, reaction=out["reaction"], fixed=setup.fixed,
-        history=out.get("history"), solver_stats=out["stats"], wall_time=wall, extra_vars=out.get("extra_vars"),
-        extra_attrs=attrs,
+        history=out.get("history"), solver_stats=out["stats"], wall_time=wall,
+        extra_vars={**(out.get("extra_vars") or {}), **guard_vars}, extra_attrs=attrs,
     )
