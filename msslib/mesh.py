@@ -19,10 +19,15 @@ Contents of this module (all lengths in metres, areas in m^2, volumes in m^3):
   most ``h``, refined to about 12 elements per full circle on curved boundaries but not below
   ``h / 8``; gmsh runs single-threaded with a fixed random ``seed``, so a call is reproducible;
   the mesh keeps only the nodes its cells use and its simplices are positively oriented;
-* input/output: :func:`read`, :func:`write_vtu`;
+* input/output: :func:`read` (every failure one ValueError naming the file), :func:`write_vtu`,
+  :func:`readable_suffixes`, :func:`check_mesh_suffix`;
 * topology and geometry: :func:`unique_edges`, :func:`face_diagonals`, :func:`inner_diagonals`,
   :func:`boundary_facets`, :func:`facet_areas`, :func:`cell_measures`, :func:`check_cells`,
-  :func:`orient`, :func:`select_nodes`, :func:`lumped_masses`.
+  :func:`orient`, :func:`select_nodes`, :func:`lumped_masses`;
+* hygiene: :func:`coincident_nodes` and :func:`resolve_coincident_nodes` (nodes at the same place
+  but with different numbers, which cut a body in two: merged or refused), :func:`connected_parts`
+  and :func:`loose_parts` (parts whose fixed dofs leave a rigid-body mode free: floating, or free
+  to slide or turn).
 
 The L-shaped block (:func:`l_block_hex`, :func:`l_block_tet`) of edge ``size`` ``s`` is the cube
 ``[0, s]^3`` from which the quadrant ``x > s/2, z > s/2`` is removed: its cross-section in the
@@ -43,6 +48,12 @@ from typing import NamedTuple
 import numpy as np
 
 CELL_TYPES = {"triangle": (2, 3), "quad": (2, 4), "tetra": (3, 4), "hexahedron": (3, 8)}
+
+#: default tolerance of :func:`coincident_nodes`, relative to the diagonal of the bounding box
+COINCIDENT_RTOL = 1e-10
+
+#: what :func:`read` and :func:`resolve_coincident_nodes` may do with coincident nodes
+COINCIDENT_POLICIES = ("merge", "error", "keep")
 
 
 @dataclass(frozen=True)
@@ -106,6 +117,8 @@ __all__ = [
     "cone_mesh",
     "l_block_tet",
     "read",
+    "readable_suffixes",
+    "check_mesh_suffix",
     "write_vtu",
     "unique_edges",
     "face_diagonals",
@@ -117,6 +130,13 @@ __all__ = [
     "orient",
     "select_nodes",
     "lumped_masses",
+    "COINCIDENT_RTOL",
+    "COINCIDENT_POLICIES",
+    "coincident_nodes",
+    "resolve_coincident_nodes",
+    "connected_parts",
+    "LoosePart",
+    "loose_parts",
 ]
 
 # --------------------------------------------------------------------------------------------
@@ -576,54 +596,180 @@ def l_block_tet(size: float, h: float, seed: int = 0) -> Mesh:
 # --------------------------------------------------------------------------------------------
 
 
-def read(path, material_key: str = "material") -> Mesh:
+def readable_suffixes() -> list[str]:
+    """The file suffixes meshio knows (``.msh``, ``.vtu``, ...), sorted; compound ones such as
+    ``.vol.gz`` included."""
+    import meshio
+
+    return sorted(meshio.extension_to_filetypes)
+
+
+def check_mesh_suffix(path) -> None:
+    """Raise ValueError naming ``path`` and the suffixes meshio knows when its suffix is not one
+    of them (meshio would otherwise give up on the file with :class:`SystemExit` or an error)."""
+    path = Path(path)
+    known = set(readable_suffixes())
+    suffixes = [s.lower() for s in path.suffixes]
+    if not any("".join(suffixes[i:]) in known for i in range(len(suffixes))):
+        shown = repr(path.suffix) if path.suffix else "(none)"
+        raise ValueError(f"{path}: unknown mesh file suffix {shown}; allowed: the suffixes meshio reads, "
+                         f"{' '.join(sorted(known))}")
+
+
+def _meshio_read(path: Path):
+    """``meshio.read`` that never exits the interpreter: any failure (meshio calls ``sys.exit``
+    for some files and raises anything from ``struct.error`` to ``UnicodeDecodeError`` for others)
+    becomes one ValueError naming the file.  What meshio prints is captured: part of the message on
+    failure; on success returned with the mesh and the warnings it raised, ``(mesh, printed,
+    warnings)``, for :func:`read` to pass on once the mesh has passed its own checks."""
+    import io
+    import warnings
+    from contextlib import redirect_stderr, redirect_stdout
+
+    import meshio
+
+    printed = io.StringIO()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            with redirect_stdout(printed), redirect_stderr(printed):
+                m = meshio.read(path)
+        except (Exception, SystemExit) as exc:  # noqa: BLE001 - every failure of a reader is bad input
+            said = " ".join(printed.getvalue().replace("Error:", " ").split())
+            if isinstance(exc, UnicodeDecodeError):
+                detail = (f"not UTF-8 text where the {path.suffix or 'chosen'} reader expects text "
+                          f"({exc.reason} at byte {exc.start})")
+            elif isinstance(exc, SystemExit):
+                detail = said or "meshio gave up on it"
+            else:
+                text = " ".join(str(exc).split())
+                detail = f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+                if said and said not in detail:
+                    detail += f" ({said})"
+            if len(detail) > 300:
+                detail = detail[:297] + "..."
+            raise ValueError(f"{path}: cannot read mesh: {detail}; allowed: a valid mesh file in a format meshio "
+                             f"reads, chosen by its suffix") from None
+    return m, " ".join(printed.getvalue().split()), caught
+
+
+def read(path, material_key: str = "material", coincident_nodes: str = "merge",
+         coincident_rtol: float = COINCIDENT_RTOL) -> Mesh:
     """Read any mesh file meshio can read.
 
     The cells are the blocks of the highest-dimensional supported type (``tetra`` or
     ``hexahedron`` before ``triangle`` or ``quad``; between two types of the same dimension the
     one with more cells); blocks of that type are concatenated.  Nodes no chosen cell uses are
     dropped (the others keep their order).  For 2D cells the z coordinate must be constant and is
-    dropped.  ``cell_data[material_key]`` (integers), when present, becomes ``material``.
+    dropped.  ``cell_data[material_key]`` (one integer per cell), when present, becomes
+    ``material``.
 
-    Raises FileNotFoundError for a missing file and ValueError (naming the cell types found) when
-    no supported cell type is present.
+    Coincident nodes (closer than ``coincident_rtol`` times the bounding-box diagonal, see
+    :func:`resolve_coincident_nodes`) are merged with a :class:`msslib.errors.MsslibWarning`
+    (``coincident_nodes="merge"``, the default), refused (``"error"``) or kept (``"keep"``); the
+    messages give node numbers of the file.
+
+    Raises FileNotFoundError for a missing file, and a one-line ValueError naming the file for
+    everything else: a directory, an unknown suffix (listing the suffixes meshio knows), an empty
+    or unreadable file (whatever meshio raises, :class:`SystemExit` included), no cells or no
+    supported cell type (naming the types found), cells referring to nodes that do not exist,
+    non-finite coordinates, material values that are not integers, a cell collapsed by merging.
     """
-    import meshio
-
+    if coincident_nodes not in COINCIDENT_POLICIES:
+        raise ValueError(f"coincident_nodes must be one of {', '.join(COINCIDENT_POLICIES)}, got {coincident_nodes!r}")
     path = Path(path)
-    if not path.is_file():
+    if path.is_dir():
+        raise ValueError(f"{path}: is a directory; allowed: a mesh file")
+    if not path.exists():
         raise FileNotFoundError(f"mesh file not found: {path}")
-    m = meshio.read(path)
-    found = [block.type for block in m.cells]
+    if not path.is_file():
+        raise ValueError(f"{path}: not a regular file; allowed: a mesh file")
+    check_mesh_suffix(path)
+    if path.stat().st_size == 0:
+        raise ValueError(f"{path}: cannot read mesh: the file is empty; allowed: a mesh file with cells")
+    m, said, caught = _meshio_read(path)
+    try:
+        mesh, used = _mesh_from_meshio(path, m, material_key)
+    except (ValueError, TypeError, IndexError, KeyError) as exc:  # one line naming the file, whatever it is
+        text = " ".join(str(exc).split()) or type(exc).__name__
+        if not text.startswith(str(path)):
+            text = f"{path}: cannot read mesh: {type(exc).__name__}: {text}"
+        if said:  # what meshio printed while reading explains the problem
+            text += f"; meshio said: {said[:200]}"
+        raise ValueError(text) from None
+    import warnings
+
+    for w in caught:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if said:
+        from msslib.errors import MsslibWarning
+
+        warnings.warn(f"{path}: meshio says: {said}", MsslibWarning, stacklevel=2)
+    hint = " (coincident_nodes: merge merges them)" if coincident_nodes == "error" else ""
+    return resolve_coincident_nodes(mesh, coincident_nodes, coincident_rtol, source=str(path), node_ids=used,
+                                    hint=hint)
+
+
+def _mesh_from_meshio(path: Path, m, material_key: str):
+    """The :class:`Mesh` of :func:`read` from a meshio mesh, and the file numbers of its nodes."""
+    allowed = f"allowed: {', '.join(CELL_TYPES)} cells"
+    blocks_all = [b for b in m.cells if len(b.data)]
+    if not blocks_all:
+        raise ValueError(f"{path}: the mesh has no cells ({len(m.points)} points); {allowed}")
+    found = [block.type for block in blocks_all]
     supported = [t for t in CELL_TYPES if t in found]
     if not supported:
-        raise ValueError(
-            f"{path}: no supported cell type; found {sorted(set(found)) or 'no cells'}, supported {sorted(CELL_TYPES)}"
-        )
+        raise ValueError(f"{path}: no supported cell type; found {sorted(set(found))}, supported {sorted(CELL_TYPES)}")
 
     def rank(t):
         return CELL_TYPES[t][0], sum(len(b.data) for b in m.cells if b.type == t)
 
     cell_type = max(supported, key=rank)
     dim = CELL_TYPES[cell_type][0]
-    blocks = [k for k, b in enumerate(m.cells) if b.type == cell_type]
-    cells = np.concatenate([m.cells[k].data for k in blocks]).astype(np.int64)
+    blocks = [k for k, b in enumerate(m.cells) if b.type == cell_type and len(b.data)]
+    cells = np.concatenate([np.asarray(m.cells[k].data).reshape(len(m.cells[k].data), -1) for k in blocks])
+    points = np.asarray(m.points, dtype=float)
+    if points.ndim != 2 or not 2 <= points.shape[1] <= 3:
+        raise ValueError(f"{path}: points have shape {points.shape}; allowed: 2 or 3 coordinates per point")
+    n_file = len(points)
+    outside = (cells < 0) | (cells >= n_file)
+    if outside.any():
+        c = int(np.flatnonzero(outside.any(axis=1))[0])
+        node = int(cells[c][outside[c]][0])
+        raise ValueError(f"{path}: {cell_type} cell {c} refers to node {node}, which does not exist; "
+                         f"allowed: nodes 0 to {n_file - 1}")
+    cells = cells.astype(np.int64)
     material = None
     if material_key in m.cell_data:
-        values = np.concatenate([np.asarray(m.cell_data[material_key][k]).reshape(len(m.cells[k].data), -1) for k in blocks])
-        if values.shape[1] == 1:
-            material = np.rint(values[:, 0]).astype(np.int64)
-    points = np.asarray(m.points, dtype=float)
+        values = np.concatenate([np.asarray(m.cell_data[material_key][k]).reshape(len(m.cells[k].data), -1)
+                                 for k in blocks])
+        if values.shape[1] != 1:
+            raise ValueError(f"{path}: cell data {material_key!r} has {values.shape[1]} values per cell; "
+                             f"allowed: one integer material index per cell")
+        values = values[:, 0]
+        if not np.issubdtype(values.dtype, np.number) or np.issubdtype(values.dtype, np.complexfloating):
+            raise ValueError(f"{path}: cell data {material_key!r} has type {values.dtype}; allowed: integers")
+        bad = np.flatnonzero(~np.isfinite(values) | (values != np.rint(values)))
+        if len(bad):
+            raise ValueError(f"{path}: cell data {material_key!r} of cell {int(bad[0])} is {values[bad[0]].item()!r}; "
+                             f"allowed: integer material indices")
+        material = np.rint(values).astype(np.int64)
+    used = np.unique(cells)  # file numbers of the nodes the cells use, ascending
+    points = points[used]
+    cells = np.searchsorted(used, cells)
+    bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+    if len(bad):
+        raise ValueError(f"{path}: node {int(used[bad[0]])} has coordinates {_fmt_point(points[bad[0]])} "
+                         f"({len(bad)} node(s) with NaN or infinite coordinates); allowed: finite coordinates")
     if points.shape[1] < dim:
         points = np.pad(points, ((0, 0), (0, dim - points.shape[1])))
-    points, cells = _compact(points, cells)
     if dim == 2 and points.shape[1] == 3:
         z = points[:, 2]
         scale = max(np.ptp(points[:, :2], axis=0).max(initial=0.0), 1e-300)
         if len(z) and np.ptp(z) > 1e-9 * scale:
             raise ValueError(f"{path}: {cell_type} cells are not in a plane z = const; cannot make a 2D mesh")
         points = points[:, :2]
-    return Mesh(points, cells, cell_type, material)
+    return Mesh(points, cells, cell_type, material), used
 
 
 def _pad_columns(a: np.ndarray, dim: int) -> np.ndarray:
@@ -882,3 +1028,279 @@ def lumped_masses(mesh: Mesh, density, thickness: float = 1.0) -> np.ndarray:
     cell_mass = density * np.abs(cell_measures(mesh)) * (thickness if mesh.dim == 2 else 1.0)
     per_node = np.repeat(cell_mass / mesh.nodes_per_cell, mesh.nodes_per_cell)
     return np.bincount(mesh.cells.ravel(), weights=per_node, minlength=mesh.n_nodes)
+
+
+# --------------------------------------------------------------------------------------------
+# mesh hygiene: coincident nodes, connected parts, rigid-body modes left free by the fixed dofs
+# --------------------------------------------------------------------------------------------
+
+
+def _fmt_point(x) -> str:
+    return "(" + ", ".join(f"{float(v):.6g}" for v in x) + ")"
+
+
+def _bbox_diagonal(points: np.ndarray) -> float:
+    if len(points) == 0:
+        return 0.0
+    return float(np.linalg.norm(np.ptp(points, axis=0)))
+
+
+def coincident_nodes(points, rtol: float = COINCIDENT_RTOL) -> np.ndarray:
+    """The lowest-numbered twin of every node: ``rep[i]`` is the smallest index of the nodes closer
+    than ``rtol`` times the diagonal of the bounding box of ``points`` to node ``i`` (transitively),
+    so ``rep[i] <= i`` and ``rep[i] == i`` for a node without twin.
+
+    Two cells that share a face geometrically but not by node index are not connected; such nodes
+    are what this finds.  Uses a k-d tree (:class:`scipy.spatial.cKDTree`): O(n log n).
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    points = np.asarray(points, dtype=float)
+    n = len(points)
+    rep = np.arange(n, dtype=np.int64)
+    if n < 2:
+        return rep
+    tol = float(rtol) * _bbox_diagonal(points)
+    pairs = cKDTree(points).query_pairs(tol, output_type="ndarray")
+    if len(pairs) == 0:
+        return rep
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    n_groups, label = connected_components(graph, directed=False)
+    lowest = np.full(n_groups, n, dtype=np.int64)
+    np.minimum.at(lowest, label, rep)
+    return lowest[label]
+
+
+def _node_name(i: int, node_ids) -> str:
+    return f"node {int(i) if node_ids is None else int(node_ids[i])}"
+
+
+def _twins_text(points, rep, dup, node_ids, max_report) -> str:
+    shown = ", ".join(f"{_node_name(i, node_ids)} = {_node_name(rep[i], node_ids)} at {_fmt_point(points[i])}"
+                      for i in dup[:max_report])
+    more = f" and {len(dup) - max_report} more" if len(dup) > max_report else ""
+    return shown + more
+
+
+def resolve_coincident_nodes(mesh: Mesh, policy: str = "merge", rtol: float = COINCIDENT_RTOL, *,
+                             source: str = "mesh", node_ids=None, hint: str = "",
+                             max_report: int = 3) -> Mesh:
+    """Find the coincident nodes of ``mesh`` (:func:`coincident_nodes`) and apply ``policy``.
+
+    ``"merge"``: every node is replaced by its lowest-numbered twin in the cells, the nodes no cell
+    uses any more are dropped (the others keep their order, so indices above a dropped node shift
+    down), the material of each cell is kept, and one :class:`msslib.errors.MsslibWarning` names
+    how many nodes were merged and the first ``max_report`` of them with their coordinates.
+    ``"error"``: a ValueError naming them.  ``"keep"``: nothing is checked.  The mesh is returned
+    unchanged when no node has a twin.
+
+    A cell two of whose own nodes coincide would collapse when merged: a ValueError names it (under
+    either policy).  ``source`` starts every message (a file name, a scene key); ``node_ids``
+    optionally maps node indices to the numbers shown (e.g. the node numbers of a file); ``hint``
+    is appended to the error message (what the caller allows instead).
+    """
+    if policy not in COINCIDENT_POLICIES:
+        raise ValueError(f"coincident node policy must be one of {', '.join(COINCIDENT_POLICIES)}, got {policy!r}")
+    if policy == "keep":
+        return mesh
+    rep = coincident_nodes(mesh.points, rtol)
+    dup = np.flatnonzero(rep != np.arange(mesh.n_nodes))
+    if len(dup) == 0:
+        return mesh
+    tol = float(rtol) * _bbox_diagonal(mesh.points)
+    merged = rep[mesh.cells]
+    ordered = np.sort(merged, axis=1)
+    collapsed = np.flatnonzero((ordered[:, 1:] == ordered[:, :-1]).any(axis=1))
+    if len(collapsed):
+        c = int(collapsed[0])
+        local = mesh.cells[c]
+        a, b = next((i, j) for i in range(len(local)) for j in range(i + 1, len(local))
+                    if rep[local[i]] == rep[local[j]])
+        more = f" (and {len(collapsed) - 1} more cell(s))" if len(collapsed) > 1 else ""
+        raise ValueError(
+            f"{source}: {mesh.cell_type} cell {c} has two coincident corners, {_node_name(local[a], node_ids)} and "
+            f"{_node_name(local[b], node_ids)} at {_fmt_point(mesh.points[local[a]])} (closer than {tol:.3g} m){more}; "
+            f"allowed: cells whose corners are distinct points")
+    what = (f"{len(dup)} coincident node(s) (closer than {tol:.3g} m to a lower-numbered node): "
+            f"{_twins_text(mesh.points, rep, dup, node_ids, max_report)}")
+    if policy == "error":
+        raise ValueError(f"{source}: {what}; allowed: distinct nodes{hint}")
+    import warnings
+
+    from msslib.errors import MsslibWarning
+
+    points, cells = _compact(mesh.points, merged)
+    warnings.warn(f"{source}: merged {what}; cells renumbered to the lower-numbered node, {len(points)} nodes left",
+                  MsslibWarning, stacklevel=2)
+    return Mesh(points, cells, mesh.cell_type, mesh.material)
+
+
+def connected_parts(mesh: Mesh) -> tuple[int, np.ndarray]:
+    """Connected parts of a mesh: two cells belong to the same part when they share a node
+    (by index: see :func:`coincident_nodes` for nodes that only share a position).
+
+    Returns ``(n_parts, part)`` with ``part`` the part of each node, ``0 .. n_parts - 1``, numbered
+    in the order of their lowest node (node 0 is in part 0); a node no cell uses is a part of its
+    own.  The part of cell ``c`` is ``part[mesh.cells[c, 0]]``.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = mesh.n_nodes
+    rows = mesh.cells.ravel()
+    cols = np.repeat(mesh.cells[:, 0], mesh.nodes_per_cell)
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    n_parts, label = connected_components(graph, directed=False)
+    # relabel in the order of the lowest node of each part (scipy's order is not documented)
+    first = np.full(n_parts, n, dtype=np.int64)
+    np.minimum.at(first, label, np.arange(n))
+    order = np.empty(n_parts, dtype=np.int64)
+    order[np.argsort(first, kind="stable")] = np.arange(n_parts)
+    return int(n_parts), order[label]
+
+
+class LoosePart(NamedTuple):
+    """A connected part of a mesh that its fixed dofs do not hold (see :func:`loose_parts`).
+
+    ``part`` is its number in :func:`connected_parts` (``n_parts`` parts in all), ``n_cells`` its
+    cell count, ``node`` its lowest node.  ``floating``: no dof of the part is fixed.  ``n_free`` is
+    the number of independent rigid-body modes left free (3 in 2D, 6 in 3D when floating) and
+    ``modes`` their names when each is a translation along an axis or a rotation about a line
+    parallel to an axis (e.g. ``"translation along x"``, ``"rotation about the z axis"``,
+    ``"rotation about the line x = 0.1, y = 0 (parallel to z)"``, in 2D ``"rotation about the
+    point (0, 0)"``; ``"rotation about an axis parallel to z"`` when a free translation lets the
+    axis slide); otherwise the names found and ``"N other rigid-body mode(s) (...)"``.
+    """
+
+    part: int
+    n_parts: int
+    n_cells: int
+    node: int
+    floating: bool
+    n_free: int
+    modes: tuple
+
+    def describe(self, mesh: Mesh) -> str:
+        """One phrase: which part, and what is loose (for error messages)."""
+        at = f"node {self.node} at {_fmt_point(mesh.points[self.node])}"
+        if self.n_cells == 0:
+            return f"{at} belongs to no cell and is not fixed in every axis"
+        what = (f"part {self.part + 1} of {self.n_parts} ({self.n_cells} {mesh.cell_type} cells, {at})"
+                if self.n_parts > 1 else f"the mesh ({self.n_cells} {mesh.cell_type} cells, {at})")
+        if self.floating:
+            return f"{what} is floating: none of its dofs is fixed"
+        return f"{what} has {self.n_free} free rigid-body mode(s): {', '.join(self.modes)}"
+
+
+def _rigid_modes(x: np.ndarray, center: np.ndarray, scale: float) -> np.ndarray:
+    """Rigid-body velocity fields at the points ``x`` (m, dim): shape (m, dim, n_modes), the
+    translations along each axis, then the rotations about the axes (z only in 2D) through
+    ``center`` divided by ``scale`` (so that every mode has entries of order one)."""
+    m, dim = x.shape
+    r = (x - center) / scale
+    if dim == 2:
+        modes = np.zeros((m, 2, 3))
+        modes[:, 0, 0] = modes[:, 1, 1] = 1.0
+        modes[:, 0, 2], modes[:, 1, 2] = -r[:, 1], r[:, 0]
+        return modes
+    modes = np.zeros((m, 3, 6))
+    for a in range(3):
+        modes[:, a, a] = 1.0
+        axis = np.zeros(3)
+        axis[a] = 1.0
+        modes[:, :, 3 + a] = np.cross(axis, r)
+    return modes
+
+
+def _name_free_modes(null: np.ndarray, dim: int, center: np.ndarray, scale: float) -> tuple:
+    """Names of the rigid-body modes spanned by the orthonormal columns of ``null`` (mode
+    coordinates of :func:`_rigid_modes`)."""
+    k = null.shape[1]
+    eye = np.eye(null.shape[0])
+    in_span = [np.linalg.norm(eye[:, a] - null @ (null.T @ eye[:, a])) < 1e-6 for a in range(dim)]
+    names = [f"translation along {'xyz'[a]}" for a in range(dim) if in_span[a]]
+    rot_rows = [2] if dim == 2 else [3, 4, 5]
+    rot_axes = [2] if dim == 2 else [0, 1, 2]
+    w = null[rot_rows, :]
+    scale_len = max(scale, 1e-300)
+    for row, a in enumerate(rot_axes):
+        target = np.zeros(len(rot_rows))
+        target[row] = 1.0
+        coef, *_ = np.linalg.lstsq(w, target, rcond=None)
+        if np.linalg.norm(w @ coef - target) > 1e-6:
+            continue
+        t = np.zeros(3)
+        t[:dim] = (null @ coef)[:dim]
+        if abs(t[a]) > 1e-6 and not (a < dim and in_span[a]):
+            continue  # a screw motion: counted, not named
+        t[a] = 0.0
+        axis = np.zeros(3)
+        axis[a] = 1.0
+        others = [b for b in range(3) if b != a and b < dim]
+        if any(in_span[b] for b in others):  # the line can slide: only its direction is defined
+            names.append("rotation" if dim == 2 else f"rotation about an axis parallel to {'xyz'[a]}")
+            continue
+        c3 = np.zeros(3)
+        c3[:dim] = center
+        p = c3 - scale_len * np.cross(t, axis)
+        p[np.abs(p) < 1e-9 * scale_len] = 0.0
+        if dim == 2:
+            names.append(f"rotation about the point {_fmt_point(p[:2])}")
+        elif not p[others].any():
+            names.append(f"rotation about the {'xyz'[a]} axis")
+        else:
+            line = ", ".join(f"{'xyz'[b]} = {p[b]:.6g}" for b in others)
+            names.append(f"rotation about the line {line} (parallel to {'xyz'[a]})")
+    if len(names) < k:
+        # fixed dofs are per axis, so every free translation is named: the rest turn about skew lines
+        names.append(f"{k - len(names)} other rigid-body mode(s) (rotation about a line not parallel to an axis)")
+    return tuple(names)
+
+
+def loose_parts(mesh: Mesh, fixed, rtol: float = 1e-8) -> list[LoosePart]:
+    """The parts of ``mesh`` (:func:`connected_parts`) whose fixed dofs leave a rigid-body mode
+    free: a static solve of such a part has a singular stiffness.
+
+    ``fixed`` is ``(n_nodes, dim)`` bool (prescribed displacements count as fixed).  For each part,
+    the rigid-body modes (translations and infinitesimal rotations; 3 in 2D, 6 in 3D) restricted to
+    its fixed dofs form a matrix whose null space (singular values below ``rtol`` times the
+    largest) holds the free modes.  A part no dof of which is fixed is ``floating``.  A node that
+    no cell uses is a part of its own, loose unless all its dofs are fixed.  Returns the loose parts
+    in part order (empty: every part is held).
+    """
+    fixed = np.asarray(fixed, dtype=bool)
+    dim = mesh.dim
+    if fixed.shape != (mesh.n_nodes, dim):
+        raise ValueError(f"fixed must have shape ({mesh.n_nodes}, {dim}), got {fixed.shape}")
+    n_modes = 3 if dim == 2 else 6
+    n_parts, part = connected_parts(mesh)
+    cell_part = part[mesh.cells[:, 0]] if mesh.n_cells else np.zeros(0, dtype=np.int64)
+    n_cells = np.bincount(cell_part, minlength=n_parts)
+    held_parts = np.unique(part[fixed.any(axis=1)])
+    order = np.argsort(part, kind="stable")
+    starts = np.searchsorted(part[order], np.arange(n_parts + 1))
+    out = []
+    for p in range(n_parts):
+        nodes = order[starts[p]:starts[p + 1]]
+        node = int(nodes.min())
+        if n_cells[p] == 0:
+            if not fixed[nodes].all():
+                out.append(LoosePart(p, n_parts, 0, node, True, dim, ()))
+            continue
+        if p not in held_parts:
+            out.append(LoosePart(p, n_parts, int(n_cells[p]), node, True, n_modes, ()))
+            continue
+        x = mesh.points[nodes]
+        center = x.mean(axis=0)
+        scale = _bbox_diagonal(x) or 1.0
+        modes = _rigid_modes(x, center, scale)[fixed[nodes]]  # (n fixed dofs, n_modes)
+        _, s, vt = np.linalg.svd(np.linalg.qr(modes, mode="r"), full_matrices=True)  # QR first: O(n_fixed)
+        rank = int(np.sum(s > rtol * s.max())) if s.size and s.max() > 0 else 0
+        if rank == n_modes:
+            continue
+        null = vt[rank:].T
+        out.append(LoosePart(p, n_parts, int(n_cells[p]), node, False, n_modes - rank,
+                             _name_free_modes(null, dim, center, scale)))
+    return out

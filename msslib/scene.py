@@ -44,7 +44,7 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     :func:`msslib.mesh.read`, relative to the directory of the scene file (or of ``base_dir`` for a
     scene given as a dict); an integer cell data array ``material`` becomes the material index.
 ``materials``
-    A non-empty list of ``{E, nu, density}``: Young's modulus ``E > 0`` (Pa), Poisson's ratio
+    A non-empty list (every material used by some cell) of ``{E, nu, density}``: Young's modulus ``E > 0`` (Pa), Poisson's ratio
     ``-1 < nu < 0.5`` and the density (kg/m^3, > 0).  ``density`` may be omitted unless the scene
     has gravity or is dynamic.  Note that the triangle and square MSS models are exact only for
     ``nu = 1/3``, Lloyd's tetrahedron without volume term for ``nu = 1/4``.
@@ -82,7 +82,9 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     (default ``all``) lists the constrained axes of the selected nodes; ``displacement`` (optional)
     gives one value per axis (m), ``null`` or 0 for the axes not fixed.  A dof fixed twice with two
     different displacements is an error.  Static solves ramp prescribed displacements with the
-    load factor; dynamic runs apply them at ``t = 0`` and hold them.
+    load factor; dynamic runs apply them at ``t = 0`` and hold them.  A static scene must hold
+    every part of its mesh: a floating part or a free rigid-body mode (a translation or rotation
+    the fixed dofs do not stop) is an error naming the part and the mode.
 ``SELECTION``
     ``all``, or a mapping with ``plane: [axis, value]`` (axis ``x``, ``y`` or ``z``) and/or
     ``box: [[xmin, ...], [xmax, ...]]`` (``null`` = unbounded, either corner may be ``null``);
@@ -464,8 +466,14 @@ def _geometry(path, value, base_dir: Path):
         file_path = Path(file_value)
         if not file_path.is_absolute():
             file_path = base_dir / file_path
+        if file_path.is_dir():
+            _fail(f"{path}.file", f"{file_value!r} is a directory ({file_path}); allowed: a mesh file")
         if not file_path.is_file():
             raise FileNotFoundError(f"{path}.file: mesh file not found: {file_value!r} (looked for {file_path})")
+        try:
+            _mesh.check_mesh_suffix(file_path)
+        except ValueError as exc:
+            _fail(f"{path}.file", str(exc))
         return {"file": file_path}
     name = _choice(f"{path}.generator", value["generator"], tuple(GENERATORS), "generator")
     args = value.get("args") or {}
@@ -704,6 +712,8 @@ def _check_size(root, geometry, model, solver, output, checks, n_nodes=None, dim
         what = f"{root}.geometry"
         if "generator" in geometry:
             what += f" ({geometry['generator']} with {', '.join(f'{k}={v}' for k, v in geometry['args'].items())})"
+        else:
+            what += f".file ({geometry['file'].name})"
         what += f": {n_nodes:.3g} nodes"
         hint = "use fewer elements"
     resources.check_memory(estimate, what, hint + " (or set checks.max_memory_gb)", checks["max_memory_gb"])
@@ -794,9 +804,11 @@ def _build_mesh(scene: Scene) -> _mesh.Mesh:
     geo = scene.geometry
     if "file" in geo:
         try:
-            mesh = _mesh.read(geo["file"])
+            mesh = _mesh.read(geo["file"], coincident_nodes=scene.checks.get("coincident_nodes", "merge"))
         except ValueError as exc:
             _fail("scene.geometry.file", str(exc))
+        _check_size("scene", geo, scene.model, scene.solver, scene.output, scene.checks, n_nodes=mesh.n_nodes,
+                    dim=mesh.dim)
         mesh = _mesh.orient(mesh)
     else:
         fn = _generator_function(geo["generator"])
@@ -864,8 +876,23 @@ def prepare(scene: Scene) -> Setup:
     Does not solve; :func:`run_scene` calls it, the ``validate`` command too.  Errors that need
     the mesh (a selection matching no node, a vector of the wrong length, a model whose cell type
     does not fit the mesh) are ValueErrors naming the key path.
+
+    Mesh hygiene: coincident nodes are merged with a warning or refused
+    (``checks.coincident_nodes``, :func:`msslib.mesh.resolve_coincident_nodes`), for generated
+    meshes too; a material no cell uses is an error; before a static solve, a part of the mesh
+    whose fixed dofs leave a rigid-body mode free (floating, or free to slide or turn:
+    :func:`msslib.mesh.loose_parts`) is an error naming the part and the mode (dynamic runs may
+    move freely).
     """
-    mesh = _build_mesh(scene)
+    policy = scene.checks.get("coincident_nodes", "merge")
+    mesh = _mesh.resolve_coincident_nodes(_build_mesh(scene), policy, source="scene.geometry",
+                                          hint=" (checks: {coincident_nodes: merge} merges them)")
+    used = np.bincount(mesh.material, minlength=len(scene.materials))
+    for i in range(len(scene.materials)):
+        if used[i] == 0:
+            in_use = ", ".join(str(j) for j in np.flatnonzero(used)) or "none"
+            _fail(f"scene.materials[{i}]", f"no cell uses material {i} (cells use materials {in_use}); allowed: "
+                  f"materials some cell uses (assigned by scene.regions or the mesh file's cell data 'material')")
     n, dim = mesh.n_nodes, mesh.dim
     size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if n else 1.0
     default_tol = max(1e-8 * size, 1e-15)
@@ -894,6 +921,15 @@ def prepare(scene: Scene) -> Setup:
             fixed[nodes, a] = True
             prescribed[nodes, a] = disp[a]
             owner[nodes, a] = i
+    if not scene.is_dynamic:
+        loose = _mesh.loose_parts(mesh, fixed)
+        if loose:
+            n_modes = 3 if dim == 2 else 6
+            more = f" (and {len(loose) - 1} more loose part(s))" if len(loose) > 1 else ""
+            fix = (f"fix at least {n_modes} dofs of every part that stop its {n_modes} rigid-body modes"
+                   if loose[0].floating else "fix dofs that stop every rigid-body mode of every part")
+            _fail("scene.boundary", f"{loose[0].describe(mesh)}{more}; a static solve needs it held: {fix}, "
+                  f"or use a dynamic solver (solver: {{type: dynamic, ...}})")
 
     thickness = 1.0 if dim == 3 else float(scene.thickness or 1.0)
     dens = np.array([np.nan if m.density is None else m.density for m in scene.materials])

@@ -133,3 +133,16 @@ def test_estimate_is_above_the_measured_peak(tmp_path):
     # and not absurdly generous: within a factor 3 of the measured peak
     assert estimate < 3 * peak
     assert np.isfinite(estimate)
+
+
+def test_file_mesh_checked_after_reading(tmp_path):
+    """A mesh file is read before its size is known: the dynamic history is checked then."""
+    from msslib.scene import prepare
+
+    path = tmp_path / "m.vtu"
+    mesh.write_vtu(path, mesh.hex_grid(1.0, 0.1, 0.1, 4, 1, 1))
+    d = _scene(solver={"type": "dynamic", "dt": 1.0e-12, "t_end": 0.1})
+    d["geometry"] = {"file": "m.vtu"}
+    scene = load_scene(d, base_dir=tmp_path)  # size unknown before reading: accepted
+    with pytest.raises(ResourceError, match=r"scene\.solver: 1e\+11 saved states of 20 nodes"):
+        prepare(scene)
