@@ -20,8 +20,15 @@ Commands
 ``paper SOURCE --out OUT.html``
     Build the paper (:mod:`msslib.paper`).
 
+Inputs and outputs: an output that is one of the command's inputs (the scene, its mesh file, the
+experiment, the result or front read) or another of its outputs is refused before anything runs
+(same resolved path, or :func:`os.path.samefile`: hard and symbolic links too).  A command that
+writes several files writes them together (:class:`msslib.io.StagedOutputs`): all are replaced,
+or none is; temporary files are removed on any error, on SIGINT and on SIGTERM.
+
 Exit codes: 0 success, 1 bad input or a failed solve (a one-line ``msslib: error: ...`` message on
-stderr, no traceback), 2 bad command-line usage (argparse).
+stderr, no traceback), 2 bad command-line usage (argparse), 130 interrupted (SIGINT), 143
+terminated (SIGTERM).
 
 Adding a command: write ``_add_NAME(subparsers)`` that creates its subparser and sets
 ``func=_cmd_NAME`` with :meth:`argparse.ArgumentParser.set_defaults`, where ``_cmd_NAME(args) ->
@@ -31,6 +38,7 @@ int``, and append it to :data:`COMMANDS`.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 from pathlib import Path
@@ -47,10 +55,46 @@ def _one_line(exc: BaseException) -> str:
     return text or type(exc).__name__
 
 
+# --------------------------------------------------------------------------------------------
+# inputs and outputs: checked before anything runs
+# --------------------------------------------------------------------------------------------
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """``a`` and ``b`` name one file: the same resolved path, or (existing files) the same inode
+    (hard links, symbolic links, other spellings)."""
+    try:
+        if a.resolve() == b.resolve():
+            return True
+    except (OSError, RuntimeError):  # a symlink loop
+        pass
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):
+        return False
+
+
+def _check_distinct(outputs, inputs=()) -> None:
+    """Refuse an output that is one of the inputs or another output (pairs ``(what, path)``)."""
+    outputs = [(what, Path(p)) for what, p in outputs if p is not None]
+    inputs = [(what, Path(p)) for what, p in inputs if p is not None]
+    for i, (what, out) in enumerate(outputs):
+        for what_in, src in inputs:
+            if _same_file(out, src):
+                raise CommandError(f"{what} {str(out)!r} is the {what_in} {str(src)!r}: refusing to overwrite "
+                                   f"an input; give another {what}")
+        for what_other, other in outputs[:i]:
+            if _same_file(out, other):
+                raise CommandError(f"{what} {str(out)!r} and {what_other} {str(other)!r} are the same file; "
+                                   f"give two different files")
+
+
 def _check_writable(path: Path, what: str) -> None:
     """Fail early (before a long run) when ``path`` cannot be written."""
     if path.is_dir():
         raise CommandError(f"{what} {str(path)!r} is a directory")
+    if path.exists() and not path.is_file():
+        raise CommandError(f"{what} {str(path)!r} exists and is not a regular file; give a file name")
     directory = path.parent
     if not directory.exists():
         raise CommandError(f"cannot write {what} {str(path)!r}: directory {str(directory)!r} does not exist")
@@ -58,6 +102,97 @@ def _check_writable(path: Path, what: str) -> None:
         raise CommandError(f"cannot write {what} {str(path)!r}: {str(directory)!r} is not a directory")
     if not os.access(directory, os.W_OK | os.X_OK):
         raise CommandError(f"cannot write {what} {str(path)!r}: directory {str(directory)!r} is not writable")
+
+
+def _input_file(path: Path, what: str) -> Path:
+    path = Path(path)
+    if not path.exists():
+        raise CommandError(f"{what} not found: {str(path)!r}")
+    if not path.is_file():
+        raise CommandError(f"{what} {str(path)!r} is not a file")
+    if not os.access(path, os.R_OK):
+        raise CommandError(f"{what} {str(path)!r} is not readable")
+    return path
+
+
+def _not_utf8(path, what, exc: UnicodeDecodeError) -> CommandError:
+    return CommandError(f"{what} {str(path)!r} is not UTF-8 text (byte {exc.start}: {exc.reason})")
+
+
+def _load_scene(path):
+    from msslib.scene import load_scene
+
+    _input_file(Path(path), "scene file")
+    try:
+        return load_scene(path)
+    except UnicodeDecodeError as exc:
+        raise _not_utf8(path, "scene file", exc) from None
+
+
+def _mesh_input(scene):
+    """``[("mesh file", path)]`` when the scene reads its mesh from a file."""
+    return [("mesh file", scene.geometry["file"])] if "file" in scene.geometry else []
+
+
+def _load_experiment(path):
+    import yaml
+
+    from msslib import experiment
+
+    _input_file(Path(path), "experiment file")
+    try:
+        return experiment.load_experiment(path)
+    except UnicodeDecodeError as exc:
+        raise _not_utf8(path, "experiment file", exc) from None
+    except yaml.YAMLError as exc:
+        raise CommandError(f"experiment file {str(path)!r}: invalid YAML: {_one_line(exc)}") from None
+    except FileNotFoundError:
+        raise
+    except ValueError as exc:
+        raise CommandError(f"experiment file {str(path)!r}: {_one_line(exc)}") from None
+    except (TypeError, AttributeError, KeyError) as exc:  # a value of the wrong kind somewhere in the file
+        raise CommandError(f"experiment file {str(path)!r} is not a valid experiment ({type(exc).__name__}: "
+                           f"{_one_line(exc)})") from None
+
+
+def _choice(option: str, value: str, allowed, what: str) -> str:
+    if value not in allowed:
+        raise CommandError(f"{option} {value!r} is not a {what}; expected one of {', '.join(map(str, allowed))}")
+    return value
+
+
+#: the variables a result needs for ``vtu`` and ``experiment compare``
+RESULT_VARIABLES = ("rest_position", "displacement", "cells", "material")
+
+
+def _read_result(path: Path, what: str = "result file", required=RESULT_VARIABLES):
+    """Read an msslib result; CommandError naming ``path`` when it is not one."""
+    from msslib.io import SCHEMA_VERSION, read_result
+
+    _input_file(path, what)
+    try:
+        ds = read_result(path)
+    except (OSError, ValueError, RuntimeError) as exc:
+        detail = _one_line(exc).replace(str(Path(path).resolve()), "").replace(str(path), "").strip(" :'")
+        raise CommandError(f"{what} {str(path)!r} is not a NetCDF file msslib can read ({detail})") from None
+    missing = [v for v in required if v not in ds.variables]
+    if missing:
+        conv = ds.attrs.get("Conventions")
+        kind = "an msslib result" if conv == SCHEMA_VERSION else f"a {SCHEMA_VERSION} result"
+        raise CommandError(f"{what} {str(path)!r} is not {kind} with a mesh: no variable "
+                           f"{', '.join(map(repr, missing))}")
+    for name in ("rest_position", "displacement"):
+        if name in required and set(ds[name].dims) != {"node", "axis"}:
+            raise CommandError(f"{what} {str(path)!r}: variable {name!r} has dimensions {ds[name].dims}, "
+                               f"expected (node, axis)")
+    if "cells" in required:
+        from msslib.io import mesh_from_result
+
+        try:
+            mesh_from_result(ds)
+        except (ValueError, TypeError, KeyError) as exc:
+            raise CommandError(f"{what} {str(path)!r}: not a valid mesh ({_one_line(exc)})") from None
+    return ds
 
 
 def _vtu_path(scene, out: Path, cli_vtu: str | None) -> Path | None:
@@ -102,30 +237,22 @@ def _add_run(subparsers) -> None:
 
 
 def _cmd_run(args) -> int:
-    from msslib.io import write_result
-    from msslib.scene import load_scene, run_scene
+    from msslib.io import StagedOutputs
+    from msslib.scene import run_scene
 
-    scene = load_scene(args.scene)
+    scene = _load_scene(args.scene)
     out = Path(args.out)
     vtu = _vtu_path(scene, out, args.vtu)
-    _check_writable(out, "output file")
-    if vtu is not None:
-        _check_writable(vtu, "VTU file")
-        if vtu.resolve() == out.resolve():
-            raise CommandError(f"the VTU file and the output file are the same: {str(out)!r}")
+    outputs = [("output file", out), ("VTU file", vtu)]
+    _check_distinct(outputs, [("scene file", Path(args.scene)), *_mesh_input(scene)])
+    for what, path in outputs:
+        if path is not None:
+            _check_writable(path, what)
     ds = run_scene(scene, progress=not args.quiet)
-    existed = out.exists()
-    write_result(out, ds)
-    if vtu is not None:
-        try:
-            _write_vtu(vtu, ds)
-        except BaseException:
-            if not existed:  # no half-finished set of outputs
-                try:
-                    out.unlink()
-                except OSError:
-                    pass
-            raise
+    with StagedOutputs() as staged:  # both files, or neither
+        staged.write_result(out, ds)
+        if vtu is not None:
+            staged.write(vtu, lambda tmp: _write_vtu(tmp, ds), what="VTU file")
     if not args.quiet:
         extra = f" and {vtu}" if vtu is not None else ""
         umax = float(abs(ds["displacement"]).max())
@@ -142,9 +269,9 @@ def _add_validate(subparsers) -> None:
 
 
 def _cmd_validate(args) -> int:
-    from msslib.scene import load_scene, prepare
+    from msslib.scene import prepare
 
-    scene = load_scene(args.scene)
+    scene = _load_scene(args.scene)
     setup = prepare(scene)
     mesh = setup.mesh
     kind = scene.solver["type"]
@@ -171,7 +298,9 @@ def _add_experiment(subparsers) -> None:
     c.add_argument("--out", "-o", required=True, help="comparison file (NetCDF)")
     c.add_argument("--table", help="also write the comparison as a Markdown table")
     c.set_defaults(func=_cmd_experiment_compare)
-    a = sub.add_parser("run-all", help="run every (case, model) of an experiment in one process")
+    a = sub.add_parser("run-all", help="run every (case, model) of an experiment in one process",
+                       description="Run every (case, model) of an experiment; the result files are written "
+                                   "together at the end (all of them, or none).")
     a.add_argument("experiment", help="experiment file (YAML)")
     a.add_argument("--out-dir", required=True, help="directory for CASE__MODEL.nc")
     a.add_argument("--quick", action="store_true", help="apply the experiment's reduced (quick) overrides")
@@ -182,12 +311,28 @@ def _add_experiment(subparsers) -> None:
     ls.set_defaults(func=_cmd_experiment_list)
 
 
+def _experiment_scenes(exp, pairs, quick):
+    """Every run's scene, validated (before anything runs); their mesh files."""
+    from msslib import experiment
+    from msslib.scene import load_scene
+
+    meshes = []
+    for case, model in pairs:
+        scene = load_scene(experiment.scene_of(exp, case, model, quick), base_dir=exp.base_dir)
+        meshes += [m for m in _mesh_input(scene) if m not in meshes]
+    return meshes
+
+
 def _cmd_experiment_run(args) -> int:
     from msslib import experiment
     from msslib.io import write_result
 
-    exp = experiment.load_experiment(args.experiment)
+    exp = _load_experiment(args.experiment)
+    _choice("--case", args.case, list(exp.cases), f"case of experiment {exp.name}")
+    _choice("--model", args.model, list(exp.models), f"model of experiment {exp.name}")
+    meshes = _experiment_scenes(exp, [(args.case, args.model)], args.quick)
     out = Path(args.out)
+    _check_distinct([("output file", out)], [("experiment file", Path(args.experiment)), *meshes])
     _check_writable(out, "output file")
     ds = experiment.run(exp, args.case, args.model, quick=args.quick, progress=not args.quiet)
     write_result(out, ds)
@@ -196,46 +341,60 @@ def _cmd_experiment_run(args) -> int:
 
 def _cmd_experiment_run_all(args) -> int:
     from msslib import experiment
-    from msslib.io import write_result
+    from msslib.io import StagedOutputs
 
-    exp = experiment.load_experiment(args.experiment)
+    exp = _load_experiment(args.experiment)
     out_dir = Path(args.out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise CommandError(f"--out-dir {str(out_dir)!r} is not a directory")
     runs = experiment.runs(exp)
-    for i, (case, model) in enumerate(runs, 1):
-        out = out_dir / f"{case}__{model}.nc"
-        if not args.quiet:
-            print(f"[{i}/{len(runs)}] {exp.name}: {case} / {model}", file=sys.stderr, flush=True)
-        write_result(out, experiment.run(exp, case, model, quick=args.quick, progress=not args.quiet))
+    meshes = _experiment_scenes(exp, runs, args.quick)
+    outputs = [("output file", out_dir / f"{case}__{model}.nc") for case, model in runs]
+    _check_distinct(outputs, [("experiment file", Path(args.experiment)), *meshes])
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for what, path in outputs:
+        _check_writable(path, what)
+    with StagedOutputs() as staged:  # every result, or none
+        for i, ((case, model), (_, out)) in enumerate(zip(runs, outputs), 1):
+            if not args.quiet:
+                print(f"[{i}/{len(runs)}] {exp.name}: {case} / {model}", file=sys.stderr, flush=True)
+            staged.write_result(out, experiment.run(exp, case, model, quick=args.quick, progress=not args.quiet))
     return 0
 
 
 def _cmd_experiment_compare(args) -> int:
     from msslib import experiment
-    from msslib.io import read_result, write_result, write_text
+    from msslib.io import StagedOutputs
 
-    exp = experiment.load_experiment(args.experiment)
+    exp = _load_experiment(args.experiment)
     out = Path(args.out)
-    _check_writable(out, "output file")
+    table = Path(args.table) if args.table else None
+    results_dir = Path(args.results)
+    if not results_dir.is_dir():
+        raise CommandError(f"--results {str(results_dir)!r} is not a directory")
+    paths = {(case, model): results_dir / f"{case}__{model}.nc" for case, model in experiment.runs(exp)}
+    outputs = [("output file", out), ("table", table)]
+    _check_distinct(outputs, [("experiment file", Path(args.experiment)), *(("run", p) for p in paths.values())])
+    for what, path in outputs:
+        if path is not None:
+            _check_writable(path, what)
     results = {}
-    for case, model in experiment.runs(exp):
-        path = Path(args.results) / f"{case}__{model}.nc"
+    for key, path in paths.items():
         if not path.is_file():
             raise CommandError(f"missing run {str(path)!r}")
-        results[(case, model)] = read_result(path)
+        results[key] = _read_result(path, "run")
     ds = experiment.compare(exp, results)
-    write_result(out, ds)
-    if args.table:
-        table = Path(args.table)
-        _check_writable(table, "table")
-        write_text(table, experiment.markdown_table(ds))
+    with StagedOutputs() as staged:  # both files, or neither
+        staged.write_result(out, ds, what="comparison")
+        if table is not None:
+            staged.write_text(table, experiment.markdown_table(ds), what="table")
     return 0
 
 
 def _cmd_experiment_list(args) -> int:
     from msslib import experiment
 
-    exp = experiment.load_experiment(args.experiment)
+    exp = _load_experiment(args.experiment)
     for case, model in experiment.runs(exp):
         print(f"{case}__{model}")
     return 0
@@ -250,14 +409,16 @@ def _add_vtu(subparsers) -> None:
 
 
 def _cmd_vtu(args) -> int:
-    from msslib.io import read_result
+    from msslib.io import StagedOutputs
 
-    src = Path(args.result)
-    if not src.is_file():
+    src, out = Path(args.result), Path(args.out)
+    if not src.exists():
         raise CommandError(f"result file not found: {str(src)!r}")
-    out = Path(args.out)
+    _check_distinct([("VTU file", out)], [("result file", src)])
     _check_writable(out, "VTU file")
-    _write_vtu(out, read_result(src))
+    ds = _read_result(src)
+    with StagedOutputs() as staged:
+        staged.write(out, lambda tmp: _write_vtu(tmp, ds), what="VTU file")
     return 0
 
 
@@ -269,10 +430,27 @@ def _add_paper(subparsers) -> None:
 
 
 def _cmd_paper(args) -> int:
-    from msslib.paper import build
+    from msslib.io import StagedOutputs
+    from msslib.paper import expand, render_html
 
-    build(args.source, args.out)
+    source, out = Path(args.source), Path(args.out)
+    twin = out.with_suffix(".md")
+    _input_file(source, "paper source")
+    _check_distinct([("output file", out), ("Markdown twin", twin)], [("paper source", source)])
+    try:
+        main_text = source.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise _not_utf8(source, "paper source", exc) from None
+    text = expand(main_text, source.parent, source.parent.parent)
+    title = next((line.lstrip("# ").strip() for line in text.splitlines() if line.startswith("# ")), "msslib")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with StagedOutputs() as staged:  # the HTML and its Markdown twin, or neither
+        staged.write_text(out, render_html(text, title), what="output file")
+        staged.write_text(twin, text, what="Markdown twin")
     return 0
+
+
+LEVELS_HELP = "distinct integers >= 1 separated by commas, e.g. 1,2,3"
 
 
 def _add_plan(subparsers) -> None:
@@ -281,38 +459,96 @@ def _add_plan(subparsers) -> None:
                                           "(model, resolution) whose error against converged non-linear FEM is within budget.")
     p.add_argument("scene", help="scene file (YAML) with a mesh generator")
     p.add_argument("--max-error", type=float, required=True, help="budget: max node error / max reference displacement")
-    p.add_argument("--front", help="a front measured before (NetCDF from `plan --save` or the workflow)")
-    p.add_argument("--save", help="write the measured front here (NetCDF)")
-    p.add_argument("--levels", default="1,2,3", help="resolution levels to measure (default 1,2,3)")
-    p.add_argument("--repeats", type=int, default=3)
-    p.add_argument("--budget", type=float, default=30.0, help="wall-time budget per run (s); slower runs are recorded as failed")
+    p.add_argument("--front", help="a front measured before (NetCDF from `plan --save`) for this scene")
+    p.add_argument("--save", help="write the front here (NetCDF)")
+    p.add_argument("--levels", help=f"resolution levels to measure: {LEVELS_HELP} (default 1,2,3)")
+    p.add_argument("--repeats", type=int, help="runs per (model, level); the median time counts (default 3)")
+    p.add_argument("--budget", type=float,
+                   help="wall-time budget per run (s); slower runs are recorded as failed (default 30)")
     p.set_defaults(func=_cmd_plan)
+
+
+def _parse_levels(text: str) -> tuple[int, ...]:
+    if not text.strip():
+        raise CommandError(f"--levels is empty; give {LEVELS_HELP}")
+    levels = []
+    for item in text.split(","):
+        item = item.strip()
+        if not item.isdigit() or not item.isascii() or int(item) < 1:
+            raise CommandError(f"--levels {text!r}: {item!r} is not an integer >= 1; give {LEVELS_HELP}")
+        if int(item) in levels:
+            raise CommandError(f"--levels {text!r}: level {int(item)} is given twice; give {LEVELS_HELP}")
+        levels.append(int(item))
+    return tuple(levels)
+
+
+def _positive_number(option: str, value: float, what: str) -> float:
+    if not (math.isfinite(value) and value > 0):
+        raise CommandError(f"{option} must be a finite number > 0 ({what}), got {value!r}")
+    return value
+
+
+def _read_front(path: Path, scene: Path):
+    import yaml
+
+    from msslib import planning
+
+    ds = _read_result(path, "front file", required=())
+    try:
+        planning.check_front(ds, name=f"front file {str(path)!r}")
+    except ValueError as exc:
+        raise CommandError(_one_line(exc)) from None
+    raw, _ = planning._raw(scene)
+    try:
+        measured = yaml.safe_load(str(ds.attrs.get("scene", "")))
+    except yaml.YAMLError:
+        measured = None
+    if measured != raw:
+        raise CommandError(f"front file {str(path)!r} was not measured for the scene {str(scene)!r}; "
+                           f"give the scene it was measured for, or measure again without --front")
+    return ds
 
 
 def _cmd_plan(args) -> int:
     from msslib import planning
-    from msslib.io import read_result, write_result
+    from msslib.io import write_result
 
-    if not args.max_error > 0:
-        raise CommandError(f"--max-error must be > 0, got {args.max_error}")
-    if args.front:
-        front = read_result(args.front)
+    scene = Path(args.scene)
+    max_error = _positive_number("--max-error", args.max_error, "a fraction of the largest reference displacement")
+    if args.front is not None:
+        given = [o for o, v in (("--levels", args.levels), ("--repeats", args.repeats), ("--budget", args.budget))
+                 if v is not None]
+        if given:
+            raise CommandError(f"{given[0]} applies to a measurement; with --front nothing is measured")
+    levels = _parse_levels("1,2,3" if args.levels is None else args.levels)
+    repeats = 3 if args.repeats is None else args.repeats
+    if repeats < 1:
+        raise CommandError(f"--repeats must be an integer >= 1, got {repeats}")
+    budget = 30.0 if args.budget is None else _positive_number("--budget", args.budget, "seconds per run")
+    _input_file(scene, "scene file")
+    front_path = Path(args.front) if args.front is not None else None
+    save = Path(args.save) if args.save is not None else None
+    _check_distinct([("--save file", save)], [("scene file", scene), ("--front file", front_path)])
+    if save is not None:
+        _check_writable(save, "--save file")
+    if front_path is not None:
+        front = _read_front(front_path, scene)
     else:
-        levels = tuple(int(v) for v in args.levels.split(","))
-        front = planning.measure_front(args.scene, levels=levels, repeats=args.repeats, budget=args.budget,
+        front = planning.measure_front(args.scene, levels=levels, repeats=repeats, budget=budget,
                                        progress=lambda s: print(s, file=sys.stderr))
-        if args.save:
-            _check_writable(Path(args.save), "front file")
-            write_result(args.save, front)
-    best = planning.choose(front, args.max_error)
+    if save is not None:
+        write_result(save, front)
+    best = planning.choose(front, max_error)
     print(f"reference: {front.attrs['reference_model']} at level {front.attrs['reference_level']}")
     for m, lv, t, e in planning.pareto(front):
         print(f"  front: {m:26s} level {lv}: {t:.3g} s, max error {100 * e:.3g} %")
     if best is None:
-        raise CommandError(f"no measured model/resolution reaches max error {args.max_error:g}; "
-                           f"smallest measured: {100 * float(front.error_max.min()):.3g} %")
+        smallest = float(front.error_max.min())
+        shown = f"{100 * smallest:.3g} %" if math.isfinite(smallest) else "none (every run failed)"
+        raise CommandError(f"no measured model/resolution reaches max error {max_error:g}; "
+                           f"smallest measured: {shown}")
     m, lv, t, e = best
-    print(f"choice: {m} at resolution level {lv}: max error {100 * e:.3g} % <= {100 * args.max_error:.3g} %, "
+    print(f"choice: {m} at resolution level {lv}: max error {100 * e:.3g} % <= {100 * max_error:.3g} %, "
           f"median wall time {t:.3g} s")
     return 0
 
@@ -330,10 +566,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    """Entry point; returns the exit code (0 ok, 1 error, 2 usage)."""
+    """Entry point; returns the exit code (0 ok, 1 error, 2 usage, 130 interrupted, 143 terminated)."""
     import warnings
 
     from msslib.errors import MsslibWarning, UnphysicalStateError
+    from msslib.io import Terminated, terminate_raises
     from msslib.solvers import ConvergenceError, DivergenceError
 
     parser = build_parser()
@@ -348,12 +585,21 @@ def main(argv=None) -> int:
 
     warnings.showwarning = show
     try:
-        return int(args.func(args) or 0)
+        with terminate_raises():  # SIGTERM unwinds like SIGINT: temporary files are removed
+            return int(args.func(args) or 0)
     except (CommandError, ValueError, OSError, ConvergenceError, DivergenceError, UnphysicalStateError) as exc:
         print(f"msslib: error: {_one_line(exc)}", file=sys.stderr)
         return 1
+    except Terminated:
+        print("msslib: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print("msslib: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:
+        if getattr(exc, "msslib_output", None) is None:  # a failed write of an output names it
+            raise
+        print(f"msslib: error: {_one_line(exc)}", file=sys.stderr)
+        return 1
     finally:
         warnings.showwarning = previous

@@ -11,12 +11,22 @@ derivations.codegen``). Where a published formula is wrong or ambiguous (see ``p
 the function returns the derived one, and ``published=True`` returns the paper's as printed.
 Out-of-domain input raises ``ValueError`` naming the value; a formula used where it is not exact
 (e.g. the triangle formula at nu != 1/3) issues a ``FormulaValidityWarning``.
+
+Types: every argument is a real number (``int``, ``float``, numpy scalar) or a numpy array of real
+numbers; strings, booleans, ``None`` (where a value is required), lists and other objects are
+refused with a ``ValueError`` naming the parameter and the value (``published`` must be
+``True`` or ``False``). Arrays are evaluated element by element: the array arguments of one call
+must all have the same shape (scalars go with any shape; no other broadcasting), and each field of
+the result has that shape (a field that depends on none of the arrays stays a scalar). A result
+that overflows to infinity or comes out NaN (e.g. ``E = 1e308``) is refused with a ``ValueError``
+naming the inputs.
 """
 
 from __future__ import annotations
 
+import numbers
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -31,6 +41,64 @@ class FormulaValidityWarning(UserWarning):
     """A formula is used outside the conditions under which it was derived."""
 
 
+def _brief(value) -> str:
+    """A value for a message: arrays by shape and dtype, long reprs cut."""
+    if isinstance(value, np.ndarray) and value.ndim:
+        return f"array of shape {value.shape} ({value.dtype})"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _real(name, value):
+    """``value`` if it is a real number or a numpy array of real numbers, else ValueError."""
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind not in "iuf":
+            raise ValueError(f"{name} must be a real number or a numpy array of real numbers, "
+                             f"got an array of dtype {value.dtype}: {_brief(value)}")
+        return value
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.integer, np.floating)):
+        raise ValueError(f"{name} must be a real number or a numpy array of real numbers, "
+                         f"got {type(value).__name__} {_brief(value)}")
+    try:
+        float(value)
+    except OverflowError:
+        raise ValueError(f"{name} is too large for double precision, got {_brief(value)}") from None
+    return value
+
+
+def _flag(name, value):
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {type(value).__name__} {_brief(value)}")
+    return bool(value)
+
+
+def _same_shape(function, **args):
+    """All array arguments of one call have the same shape (scalars go with any)."""
+    shapes = {k: np.shape(v) for k, v in args.items() if isinstance(v, np.ndarray) and v.ndim}
+    if len(set(shapes.values())) > 1:
+        shown = ", ".join(f"{k} {s}" for k, s in shapes.items())
+        raise ValueError(f"{function}: array arguments must all have the same shape (no broadcasting), got {shown}")
+
+
+def _evaluate(function, formula, cls, **args):
+    """``cls(*formula(*args))``; a field that overflows to inf or comes out NaN is refused."""
+    shown = ", ".join(f"{k}={_brief(v)}" for k, v in args.items())
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
+        try:
+            values = formula(*args.values())
+        except (OverflowError, ZeroDivisionError):
+            raise ValueError(f"{function}({shown}): the result overflows double precision; the inputs are "
+                             f"out of its range") from None
+    values = values if isinstance(values, tuple) else (values,)
+    for f, v in zip(fields(cls), values):
+        bad = ~np.isfinite(np.asarray(v, dtype=float))
+        if np.any(bad):
+            what = "is infinite" if np.any(np.isinf(np.asarray(v, dtype=float))) else "is NaN"
+            raise ValueError(f"{function}({shown}): {f.name} {what}; the inputs are out of the range "
+                             f"of double precision")
+    return cls(*values)
+
+
 def _offending(value, bad):
     """The value itself (scalars) or the first offending entry and where it is (arrays)."""
     v = np.asarray(value, dtype=float)
@@ -41,6 +109,7 @@ def _offending(value, bad):
 
 
 def _positive(name, value):
+    _real(name, value)
     v = np.asarray(value, dtype=float)
     bad = ~np.isfinite(v) | (v <= 0)
     if np.any(bad):
@@ -49,6 +118,7 @@ def _positive(name, value):
 
 
 def _poisson(nu, low=-1.0, high=0.5):
+    _real("Poisson's ratio nu", nu)
     v = np.asarray(nu, dtype=float)
     bad = ~np.isfinite(v) | (v <= low) | (v >= high)
     if np.any(bad):
@@ -73,6 +143,9 @@ def check_material(E, nu, model=None):
     (``FormulaValidityWarning``) when ``model`` is exact or optimal only at another nu."""
     _positive("E", E)
     _poisson(nu)
+    _same_shape("check_material", E=E, nu=nu)
+    if model is not None and not isinstance(model, str):
+        raise ValueError(f"model must be a model name or None, got {type(model).__name__} {_brief(model)}")
     if model in VALID_NU:
         _warn_nu(nu, VALID_NU[model], model)
 
@@ -121,8 +194,9 @@ def lloyd_triangle(E, t, *, nu=None) -> TriangleSprings:
     _positive("E", E), _positive("thickness t", t)
     if nu is not None:
         _poisson(nu)
+    _same_shape("lloyd_triangle", E=E, t=t, nu=nu)
     _warn_nu(nu, 1 / 3, "lloyd_triangle")
-    return TriangleSprings(_tri.lloyd_triangle(E, t))
+    return _evaluate("lloyd_triangle", _tri.lloyd_triangle, TriangleSprings, E=E, t=t)
 
 
 def van_gelder_triangle(E, t, area, length, *, nu=None) -> TriangleSprings:
@@ -130,8 +204,10 @@ def van_gelder_triangle(E, t, area, length, *, nu=None) -> TriangleSprings:
     _positive("E", E), _positive("thickness t", t), _positive("area", area), _positive("length", length)
     if nu is not None:
         _poisson(nu)
+    _same_shape("van_gelder_triangle", E=E, t=t, area=area, length=length, nu=nu)
     _warn_nu(nu, 1 / 3, "van_gelder_triangle")
-    return TriangleSprings(_tri.van_gelder_triangle(E, t, area, length))
+    return _evaluate("van_gelder_triangle", _tri.van_gelder_triangle, TriangleSprings, E=E, t=t, area=area,
+                     length=length)
 
 
 def lloyd_square(E, t, *, nu=None) -> SquareSprings:
@@ -139,8 +215,9 @@ def lloyd_square(E, t, *, nu=None) -> SquareSprings:
     _positive("E", E), _positive("thickness t", t)
     if nu is not None:
         _poisson(nu)
+    _same_shape("lloyd_square", E=E, t=t, nu=nu)
     _warn_nu(nu, 1 / 3, "lloyd_square")
-    return SquareSprings(*_square.lloyd_square(E, t))
+    return _evaluate("lloyd_square", _square.lloyd_square, SquareSprings, E=E, t=t)
 
 
 def equivalent_edge_length(volume):
@@ -154,26 +231,32 @@ def lloyd_tetrahedron(E, l, *, nu=None) -> TetrahedronSprings:
     least-squares optimum for that nu (derived; eq. 12 is its value at 1/4)."""
     _positive("E", E), _positive("edge length l", l)
     if nu is None:
-        return TetrahedronSprings(_tet.lloyd_tetrahedron(E, l))
+        _same_shape("lloyd_tetrahedron", E=E, l=l)
+        return _evaluate("lloyd_tetrahedron", _tet.lloyd_tetrahedron, TetrahedronSprings, E=E, l=l)
     _poisson(nu)
-    return TetrahedronSprings(_tet.lloyd_tetrahedron_general_nu(E, nu, l))
+    _same_shape("lloyd_tetrahedron", E=E, l=l, nu=nu)
+    return _evaluate("lloyd_tetrahedron", _tet.lloyd_tetrahedron_general_nu, TetrahedronSprings, E=E, nu=nu, l=l)
 
 
 def lloyd_tetrahedron_volume(E, l, nu=0.25, *, published=False) -> TetrahedronVolumeSprings:
     """Lloyd et al. eq. 14 with the volume energy: the least-squares optimum for ``nu`` (derived);
     ``published=True`` gives eq. 14 as printed (its value at nu = 1/4, whatever ``nu``)."""
     _positive("E", E), _positive("edge length l", l), _poisson(nu)
-    if published:
-        return TetrahedronVolumeSprings(*_tet.lloyd_tetrahedron_volume_published(E, l))
-    return TetrahedronVolumeSprings(*_tet.lloyd_tetrahedron_volume(E, nu, l))
+    _same_shape("lloyd_tetrahedron_volume", E=E, l=l, nu=nu)
+    if _flag("published", published):
+        return _evaluate("lloyd_tetrahedron_volume", _tet.lloyd_tetrahedron_volume_published, TetrahedronVolumeSprings,
+                         E=E, l=l)
+    return _evaluate("lloyd_tetrahedron_volume", _tet.lloyd_tetrahedron_volume, TetrahedronVolumeSprings,
+                     E=E, nu=nu, l=l)
 
 
 def baudet_cube(E, nu, a, *, published=False) -> BaudetCube:
     """Baudet et al. eqs. 7-8 for a cube of edge a; the correction factor is for resultants per face
     (derived: -(4 nu - 1)/2); ``published=True`` gives the printed -(4 nu - 1)/16."""
     _positive("E", E), _poisson(nu), _positive("cube edge a", a)
-    f = _baudet.baudet_cube_published if published else _baudet.baudet_cube
-    return BaudetCube(*f(E, nu, a))
+    _same_shape("baudet_cube", E=E, nu=nu, a=a)
+    f = _baudet.baudet_cube_published if _flag("published", published) else _baudet.baudet_cube
+    return _evaluate("baudet_cube", f, BaudetCube, E=E, nu=nu, a=a)
 
 
 def golec_cube(E, nu, a, A, *, published=False) -> GolecCube:
@@ -181,5 +264,6 @@ def golec_cube(E, nu, a, A, *, published=False) -> GolecCube:
     make the lattice exactly isotropic with E and nu); ``published=True`` gives the printed values
     (k_edge and k_face there are interior totals, see the errata)."""
     _positive("E", E), _poisson(nu), _positive("cube edge a", a), _positive("ratio A", A)
-    f = _golec.golec_cube_published if published else _golec.golec_cube
-    return GolecCube(*f(E, nu, a, A))
+    _same_shape("golec_cube", E=E, nu=nu, a=a, A=A)
+    f = _golec.golec_cube_published if _flag("published", published) else _golec.golec_cube
+    return _evaluate("golec_cube", f, GolecCube, E=E, nu=nu, a=a, A=A)

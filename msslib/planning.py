@@ -15,6 +15,9 @@ reference displacement (maximum over nodes of the Euclidean error).
 from __future__ import annotations
 
 import copy
+import math
+import numbers
+import os
 import time
 from pathlib import Path
 
@@ -32,32 +35,114 @@ SCALED = {"nx", "ny", "nz", "n", "n_rings"}
 
 
 def _raw(scene):
+    """The scene as a plain mapping, and the directory its relative paths refer to."""
     if isinstance(scene, dict):
         return copy.deepcopy(scene), Path.cwd()
+    if not isinstance(scene, (str, os.PathLike)):
+        raise ValueError(f"scene must be a scene file or a mapping, got {type(scene).__name__} {scene!r}")
     path = Path(scene)
     if not path.is_file():
         raise FileNotFoundError(f"scene file not found: {str(scene)!r}")
-    return yaml.safe_load(path.read_text(encoding="utf-8")), path.parent
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"scene file {str(scene)!r} is not UTF-8 text (byte {exc.start}: {exc.reason})") from None
+    try:
+        raw = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ValueError(f"scene file {str(scene)!r}: invalid YAML: {' '.join(str(exc).split())}") from None
+    if raw is None:
+        raise ValueError(f"scene file {str(scene)!r} is empty; planning needs a scene with a mesh generator")
+    if not isinstance(raw, dict):
+        raise ValueError(f"scene file {str(scene)!r}: expected a mapping (a scene), got {type(raw).__name__}")
+    return raw, path.resolve().parent
+
+
+def _scaled(path, value, level, kind):
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, str)):
+        raise ValueError(f"{path}: expected a number, got {value!r}")
+    try:
+        number = float(value)
+    except (ValueError, OverflowError):
+        raise ValueError(f"{path}: expected a number, got {value!r}") from None
+    if not math.isfinite(number) or number <= 0:
+        raise ValueError(f"{path}: expected a finite number > 0, got {value!r}")
+    if kind == "count":
+        if number != int(number):
+            raise ValueError(f"{path}: expected an integer (a number of cells), got {value!r}")
+        return int(number) * level
+    return number / level
 
 
 def refine(raw: dict, level: int) -> dict:
     """The scene with its generator's resolution arguments scaled by ``level``."""
+    level = _level("level", level)
+    if not isinstance(raw, dict):
+        raise ValueError(f"scene: expected a mapping, got {type(raw).__name__}")
     out = copy.deepcopy(raw)
     geo = out.get("geometry", {})
-    if "generator" not in geo:
+    if not isinstance(geo, dict) or "generator" not in geo:
         raise ValueError("scene.geometry: planning needs a generator (a mesh file has one resolution)")
     args = geo.setdefault("args", {})
+    if not isinstance(args, dict):
+        raise ValueError(f"scene.geometry.args: expected a mapping, got {args!r}")
     scaled = False
     for k in list(args):
         if k in SCALED:
-            args[k] = int(args[k]) * level
+            args[k] = _scaled(f"scene.geometry.args.{k}", args[k], level, "count")
             scaled = True
         elif k == "h":
-            args[k] = float(args[k]) / level
+            args[k] = _scaled(f"scene.geometry.args.{k}", args[k], level, "size")
             scaled = True
     if not scaled:
         raise ValueError(f"scene.geometry.args: no resolution argument among {sorted(SCALED | {'h'})}")
     return out
+
+
+def _level(name, value):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Integral, np.integer)) or value < 1:
+        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+    return int(value)
+
+
+def check_arguments(*, levels=(1, 2, 3), models=None, repeats=3, budget=30.0, max_error=None):
+    """Validate the arguments of :func:`measure_front` (and ``max_error`` of :func:`choose`);
+    ValueError naming the argument and what is allowed. Returns ``levels`` as a tuple of ints."""
+    if isinstance(levels, (str, bytes)) or not isinstance(levels, (list, tuple, np.ndarray)):
+        raise ValueError(f"levels must be a non-empty sequence of integers >= 1, got {levels!r}")
+    levels = tuple(_level(f"levels[{i}]", v) for i, v in enumerate(levels))
+    if not levels:
+        raise ValueError("levels must be a non-empty sequence of integers >= 1, got none")
+    twice = sorted({v for v in levels if levels.count(v) > 1})
+    if twice:
+        raise ValueError(f"levels must be distinct, got {list(levels)} ({', '.join(map(str, twice))} repeated)")
+    if models is not None:
+        if isinstance(models, str) or not isinstance(models, (list, tuple)) or not models:
+            raise ValueError(f"models must be None or a non-empty list of model names, got {models!r}")
+        from msslib.scene import MODELS as known
+
+        for m in models:
+            if m not in known:
+                raise ValueError(f"models: unknown model {m!r}; expected some of {', '.join(known)}")
+        if len(set(models)) != len(models):
+            raise ValueError(f"models must be distinct, got {list(models)}")
+    if isinstance(repeats, (bool, np.bool_)) or not isinstance(repeats, (numbers.Integral, np.integer)) or repeats < 1:
+        raise ValueError(f"repeats must be an integer >= 1, got {repeats!r}")
+    if budget is not None:
+        if isinstance(budget, (bool, np.bool_)) or not isinstance(budget, numbers.Real) or not (
+                math.isfinite(budget) and budget > 0):
+            raise ValueError(f"budget must be a finite number of seconds > 0 (or None for no limit), got {budget!r}")
+    if max_error is not None:
+        _max_error(max_error)
+    return levels
+
+
+def _max_error(value):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) or not (
+            math.isfinite(value) and value > 0):
+        raise ValueError(f"max_error must be a finite number > 0 (a fraction of the largest reference "
+                         f"displacement), got {value!r}")
+    return float(value)
 
 
 def _with_model(raw, model):
@@ -66,9 +151,11 @@ def _with_model(raw, model):
     opts = {k: v for k, v in m.items() if k not in ("type", "published", "terms", "A")} if isinstance(m, dict) else {}
     if model.startswith("fem"):
         opts = {k: v for k, v in opts.items() if k == "plane"}
-        sol = out.get("solver", {})
-        if sol.get("type") == "dynamic":
+        sol = out.get("solver") or {}
+        if isinstance(sol, dict) and sol.get("type") == "dynamic":
             raise ValueError("planning compares static solves; the scene is dynamic")
+    else:  # mass-spring models are plane stress and take no FEM option
+        opts = {k: v for k, v in opts.items() if k != "plane"}
     out["model"] = {"type": model, **opts}
     return out
 
@@ -98,22 +185,52 @@ def _run(raw, base_dir, budget=None):
         signal.signal(signal.SIGALRM, old)
 
 
+def check_scene(scene, *, levels=(1, 2, 3), models=None):
+    """Validate a scene for planning without solving anything: a mapping or a scene file with a
+    mesh generator and a resolution argument, valid (:func:`msslib.scene.load_scene`) at every
+    level with every model, a mesh that can be built at the first level, a static solver.
+    Returns ``(raw, base_dir, cell_type, models, reference_model)``; ValueError (or
+    FileNotFoundError) naming what is wrong."""
+    from msslib.scene import FEM_MODELS, MSS_MODELS, load_scene, prepare
+
+    levels = check_arguments(levels=levels, models=models)
+    raw, base_dir = _raw(scene)
+    load_scene(raw, base_dir=base_dir)  # every key and value, with the usual messages
+    setup = prepare(load_scene(refine(raw, levels[0]), base_dir=base_dir))  # builds the mesh, no solve
+    cell_type = setup.mesh.cell_type
+    if cell_type not in MODELS:
+        raise ValueError(f"scene.geometry: planning knows no models for {cell_type} cells")
+    if setup.scene.is_dynamic:
+        raise ValueError("scene.solver: planning compares static solves; the scene is dynamic")
+    models = list(models or MODELS[cell_type])
+    fitting = [*FEM_MODELS, *(m for m, (cells, _) in MSS_MODELS.items() if cells == cell_type)]
+    wrong = [m for m in models if m not in fitting]
+    if wrong:
+        raise ValueError(f"models: {', '.join(wrong)} cannot run on {cell_type} cells; expected some of "
+                         f"{', '.join(fitting)}")
+    ref_model = REFERENCE[cell_type]
+    for level in (*levels, max(levels) + 1):
+        for model in dict.fromkeys([*models, ref_model]):
+            load_scene(_with_model(refine(raw, level), model), base_dir=base_dir)
+    return raw, base_dir, cell_type, models, ref_model
+
+
 def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.0, progress=print):
     """Measure time and error of every (model, level); returns an xarray Dataset.
 
-    A run that fails or exceeds ``budget`` seconds is recorded in ``status`` (with NaN time and
-    error) instead of stopping the sweep: that a model breaks on a scene is a result too."""
+    Every argument and the scene are checked before anything is run (:func:`check_arguments`,
+    :func:`check_scene`). A run that fails or exceeds ``budget`` seconds (None: no limit) is
+    recorded in ``status`` (with NaN time and error) instead of stopping the sweep: that a model
+    breaks on a scene is a result too."""
     import xarray as xr
 
     from msslib.experiment import interpolate
     from msslib.io import mesh_from_result
     from msslib.metrics import displacement_error
 
-    raw, base_dir = _raw(scene)
-    probe = _run(refine(raw, levels[0]), base_dir) if models is None else None
-    cell_type = probe.cells.attrs["cell_type"] if probe is not None else None
-    models = list(models or MODELS[cell_type])
-    ref_model = REFERENCE[cell_type] if cell_type else "fem_neohookean"
+    levels = check_arguments(levels=levels, models=models, repeats=repeats, budget=budget)
+    raw, base_dir, cell_type, models, ref_model = check_scene(scene, levels=levels, models=models)
+    repeats = int(repeats)
     ref_level = max(levels) + 1
     t0 = time.perf_counter()
     ref = _run(_with_model(refine(raw, ref_level), ref_model), base_dir)
@@ -122,6 +239,10 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
     ref_mesh = mesh_from_result(ref)
     u_ref = ref["displacement"].transpose("node", "axis").values
     scale = float(np.linalg.norm(u_ref, axis=1).max())
+    if not (math.isfinite(scale) and scale > 0):
+        raise ValueError(f"the reference ({ref_model} at level {ref_level}) does not move (largest displacement "
+                         f"{scale:g} m): errors relative to it mean nothing; give the scene a load or a "
+                         f"prescribed displacement")
     shape = (len(models), len(levels))
     wall = np.full(shape, np.nan)
     err_max = np.full(shape, np.nan)
@@ -163,8 +284,27 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
     return out
 
 
+FRONT_VARIABLES = ("wall_time", "error_max", "error_mean", "n_dofs", "status")
+FRONT_ATTRS = ("reference_model", "reference_level")
+
+
+def check_front(front, name="front"):
+    """ValueError naming ``name`` unless ``front`` is a front of :func:`measure_front`."""
+    import xarray as xr
+
+    if not isinstance(front, xr.Dataset):
+        raise ValueError(f"{name} must be an xarray Dataset from measure_front, got {type(front).__name__}")
+    missing = [v for v in FRONT_VARIABLES if v not in front.variables] + [a for a in FRONT_ATTRS if a not in front.attrs]
+    if missing or set(front["error_max"].dims) != {"model", "level"}:
+        what = f"lacks {', '.join(map(repr, missing))}" if missing else "has the wrong dimensions"
+        raise ValueError(f"{name} is not a front measured by msslib plan ({what})")
+    return front
+
+
 def choose(front, max_error: float):
     """The cheapest measured (model, level) with ``error_max <= max_error``, or None."""
+    check_front(front)
+    max_error = _max_error(max_error)
     best = None
     for m in front.model.values:
         for lv in front.level.values:
@@ -177,6 +317,7 @@ def choose(front, max_error: float):
 
 def pareto(front):
     """(model, level, time, error) on the Pareto front: no other point is both faster and more accurate."""
+    check_front(front)
     pts = [(str(m), int(lv), float(front.wall_time.sel(model=m, level=lv)), float(front.error_max.sel(model=m, level=lv)))
            for m in front.model.values for lv in front.level.values]
     pts = [p for p in pts if np.isfinite(p[2]) and np.isfinite(p[3])]

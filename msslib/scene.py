@@ -346,7 +346,10 @@ def _number(path, value, *, low=None, high=None, low_open=True, high_open=True, 
         except ValueError:
             _fail(path, f"expected {what}, got {value!r}")
     elif isinstance(value, (int, float, np.integer, np.floating)):
-        number = float(value)
+        try:
+            number = float(value)
+        except OverflowError:  # an integer beyond double precision
+            number = math.inf
     else:
         _fail(path, f"expected {what}, got {value!r}")
     if not math.isfinite(number):
@@ -500,9 +503,9 @@ def _generator_arg(path, value):
         return tuple(_generator_arg(f"{path}[{i}]", v) for i, v in enumerate(value))
     if isinstance(value, bool):
         _fail(path, f"expected a number, got {value!r}")
-    if isinstance(value, int):
+    if isinstance(value, int) and abs(value) < 2**63:
         return value
-    return _number(path, value)
+    return _number(path, value)  # an integer beyond 64 bits as a float; beyond double range refused
 
 
 def _materials(path, value):
