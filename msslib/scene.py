@@ -733,9 +733,9 @@ def load_scene(source, *, base_dir=None) -> Scene:
     if isinstance(source, Scene):
         return source
     if isinstance(source, Mapping):
-        raw = source
+        raw = _plain(source)
         path = None
-        text = yaml.safe_dump(_plain(raw), sort_keys=False)
+        text = yaml.safe_dump(raw, sort_keys=False)
         base = Path(base_dir) if base_dir is not None else Path.cwd()
     else:
         path = Path(source)
@@ -785,17 +785,22 @@ def load_scene(source, *, base_dir=None) -> Scene:
                  solver=solver, output=output, checks=checks, text=text, path=path)
 
 
-def _plain(value):
-    """A dict/list tree of plain Python values (for YAML dumping)."""
+def _plain(value, path="scene"):
+    """A dict/list tree of plain Python values (for YAML dumping and validation): numpy scalars and
+    arrays become numbers and lists, paths strings; any other object is an error naming its key."""
     if isinstance(value, Mapping):
-        return {str(k): _plain(v) for k, v in value.items()}
+        return {str(k): _plain(v, f"{path}.{k}") for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
+        return [_plain(v, f"{path}[{i}]") for i, v in enumerate(value)]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist(), path)
     if isinstance(value, np.generic):
         return value.item()
     if isinstance(value, Path):
         return str(value)
-    return value
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    _fail(path, f"expected numbers, strings, lists or mappings, got {type(value).__name__} {value!r}")
 
 
 # --------------------------------------------------------------------------------------------

@@ -373,3 +373,20 @@ def test_scene_with_huge_values_stops_with_one_line(tmp_path, capsys):
 def test_valid_scene_still_runs():
     ds = run_scene(SCENE, progress=False)
     assert float(abs(ds["displacement"]).max()) == pytest.approx(0.001)
+
+
+def test_dict_scene_with_numpy_values_is_read_and_checked():
+    import numpy as np
+
+    from msslib.scene import load_scene
+
+    d = {"geometry": {"generator": "hex_grid", "args": {"lx": 1, "ly": 1, "lz": 1, "nx": np.int64(2), "ny": 2, "nz": 2}},
+         "materials": [{"E": np.float64(1e6), "nu": 0.3, "density": 1.0}], "model": "golec_cube",
+         "loads": [{"type": "gravity", "g": np.array([0.0, 0.0, -9.81])}]}
+    assert load_scene(d).loads[0]["g"] == [0.0, 0.0, -9.81]
+    d["loads"][0]["g"] = np.zeros((2, 2))
+    with pytest.raises(ValueError, match=r"scene\.loads\[0\]\.g\[0\]: expected a number"):
+        load_scene(d)
+    d["loads"][0]["g"] = object()
+    with pytest.raises(ValueError, match=r"scene\.loads\[0\]\.g: expected numbers, strings, lists or mappings"):
+        load_scene(d)
