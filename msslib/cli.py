@@ -218,7 +218,9 @@ def _write_vtu(path: Path, ds) -> None:
         point_data["reaction_force"] = ds["reaction_force"].transpose("node", "axis").values
     if "fixed" in ds:
         point_data["fixed"] = np.asarray(ds["fixed"].transpose("node", "axis").values, dtype=np.int8)
-    write_vtu(path, mesh, point_data=point_data)
+    # the final state's cell check (msslib.quality): ParaView can threshold on the inverted cells
+    cell_data = {name: np.asarray(ds[name].values) for name in ("cell_state", "relative_jacobian") if name in ds}
+    write_vtu(path, mesh, point_data=point_data, cell_data=cell_data or None)
 
 
 # --------------------------------------------------------------------------------------------

@@ -296,6 +296,14 @@ def test_warning_through_the_cli_keeps_the_result(tmp_path, capsys):
     assert len([line for line in err if "unphysical" in line]) == 1
     ds = read_result(out)
     assert ds.attrs["inverted_cells"] == 8 and ds["cell_state"].values.tolist() == [Q.INVERTED] * 8
+    # the VTU export carries the cell check, for ParaView
+    vtu = tmp_path / "out.vtu"
+    assert main(["vtu", str(out), "--out", str(vtu)]) == 0
+    import meshio
+
+    cell_data = meshio.read(vtu).cell_data
+    assert np.concatenate(cell_data["cell_state"]).tolist() == [Q.INVERTED] * 8
+    np.testing.assert_allclose(np.concatenate(cell_data["relative_jacobian"]), ds["relative_jacobian"].values)
 
 
 @pytest.mark.parametrize("strain", [0.1, 0.5])
