@@ -34,9 +34,20 @@ Cases (dimension ``case``):
   dimensions).
 * ``contrast_1`` / ``contrast_1000``: bar of two materials (E and 1000 E) in series, clamped at
   one end, pulled by a traction at the other (1 % strain in the soft half).
-* ``explicit_1.5x`` / ``implicit_1.5x``: cantilever under gravity released from rest, symplectic
-  Euler at 1.5 times ``explicit_stability_limit`` (must raise DivergenceError) and implicit Euler
-  at the same step (must stay finite; error = max |u| / static max |u|).
+* ``explicit_1.05x`` / ``explicit_1.2x`` / ``explicit_1.5x`` / ``explicit_2x`` / ``implicit_1.5x``:
+  cantilever under gravity released from rest, symplectic Euler at that multiple of
+  ``explicit_stability_limit``: refused by default (StabilityError, both numbers in the
+  message), then run with ``allow_unstable=True`` until the divergence detector stops it
+  (DivergenceError; ``stop_step``, ``stop_displacement`` = max |u| when stopped / static max |u|,
+  and error = distance of the last state before the stop from a stable run to the same time /
+  static max |u| record how early); implicit Euler at 1.5 x (must stay finite; error = max |u| /
+  static max |u|).
+* ``unloaded``: 0.1 m cube clamped on one face, no load: every static solver must return at once
+  (``iterations`` 0, at the round-off floor; error = max |u| / edge length).
+* ``slender_beam``: 1 m x 2 cm x 2 cm beam, E = 1 GPa, clamped, under its own weight, default
+  tolerance 1e-8 (below the round-off of the spring forces: converged at the round-off floor);
+  error = tip deflection / Euler-Bernoulli ``q L^4 / (8 E I)`` - 1 (4 cubes across; 2 in quick
+  mode, where bending locking makes every model stiffer).
 """
 
 from __future__ import annotations
@@ -70,14 +81,16 @@ COMPRESSIONS = (0.1, 0.3, 0.5)
 SHAPES = ("regular", "sliver", "cap", "spindle", "wedge")
 TET_EDGES = M._LOCAL_EDGES["tetra"]
 
-FIELDS = ("ran", "converged", "error", "volume_ratio", "min_volume_ratio", "n_inverted", "outcome")
+FIELDS = ("ran", "converged", "error", "volume_ratio", "min_volume_ratio", "n_inverted", "iterations", "stop_step",
+          "stop_displacement", "outcome")
 
 
 def _record(ran=False, converged=False, error=np.nan, volume_ratio=np.nan, min_volume_ratio=np.nan,
-            n_inverted=-1, outcome=""):
+            n_inverted=-1, outcome="", iterations=-1, stop_step=-1, stop_displacement=np.nan):
     return {"ran": bool(ran), "converged": bool(converged), "error": float(error),
             "volume_ratio": float(volume_ratio), "min_volume_ratio": float(min_volume_ratio),
-            "n_inverted": int(n_inverted), "outcome": " ".join(str(outcome).split())[:300]}
+            "n_inverted": int(n_inverted), "iterations": int(iterations), "stop_step": int(stop_step),
+            "stop_displacement": float(stop_displacement), "outcome": " ".join(str(outcome).split())[:300]}
 
 
 def _short(exc: BaseException) -> str:
@@ -405,22 +418,52 @@ def cantilever(name, n=4):
     return MD.Model(mesh, terms, fixed=fixed, masses=masses)
 
 
+def explicit_run(model, factor, n_steps):
+    """Symplectic Euler at ``factor`` x the stability limit: first as a user would run it (refused
+    up front), then with ``allow_unstable`` (stopped by the divergence detector); one record."""
+    from msslib.errors import StabilityError
+
+    limit = S.explicit_stability_limit(model, model.x0)
+    dt = factor * limit
+    v0 = np.zeros(model.n_dof)
+    kw = dict(dt=dt, t_end=n_steps * dt, method="symplectic_euler", damping=0.0)
+    try:
+        S.integrate(model, model.x0, v0, **kw)
+        refused, detail = f"NOT REFUSED at {factor:g} x the limit {limit:.4g} s", ""
+    except StabilityError as exc:
+        refused, detail = "refused", f"; {_short(exc)[:120]}"
+    u_static = np.abs(S.static_solve(model, model.x0).x - model.x0).max()
+    try:
+        S.integrate(model, model.x0, v0, allow_unstable=True, **kw)
+        return _record(True, True, outcome=f"{refused}; NOT DETECTED: no divergence in {n_steps} steps with "
+                       f"allow_unstable{detail}")
+    except S.DivergenceError as exc:
+        moved = exc.max_displacement / u_static
+        ok = np.isfinite(exc.x_last).all()
+        # how wrong the body was: the last state against a stable run (half the limit) to the same time
+        t_last = (exc.step - 1) * dt
+        if t_last > 0:
+            ref = S.integrate(model, model.x0, v0, dt=0.5 * limit, t_end=t_last, method="symplectic_euler",
+                              damping=0.0, save_every=10**9)
+            wrong = float(np.abs(exc.x_last - ref.x_final).max()) / u_static
+        else:
+            wrong = float(np.abs(exc.x_last - model.x0).max()) / u_static
+        return _record(ran=True, error=wrong, stop_step=exc.step, stop_displacement=moved,
+                       outcome=f"{refused}; allow_unstable: stopped at step {exc.step}, off a stable run by "
+                       f"{wrong:.2g} x static (max |u| {moved:.3g} x static, {exc.quantity}, last state "
+                       f"{'finite' if ok else 'NON-FINITE'}){detail}")
+
+
 def dynamics_case(factor=1.5, n_steps=200):
-    """Symplectic Euler and implicit Euler at ``factor`` times the explicit stability limit."""
+    """Symplectic Euler (refused; then with allow_unstable) and implicit Euler at ``factor`` times
+    the explicit stability limit."""
     explicit, implicit = {}, {}
     for name in MSS_MODELS:
         model = cantilever(name)
+        explicit[name] = explicit_run(model, factor, n_steps)
         limit = S.explicit_stability_limit(model, model.x0)
         dt = factor * limit
         v0 = np.zeros(model.n_dof)
-        try:
-            r = S.integrate(model, model.x0, v0, dt=dt, t_end=n_steps * dt, method="symplectic_euler", damping=0.0)
-            explicit[name] = _record(True, True, outcome=f"NOT DETECTED: no divergence in {n_steps} steps at dt = "
-                                     f"{factor} x {limit:.3g} s")
-        except S.DivergenceError as exc:
-            ok = np.isfinite(exc.x_last).all()
-            explicit[name] = _record(ran=True, outcome=f"DivergenceError at step {exc.step} ({exc.quantity}; last "
-                                     f"state {'finite' if ok else 'NON-FINITE'}), dt = {factor} x limit {limit:.3g} s")
         static = S.static_solve(model, model.x0)
         u_static = np.abs(static.x - model.x0).max()
         try:
@@ -432,6 +475,92 @@ def dynamics_case(factor=1.5, n_steps=200):
         except (S.DivergenceError, S.ConvergenceError) as exc:
             implicit[name] = _record(ran=True, outcome=_short(exc))
     return explicit, implicit
+
+
+def explicit_case(factor, n_steps=200):
+    """Symplectic Euler at ``factor`` x the limit, every MSS model (see :func:`explicit_run`)."""
+    return {name: explicit_run(cantilever(name), factor, n_steps) for name in MSS_MODELS}
+
+
+def _static_record(res, t0, error, extra=""):
+    floor = (f"; at the round-off floor {res.roundoff_floor:.2e} N (tol x F_ref {1e-8 * res.force_scale:.2e} N)"
+             if res.roundoff_steps else "")
+    return _record(True, True, error=error, iterations=res.total_iterations,
+                   outcome=f"converged ({res.total_iterations} Newton iterations, {time.perf_counter() - t0:.2f} s)"
+                   f"{floor}{extra}")
+
+
+def unloaded_case(n=3):
+    """0.1 m cube clamped on x = 0, no load: every static solve must return at once."""
+    hexm, tetm = cube_meshes(0.1, n)
+    out = {}
+    for mesh, names in ((hexm, CUBE_MODELS + FEM_MODELS), (tetm, TET_MODELS)):
+        fixed = np.zeros((mesh.n_nodes, 3), bool)
+        fixed[np.isclose(mesh.points[:, 0], 0.0)] = True
+        for name in names:
+            t0 = time.perf_counter()
+            if name in FEM_MODELS:
+                law = {"fem_linear": None, "fem_svk": "svk", "fem_neohookean": "neohookean"}[name]
+                rec, r = run_fem(law, mesh, E0, 0.3, fixed, steps=1)
+                if r is not None:
+                    its = sum(r.stats["iterations"]) if law else 0
+                    rec.update(error=float(np.abs(r.displacement).max()) / 0.1, iterations=its)
+                    rec["outcome"] += f"; {its} Newton iterations" if law else "; linear solve"
+                out[name] = rec
+                continue
+            model = MD.Model(mesh, mss_terms(name, mesh, [(E0, 0.3)]), fixed=fixed)
+            try:
+                res = S.static_solve(model, model.x0)
+            except S.ConvergenceError as exc:
+                out[name] = _record(ran=True, outcome=f"no convergence: {_short(exc)}")
+                continue
+            out[name] = _static_record(res, t0, np.abs(res.x - model.x0).max() / 0.1)
+    return out
+
+
+def slender_beam_case(nyz=4, length=1.0, width=0.02, E=1.0e9):
+    """``length`` x ``width``^2 beam of ``nyz``^2 cubes across, clamped at x = 0, under its own
+    weight, default tolerance; error = tip deflection / Euler-Bernoulli - 1."""
+    nx = int(round(length / width * nyz))
+    hexm = M.hex_grid(length, width, width, nx, nyz, nyz)
+    tetm = M.tet_grid(length, width, width, nx, nyz, nyz, scheme=6)
+    q, inertia = DENSITY * 9.81 * width**2, width**4 / 12.0
+    w_eb = q * length**4 / (8.0 * E * inertia)
+    out = {}
+    for mesh, names in ((hexm, CUBE_MODELS + FEM_MODELS), (tetm, TET_MODELS)):
+        fixed = np.zeros((mesh.n_nodes, 3), bool)
+        fixed[np.isclose(mesh.points[:, 0], 0.0)] = True
+        masses = M.lumped_masses(mesh, DENSITY)
+        for name in names:
+            t0 = time.perf_counter()
+            if name in FEM_MODELS:
+                law = {"fem_linear": None, "fem_svk": "svk", "fem_neohookean": "neohookean"}[name]
+                body = [0.0, 0.0, -DENSITY * 9.81]
+                try:
+                    if law is None:
+                        r = fem.solve_linear(mesh, E, 0.3, fixed=fixed, body_force=body)
+                    else:
+                        r = fem.solve_nonlinear(mesh, E, 0.3, fixed=fixed, body_force=body, law=law, steps=1)
+                except RuntimeError as exc:
+                    out[name] = _record(ran=True, outcome=f"no convergence: {_short(exc)}")
+                    continue
+                w = -float(r.displacement[:, 2].min())
+                its = sum(r.stats["iterations"]) if law else 0
+                out[name] = _record(True, True, error=w / w_eb - 1.0, iterations=its if law else -1,
+                                    outcome=f"converged ({time.perf_counter() - t0:.2f} s); tip {1e3 * w:.3f} mm, "
+                                    f"Euler-Bernoulli {1e3 * w_eb:.3f} mm")
+                continue
+            terms = mss_terms(name, mesh, [(E, 0.3)]) + [Gravity(masses, [0.0, 0.0, -9.81])]
+            model = MD.Model(mesh, terms, fixed=fixed, masses=masses)
+            try:
+                res = S.static_solve(model, model.x0)
+            except S.ConvergenceError as exc:
+                out[name] = _record(ran=True, outcome=f"no convergence: {_short(exc)}")
+                continue
+            w = -float((res.x - model.x0).reshape(-1, 3)[:, 2].min())
+            out[name] = _static_record(res, t0, w / w_eb - 1.0,
+                                       f"; tip {1e3 * w:.3f} mm, Euler-Bernoulli {1e3 * w_eb:.3f} mm")
+    return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -459,7 +588,15 @@ def run_all(quick=False, log=print):
         log(f"contrast {contrast}")
         cases[f"contrast_{contrast}"] = contrast_case(float(contrast), bar_n)
     log("dynamics")
-    cases["explicit_1.5x"], cases["implicit_1.5x"] = dynamics_case(n_steps=100 if quick else 200)
+    n_steps = 100 if quick else 200
+    for factor in (1.05, 1.2):
+        cases[f"explicit_{factor:g}x"] = explicit_case(factor, n_steps)
+    cases["explicit_1.5x"], cases["implicit_1.5x"] = dynamics_case(n_steps=n_steps)
+    cases["explicit_2x"] = explicit_case(2.0, n_steps)
+    log("unloaded")
+    cases["unloaded"] = unloaded_case()
+    log("slender beam")
+    cases["slender_beam"] = slender_beam_case(nyz=2 if quick else 4)
     return cases, shape_data
 
 
@@ -470,10 +607,18 @@ def to_dataset(cases, shape_data, quick):
         "ran": ("1", "model ran (mesh and constants accepted, solver called)"),
         "converged": ("1", "solver converged (static) / integration completed (dynamic)"),
         "error": ("1", "max nodal |u - u_ref| / max |u_ref|, u_ref neo-Hookean FEM on the same mesh "
-                       "(implicit_1.5x: max |u| / static max |u|); NaN where not meaningful"),
+                       "(implicit_1.5x: max |u| / static max |u|; explicit_*: max nodal distance of the last state "
+                       "before the stop from a stable run (half the limit) to the same time / static max |u|; "
+                       "unloaded: max |u| / edge length; slender_beam: "
+                       "tip deflection / Euler-Bernoulli - 1); NaN where not meaningful"),
         "volume_ratio": ("1", "total volume / rest volume of the final state"),
         "min_volume_ratio": ("1", "smallest element volume / its rest volume (negative: inverted)"),
         "n_inverted": ("1", "number of elements with non-positive volume in the final state (-1: not run)"),
+        "iterations": ("1", "Newton iterations of a static solve, all load steps (-1: not recorded)"),
+        "stop_step": ("1", "explicit run with allow_unstable: the step at which the divergence detector stopped it "
+                           "(-1: n/a)"),
+        "stop_displacement": ("1", "explicit run with allow_unstable: max |u| when stopped / static max |u| "
+                                   "(NaN: n/a)"),
         "outcome": ("1", "how the run ended or broke (one line)"),
     }
     data = {}
@@ -481,7 +626,7 @@ def to_dataset(cases, shape_data, quick):
         values = np.array(table[f], dtype=object if f == "outcome" else None)
         if f in ("ran", "converged"):
             values = values.astype(np.int8)
-        elif f == "n_inverted":
+        elif f in ("n_inverted", "iterations", "stop_step"):
             values = values.astype(np.int64)
         elif f == "outcome":
             values = values.astype(str)

@@ -538,14 +538,41 @@ class LatticeExplicit:
 
     # ---- dynamics ------------------------------------------------------------------------------
 
-    def run(self, x, v, h: float, n_steps: int, alpha: float | None = None, save_every: int = 1):
+    def stability_limit(self, x, alpha: float = 0.0) -> dict:
+        """:func:`msslib.solvers.check_time_step` information (``stability_limit``, ...) of a run
+        from ``x`` with damping ``alpha``, without a check; ``omega_max`` is computed once per
+        starting state (kept for the next call from the same ``x``)."""
+        from msslib.solvers import check_time_step
+
+        return check_time_step(self.model, x, 0.0, method="symplectic_euler", damping=float(alpha),
+                               load=self.load, omega_max=self._omega_max(x))
+
+    def _omega_max(self, x):
+        x = np.asarray(x, dtype=float).reshape(-1)
+        cached = getattr(self, "_omega_cache", None)
+        if cached is not None and cached[0].shape == x.shape and np.array_equal(cached[0], x):
+            return cached[1]
+        from msslib.solvers import _omega_max_squared
+
+        omega = float(np.sqrt(_omega_max_squared(self.model, x, self.load)))
+        self._omega_cache = (x.copy(), omega)
+        return omega
+
+    def run(self, x, v, h: float, n_steps: int, alpha: float | None = None, save_every: int = 1,
+            allow_unstable: bool = False):
         """Symplectic Euler with mass-proportional damping ``C = alpha M`` for ``n_steps`` steps of
         ``h``; the scheme of ``solvers.integrate(method="symplectic_euler", damping=alpha)``.
 
         ``x``, ``v``: flat model-layout state (not modified; the velocity of fixed dofs is set to
         0 and fixed dofs keep their position).  ``alpha`` None takes ``model.damping`` (a scalar;
         Rayleigh ``beta`` is not supported).  Returns ``(x, v, saved)`` with ``saved`` the
-        positions after steps ``save_every, 2 save_every, ...`` (``n_steps // save_every`` rows)."""
+        positions after steps ``save_every, 2 save_every, ...`` (``n_steps // save_every`` rows).
+
+        As in :func:`msslib.solvers.integrate`, a step ``h`` above the stability limit of the model
+        at ``x`` (:func:`msslib.solvers.check_time_step`, computed on the first call from a given
+        ``x`` and kept) raises :class:`msslib.errors.StabilityError` unless ``allow_unstable``.
+        The numba loop itself has no per-step divergence detector (it would cost the loop its
+        vectorisation): a non-finite final state raises :class:`msslib.solvers.DivergenceError`."""
         if alpha is None:
             alpha = self.model.damping if self.model.damping is not None else 0.0
             if np.ndim(alpha) != 0:
@@ -555,6 +582,11 @@ class LatticeExplicit:
                 alpha = a
         if not (h > 0) or n_steps < 0 or save_every < 1:
             raise ValueError("need h > 0, n_steps >= 0 and save_every >= 1")
+        from msslib.solvers import DivergenceError, check_time_step
+
+        limit = check_time_step(self.model, x, float(h), method="symplectic_euler", damping=float(alpha),
+                                load=self.load, allow_unstable=allow_unstable,
+                                omega_max=self._omega_max(x))["stability_limit"]
         P = self.to_lattice(x)
         vv = np.array(v, dtype=float).reshape(-1)
         vv[~self.free_flat] = 0.0
@@ -566,4 +598,10 @@ class LatticeExplicit:
         _run(P, Vel, float(h), int(n_steps), int(save_every), float(alpha), self.mass, self.inv_m, self.fext,
              self.offs, self.nspan, self._K, self._L0, self._F, self.ncell, self.NX, self.S, self._kv, self._V0,
              self._W, self.pad, self.lat, out, Pk, G, copy)
+        if not (np.isfinite(P).all() and np.isfinite(Vel).all()):
+            raise DivergenceError(
+                f"LatticeExplicit.run diverged: non-finite state after {n_steps} steps of h = {h:.6g} s (the "
+                f"stability limit of the model at the start is {limit:.6g} s; the loop does not check each step)",
+                step=int(n_steps), time=float(n_steps * h), quantity="position", dof=-1, value=float("nan"),
+                dt=float(h), stability_limit=limit)
         return self.from_lattice(P), self.from_lattice(Vel), out

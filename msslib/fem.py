@@ -520,7 +520,13 @@ def solve_nonlinear(
     (``W = mu/2 (I1 - 3) - mu ln J + lam/2 (ln J)^2``). Loads and prescribed displacements are
     applied in ``steps`` equal load-factor increments; each increment is solved by Newton's method
     and converged when the residual force norm on the free dofs is at most
-    ``tol * max(|load|, |reactions|)`` (load = current external force vector). A failed increment
+    ``max(tol * max(|load|, |reactions|), floor)`` (load = current external force vector; the
+    criterion of :func:`msslib.solvers.convergence_threshold`), ``floor`` the round-off floor
+    :func:`msslib.solvers.roundoff_floor` of ``|| |K| |u| + sum_e |f_e| + |load| ||`` on the free
+    dofs (the size of what the internal force sums: the displacement gradient differences nodal
+    displacements, each element force sums stresses), so that a problem whose ``tol * F_ref`` lies
+    below the round-off converges at the floor instead of iterating on it (an increment accepted
+    there, above ``tol * F_ref``, is listed in ``stats``). A failed increment
     (no convergence in ``max_iter`` iterations, or an inverted element) is halved, at most
     ``max_halvings`` times in a row and never below ``1 / (steps * 2**max_halvings)``; then
     :class:`RuntimeError` names the step and the residual.
@@ -529,8 +535,12 @@ def solve_nonlinear(
 
     ``stats``: ``iterations`` (Newton iterations per converged increment), ``residuals`` (relative
     residual history per increment), ``load_factors`` (after each converged increment), ``n_halvings``,
-    ``n_dofs``, ``wall_time``, ``solver``.
+    ``n_dofs``, ``wall_time``, ``solver``, ``tol``, ``roundoff_floor`` and ``threshold`` (of the
+    last converged increment, absolute), ``roundoff_steps`` (increments accepted at the floor,
+    1-based) and ``messages``.
     """
+    from msslib.solvers import _abs_times, convergence_threshold, roundoff_floor, roundoff_note
+
     t0 = time.perf_counter()
     d = mesh.dim
     if d == 2:
@@ -561,10 +571,11 @@ def solve_nonlinear(
         fint = geo.assemble_vector(fe)
         energy = float(np.sum(W * geo.dx) * w)
         if not tangent:
-            return fint, None, energy
+            return fint, None, energy, None
+        fabs = geo.assemble_vector(np.abs(fe))  # the size of what fint sums: its round-off scale
         ke = np.einsum("aJmq,iJkLmq,bLmq,mq->maibk", geo.dphi, A, geo.dphi, geo.dx, optimize=True)
         K = geo.assemble_matrix(ke.reshape(m, nb * d, nb * d) * w)
-        return fint, K, energy
+        return fint, K, energy, fabs
 
     u = np.zeros(geo.n_dofs)
     lf = 0.0  # converged load factor
@@ -575,6 +586,9 @@ def solve_nonlinear(
     n_halvings = 0
     next_report = 1
     last_res = np.nan
+    floor = thr = np.nan
+    roundoff_steps, messages = [], []
+    load_abs = np.abs(f_ext)
     while lf < 1.0 - 1e-12:
         target = min(1.0, lf + dlf)
         ut = u.copy()
@@ -584,15 +598,18 @@ def solve_nonlinear(
         ok = False
         try:
             for it in range(max_iter + 1):
-                fint, K, _ = internal(ut, tangent=True)
+                fint, K, _, fabs = internal(ut, tangent=True)
                 r = fint - fe_t
                 ref = max(np.linalg.norm(fe_t[free]), np.linalg.norm(r[cons]), np.finfo(float).tiny)
                 res = np.linalg.norm(r[free])
                 if not np.isfinite(res):
                     raise FloatingPointError("non-finite residual")
+                mag = _abs_times(K, np.abs(ut)) + fabs + target * load_abs
+                floor = roundoff_floor(float(np.linalg.norm(mag[free])))
+                thr = convergence_threshold(tol, ref, floor)
                 hist.append(res / ref)
                 last_res = res
-                if res <= tol * ref or not free.any():
+                if res <= thr or not free.any():
                     ok = True
                     break
                 if it == max_iter:
@@ -604,6 +621,10 @@ def solve_nonlinear(
         except (FloatingPointError, np.linalg.LinAlgError):
             ok = False
         if ok:
+            if free.any() and last_res > tol * ref:  # accepted at the round-off floor
+                roundoff_steps.append(len(factors) + 1)
+                messages.append(f"increment {len(factors) + 1} (load factor {target:.6g}): "
+                                f"{roundoff_note(last_res, floor, tol * ref)}")
             u, lf = ut, target
             iterations.append(len(hist) - 1)
             residuals.append(hist)
@@ -623,11 +644,11 @@ def solve_nonlinear(
             raise RuntimeError(
                 f"Newton did not converge in load step {step} of {steps} (load factor {lf:.6g} -> {target:.6g}, "
                 f"after {max_halvings} step halvings): last residual norm {last_res:.3e} "
-                f"(relative {hist[-1] if hist else float('nan'):.3e}, tol {tol:.1e})"
+                f"(relative {hist[-1] if hist else float('nan'):.3e}, tol {tol:.1e}; round-off floor {floor:.3e})"
             )
         dlf *= 0.5
 
-    fint, _, energy = internal(u, tangent=False)
+    fint, _, energy, _ = internal(u, tangent=False)
     r = fint - f_ext
     reaction = np.where(cons, r, 0.0)
     stats = {
@@ -641,5 +662,10 @@ def solve_nonlinear(
         "plane": pl,
         "wall_time": time.perf_counter() - t0,
         "solver": "Newton, " + _SOLVER,
+        "tol": float(tol),
+        "roundoff_floor": float(floor),
+        "threshold": float(thr),
+        "roundoff_steps": roundoff_steps,
+        "messages": messages,
     }
     return FemResult(displacement=u.reshape(-1, d), reaction=reaction.reshape(-1, d), strain_energy=energy, stats=stats)

@@ -1159,7 +1159,8 @@ def _solve_mss_static(setup: Setup, report):
         "type": "static", "load_steps": s["load_steps"], "tol": s["tol"], "n_load_steps": res.n_load_steps,
         "n_cuts": res.n_cuts, "iterations": res.iterations, "total_iterations": res.total_iterations,
         "final_residual": res.residuals[-1][-1] if res.residuals and res.residuals[-1] else 0.0,
-        "force_scale": res.force_scale, "line_search_merit": res.line_search_merit, "wall_time": res.wall_time,
+        "force_scale": res.force_scale, "roundoff_floor": res.roundoff_floor, "threshold": res.threshold,
+        "roundoff_steps": res.roundoff_steps, "line_search_merit": res.line_search_merit, "wall_time": res.wall_time,
         "messages": res.messages,
     }
     energy = model.energy(res.x, 1.0)
@@ -1178,7 +1179,8 @@ def _solve_mss_dynamic(setup: Setup, report):
         report(info["step"] / n, f"t = {info['t']:.4g} s")
 
     res = integrate(model, x_start, np.zeros(model.n_dof), dt=s["dt"], t_end=s["t_end"], method=s["method"],
-                    damping=s["damping"], save_every=s["save_every"], progress=cb)
+                    damping=s["damping"], save_every=s["save_every"], progress=cb,
+                    allow_unstable=s.get("allow_unstable", False))
     n, dim = model.n_nodes, model.dim
     u = (res.x_final - model.x0).reshape(n, dim)
     out = {"displacement": u, "reaction": model.reaction(res.x_final, 1.0),

@@ -20,6 +20,7 @@ from msslib import cli
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import solvers as S
+from msslib.errors import StabilityError
 from msslib.scene import load_scene, prepare
 
 _SCRIPT = Path(__file__).resolve().parents[1] / "experiments" / "stability.py"
@@ -212,8 +213,11 @@ def test_explicit_step_above_limit_diverges_implicit_is_stable(name):
     limit = S.explicit_stability_limit(model, model.x0)
     dt = 1.5 * limit
     v0 = np.zeros(model.n_dof)
-    with pytest.raises(S.DivergenceError, match="symplectic_euler diverged") as info:
+    with pytest.raises(StabilityError, match="1.5 x the explicit stability limit"):  # refused up front
         S.integrate(model, model.x0, v0, dt=dt, t_end=100 * dt, method="symplectic_euler", damping=0.0)
+    with pytest.raises(S.DivergenceError, match="symplectic_euler diverged") as info:
+        S.integrate(model, model.x0, v0, dt=dt, t_end=100 * dt, method="symplectic_euler", damping=0.0,
+                    allow_unstable=True)
     assert info.value.step < 30  # the highest mode grows ~6.9x per step at omega dt = 3
     assert np.isfinite(info.value.x_last).all() and np.isfinite(info.value.v_last).all()
     res = S.integrate(model, model.x0, v0, dt=dt, t_end=40 * dt, method="implicit_euler", damping=0.0)
@@ -247,7 +251,7 @@ def test_cli_explicit_over_limit_fails_without_output(tmp_path, capsys):
         assert cli.main(["run", str(scene), "--out", str(out), "--quiet"]) == code
         err = capsys.readouterr().err
         if code:
-            assert "msslib: error:" in err and "diverged" in err and "stability limit" in err
+            assert "msslib: error:" in err and "would diverge" in err and "stability limit" in err
             assert not out.exists()
         else:
             from msslib.io import read_result

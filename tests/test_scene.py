@@ -251,7 +251,7 @@ def test_unwritable_output(where, tmp_path, capsys):
 
 def test_divergence_is_one_line_and_leaves_no_file(tmp_path, capsys):
     data = _example("cantilever_gravity_dynamic")
-    data["solver"].update(dt=1.0e-2, t_end=0.2)
+    data["solver"].update(dt=1.0e-2, t_end=0.2, allow_unstable=True)  # else refused before the run
     scene = _write(tmp_path, data)
     out = tmp_path / "out.nc"
     assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 1

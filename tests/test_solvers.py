@@ -375,8 +375,8 @@ def _unstable_setup():
 @pytest.mark.parametrize("method", ["symplectic_euler", "velocity_verlet"])
 def test_explicit_step_above_limit_raises(method):
     prob, x0, dt = _unstable_setup()
-    with pytest.raises(DivergenceError) as info:
-        integrate(prob, x0, np.zeros(prob.n_dof), dt=dt, t_end=500 * dt, method=method)
+    with pytest.raises(DivergenceError) as info:  # refused up front unless allow_unstable
+        integrate(prob, x0, np.zeros(prob.n_dof), dt=dt, t_end=500 * dt, method=method, allow_unstable=True)
     err = info.value
     msg = str(err)
     assert f"at step {err.step}," in msg and "t = " in msg and "stability limit" in msg

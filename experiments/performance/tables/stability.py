@@ -9,12 +9,21 @@ from msslib.io import read_result, write_text
 INPUTS = ["results/stability.nc"]
 
 
+def _md(text):
+    """Text for a Markdown table cell (a bare pipe would split the cell)."""
+    return text.replace("|", "\\|")
+
+
 def cell(r):
-    text = " ".join(str(r.outcome.values).split())
+    text = _md(" ".join(str(r.outcome.values).split()))
     if not int(r.ran):
         return text[:70] if text else "-"
     parts = []
-    if not int(r.converged):
+    step = int(r.stop_step) if "stop_step" in r else -1
+    if step >= 0:  # an explicit step over the limit: refused, then stopped by the divergence detector
+        parts.append(f"**refused**; with allow_unstable stopped at step {step}, "
+                     f"max displacement {float(r.stop_displacement):.2g} x static")
+    elif not int(r.converged):
         parts.append(f"**{text[:70]}**" if text else "**no convergence**")
     e, v, inv = float(r.error), float(r.volume_ratio), int(r.n_inverted)
     if np.isfinite(e):
@@ -33,7 +42,12 @@ def main():
     d = read_result(INPUTS[0])
     models = [str(m) for m in d.model.values]
     lines = [f"Hard cases (E = {d.attrs['E']:g} Pa). *err*: largest node error relative to the largest displacement of "
-             "neo-Hookean FEM on the same mesh; *V/V0*: volume ratio.", "",
+             "neo-Hookean FEM on the same mesh (explicit_*: distance of the last state before the stop from a stable run, "
+             "relative to the static maximum displacement; implicit_1.5x: maximum over static maximum displacement; "
+             "unloaded: maximum displacement over edge length; slender_beam: tip deflection over Euler-Bernoulli's, "
+             "minus 1); *V/V0*: volume ratio. Explicit steps over the stability limit of the model at rest are "
+             "refused; the table shows where the divergence detector stops them when the scene asks to run anyway "
+             "(allow_unstable).", "",
              "| case | " + " | ".join(models) + " |", "|---" * (len(models) + 1) + "|"]
     for c in d.case.values:
         lines.append(f"| {c} | " + " | ".join(cell(d.sel(case=c, model=m)) for m in models) + " |")
@@ -42,7 +56,7 @@ def main():
         for m in models:
             text = " ".join(str(d.outcome.sel(case=c, model=m).values).split())
             if text and not text.startswith("ok"):
-                lines.append(f"- {c}, {m}: {text[:200]}")
+                lines.append(f"- {c}, {m}: {_md(text[:200])}")
     lines += ["", "Bad tetrahedra: Lloyd's equivalent-edge constant vs the element-wise least-squares optimum "
               "(N/m, E as above):", "", "| shape | Lloyd k | least-squares k per edge | negative |", "|---|---|---|---|"]
     for s in d.shape.values:
