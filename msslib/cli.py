@@ -580,10 +580,9 @@ def main(argv=None) -> int:
     previous = warnings.showwarning
 
     def show(message, category, filename, lineno, file=None, line=None):
-        if issubclass(category, MsslibWarning):
-            print(f"msslib: warning: {_one_line(message)}", file=sys.stderr)
-        else:
-            previous(message, category, filename, lineno, file, line)
+        # one line per warning: msslib's own as they are, others (numpy, scipy, ...) with their origin
+        origin = "" if issubclass(category, MsslibWarning) else f" ({category.__name__} in {Path(filename).name})"
+        print(f"msslib: warning: {_one_line(message)}{origin}", file=sys.stderr)
 
     warnings.showwarning = show
     try:

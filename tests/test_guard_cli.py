@@ -376,3 +376,23 @@ def test_temporary_name_carries_pid(tmp_path):
     assert os.listdir(tmp_path) == []
     write_text(tmp_path / "x.txt", "done\n")
     assert os.listdir(tmp_path) == ["x.txt"]
+
+
+def test_every_warning_is_one_line_naming_its_origin(monkeypatch, capsys):
+    import warnings as _warnings
+
+    from msslib.errors import MsslibWarning
+
+    def noisy(args):
+        _warnings.warn("overflow encountered in dot\n  sqnorm = x.dot(x)", RuntimeWarning)
+        _warnings.warn("3 nodes merged", MsslibWarning)
+        return 0
+
+    parser = cli.build_parser()
+    args = parser.parse_args(["validate", "x.yaml"])
+    monkeypatch.setattr(cli, "build_parser", lambda: type("P", (), {"parse_args": lambda self, argv: args})())
+    monkeypatch.setattr(args, "func", noisy)
+    assert cli.main(["validate", "x.yaml"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err == ["msslib: warning: overflow encountered in dot sqnorm = x.dot(x) (RuntimeWarning in test_guard_cli.py)",
+                   "msslib: warning: 3 nodes merged"]
