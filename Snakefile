@@ -5,6 +5,7 @@
 #   snakemake -j2                    everything
 #   snakemake -j2 --config quick=1   a reduced version of every output (CI)
 #   snakemake -n                     the whole DAG
+#   snakemake --report report.html   a report of the figures, tables and paper (after a build)
 #
 # Layout the rules discover (add a file, the DAG grows):
 #   experiments/<paper>/<name>.yaml              an experiment: cases x model variants (msslib.experiment)
@@ -25,7 +26,8 @@ DERIVATIONS = ["triangle", "square", "rectangle", "tetrahedron", "cube_baudet", 
 ENGINE = ["__init__", "elasticity", "fem", "mss", "match", "lattice", "records", "codegen", "report"]
 SCENES = sorted(glob_wildcards("experiments/scenes/{name}.yaml").name)
 # every result depends on the library that computed it: a change in msslib reruns what it touches
-MSSLIB = sorted(str(p) for p in Path("msslib").rglob("*.py"))
+# (msslib/paper.py computes no result: only the paper rules depend on it)
+MSSLIB = sorted(str(p) for p in Path("msslib").rglob("*.py") if p != Path("msslib", "paper.py"))
 
 wildcard_constraints:
     paper="|".join(PAPERS),
@@ -64,6 +66,9 @@ def declared_inputs(path):
     return list(namespace.get("INPUTS", []))
 
 
+# `snakemake --report`: figures, tables and the paper, one category per paper (captions in paper/report/)
+report: "paper/report/workflow.rst"
+
 COMPARISONS = [f"results/{p}/{n}/comparison.nc" for p, n in experiments()]
 STUDIES = [f"results/{p}/studies/{n}.nc" for p, n in scripts("studies")]
 FIGURES = [f"paper/figures/{p}_{n}.png" for p, n in scripts("figures")]
@@ -74,6 +79,7 @@ TABLES = ([f"paper/tables/experiments/{p}_{n}.md" for p, n in experiments()]
 rule all:
     input:
         "paper/build/paper.html",
+        "paper/build/paper.pdf",
         expand("results/scenes/{name}.nc", name=SCENES),
 
 
@@ -133,7 +139,8 @@ rule experiment_compare:
         runs=lambda wc: expand("results/{paper}/{exp}/{run}.nc", paper=wc.paper, exp=wc.exp, run=runs(wc.paper, wc.exp)),
     output:
         nc="results/{paper}/{exp}/comparison.nc",
-        table="paper/tables/experiments/{paper}_{exp}.md",
+        table=report("paper/tables/experiments/{paper}_{exp}.md", caption="paper/report/comparison.rst",
+                     category="{paper}", subcategory="experiments", labels={"experiment": "{exp}"}),
     log:
         "logs/{paper}/{exp}/compare.log",
     shell:
@@ -169,7 +176,8 @@ rule figure:
         shared=shared,
         data=lambda wc: declared_inputs(f"experiments/{wc.paper}/figures/{wc.name}.py"),
     output:
-        png="paper/figures/{paper}_{name}.png",
+        png=report("paper/figures/{paper}_{name}.png", caption="paper/report/figure.rst",
+                   category="{paper}", subcategory="figures", labels={"figure": "{name}"}),
         pdf="paper/figures/{paper}_{name}.pdf",
     log:
         "logs/{paper}/figures/{name}.log",
@@ -183,7 +191,8 @@ rule table:
         shared=shared,
         data=lambda wc: declared_inputs(f"experiments/{wc.paper}/tables/{wc.name}.py"),
     output:
-        "paper/tables/{paper}_{name}.md",
+        report("paper/tables/{paper}_{name}.md", caption="paper/report/table.rst",
+               category="{paper}", subcategory="tables", labels={"table": "{name}"}),
     log:
         "logs/{paper}/tables/{name}.log",
     shell:
@@ -214,7 +223,7 @@ rule benchmarks:
         code=MSSLIB + sorted(str(p) for p in Path("benchmarks").glob("*.py")),
     output:
         "results/benchmarks.json",
-    threads: workflow.cores
+    threads: lambda wildcards: workflow.cores  # evaluated per job: `snakemake --report` needs no --cores
     params:
         size="--quick" if QUICK or config.get("benchmarks") == "quick" else "",
     log:
@@ -223,17 +232,50 @@ rule benchmarks:
         "python -m benchmarks {params.size} --out {output} > {log} 2>&1"
 
 
-rule paper:
-    """The paper: Markdown sources with figures, tables and numbers from results, to HTML."""
+PAPER_SOURCES = sorted(Path("paper").glob("*.md.in")) + sorted(Path("paper", "sections").glob("*.md"))
+
+
+rule paper_markdown:
+    """The paper's Markdown: the sources with figures, tables and numbers from results filled in."""
     input:
-        source=sorted(Path("paper").glob("*.md.in")) + sorted(Path("paper", "sections").glob("*.md")),
+        source=PAPER_SOURCES,
         derived=["paper/errata.md", "paper/derivations.md"],
         figures=FIGURES,
         tables=TABLES,
         results=COMPARISONS + STUDIES,
+        code="msslib/paper.py",
     output:
-        "paper/build/paper.html",
+        "paper/build/paper.md",
     log:
-        "logs/paper.log",
+        "logs/paper_markdown.log",
     shell:
-        "python -m msslib paper paper/paper.md.in --out {output} > {log} 2>&1"
+        "python -m msslib.paper fill paper/paper.md.in --out {output} > {log} 2>&1"
+
+
+rule paper_html:
+    """The paper as one HTML file: math as MathML and figures embedded, no script, no network."""
+    input:
+        markdown="paper/build/paper.md",
+        figures=FIGURES,
+        code="msslib/paper.py",
+    output:
+        report("paper/build/paper.html", caption="paper/report/paper.rst", category="Paper", labels={"format": "HTML"}),
+    log:
+        "logs/paper_html.log",
+    shell:
+        "python -m msslib.paper html {input.markdown} --out {output} > {log} 2>&1"
+
+
+rule paper_pdf:
+    """The paper as PDF: pandoc writes Typst (paper/build/paper.typ), the typst compiler the PDF."""
+    input:
+        markdown="paper/build/paper.md",
+        figures=FIGURES,
+        code="msslib/paper.py",
+    output:
+        pdf=report("paper/build/paper.pdf", caption="paper/report/paper.rst", category="Paper", labels={"format": "PDF"}),
+        typst="paper/build/paper.typ",
+    log:
+        "logs/paper_pdf.log",
+    shell:
+        "python -m msslib.paper pdf {input.markdown} --out {output.pdf} > {log} 2>&1"

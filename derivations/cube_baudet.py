@@ -156,7 +156,7 @@ def derive() -> Derivation:
         {"k_edge": PUBLISHED["k_x"], "k_diagonal": PUBLISHED["k_d"], "correction_factor": PUBLISHED["alpha"]},
         "Baudet et al.'s eqs. 7-8 as printed (correction factor -(4 nu - 1)/16)."))
     d.findings += [
-        ("k_d per shear plane (parallelepiped)", ", ".join(f"{n}: {sp.latex(v)}" for n, v in per_plane.items())),
+        ("k_d per shear plane (parallelepiped)", ",\\ ".join(f"k_d^{{{n}}} = {sp.latex(v)}" for n, v in per_plane.items())),
         ("k_d (cube)", sp.latex(kd)),
         ("k_x", sp.latex(s[k_x])),
         ("correction factor (per-face total)", sp.latex(s[alpha])),
@@ -164,8 +164,9 @@ def derive() -> Derivation:
         ("bulk modulus with correction", sp.latex(sp.factor(B_with))),
         ("bulk modulus target", sp.latex(sp.factor(E / (3 * (1 - 2 * nu))))),
         ("bulk modulus without correction", sp.latex(sp.factor(B_without))),
-        ("assembled lattice (no correction inside)", f"isotropy defect {sp.latex(sp.factor(lat['isotropy defect']))}, "
-                                                      f"\\nu = {sp.latex(lat['nu_lattice'])}, E_{{axis}} = {sp.latex(lat['uniaxial E along an axis'])}"),
+        ("assembled lattice (no correction inside)", f"\\text{{isotropy defect}}\\ C_{{11}} - C_{{12}} - 2 C_{{44}} = {sp.latex(sp.factor(lat['isotropy defect']))},\\ "
+                                                      f"\\nu_{{\\text{{lattice}}}} = {sp.latex(lat['nu_lattice'])},\\ "
+                                                      f"E_{{\\text{{axis}}}} = {sp.latex(lat['uniaxial E along an axis'])}"),
     ]
     d.data.update(solution=s, k_d=kd, per_plane=per_plane, per_node=sols_node, B_with=B_with,
                   B_without=B_without, lattice=C, lattice_moduli=lat)

@@ -100,17 +100,18 @@ def derive() -> Derivation:
         "golec_cube_published", (E, nu, a, A),
         {"k_edge": PUBLISHED[k_e], "k_face": PUBLISHED[k_f], "k_inner": PUBLISHED[k_c], "kappa": KAPPA_PUBLISHED},
         "Golec et al.'s constants as printed (k_edge and k_face are the assembled values of an interior spring)."))
+    defect = r"\text{isotropy defect}\ C_{11} - C_{12} - 2 C_{44}"  # zero for an isotropic lattice
     d.findings += [
-        ("lattice tensor", sp.latex(C)),
+        ("lattice tensor", f"C = \\frac{{1}}{{3 a}} {sp.latex((3 * a * C).applyfunc(sp.expand))}"),  # entries without nested fractions
         ("residual stress at rest", sp.latex(sigma0.T)),
-        ("derived k_e, k_f, k_c", f"{sp.latex(s[k_e])},\\ {sp.latex(s[k_f])},\\ {sp.latex(s[k_c])}"),
-        ("derived kappa", sp.latex(sp.factor(s[kappa]))),
-        ("springs alone", f"isotropy defect {sp.latex(springs_only['isotropy defect C11-C12-2C44'])}, "
-                          f"\\nu = {sp.latex(springs_only['E,nu,G,K'][1])}"),
-        ("printed constants read per element", f"isotropy defect {sp.latex(pub_per_element['isotropy defect C11-C12-2C44'])}, "
-                                               f"\\nu = {sp.latex(sp.factor(pub_per_element['E,nu,G,K'][1]))}"),
-        ("printed constants read as interior totals", f"isotropy defect {sp.latex(pub_totals['isotropy defect C11-C12-2C44'])}, "
-                                                      f"E = {sp.latex(pub_totals['E,nu,G,K'][0])}, \\nu = {sp.latex(pub_totals['E,nu,G,K'][1])}"),
+        ("derived k_e, k_f, k_c", f"k_e = {sp.latex(s[k_e])},\\ k_f = {sp.latex(s[k_f])},\\ k_c = {sp.latex(s[k_c])}"),
+        ("derived kappa", f"\\kappa = {sp.latex(sp.factor(s[kappa]))}"),
+        ("springs alone", f"{defect} = {sp.latex(springs_only['isotropy defect C11-C12-2C44'])},\\ "
+                          f"\\nu_{{\\text{{lattice}}}} = {sp.latex(springs_only['E,nu,G,K'][1])}"),
+        ("printed constants read per element", f"{defect} = {sp.latex(pub_per_element['isotropy defect C11-C12-2C44'])},\\ "
+                                               f"\\nu_{{\\text{{lattice}}}} = {sp.latex(sp.factor(pub_per_element['E,nu,G,K'][1]))}"),
+        ("printed constants read as interior totals", f"{defect} = {sp.latex(pub_totals['isotropy defect C11-C12-2C44'])},\\ "
+                                                      f"E_{{\\text{{lattice}}}} = {sp.latex(pub_totals['E,nu,G,K'][0])},\\ \\nu_{{\\text{{lattice}}}} = {sp.latex(pub_totals['E,nu,G,K'][1])}"),
         ("shear modulus with printed constants", f"\\mu = {sp.latex(mu_pub)}\\ \\text{{vs}}\\ {sp.latex(mu)}"),
     ]
     d.data.update(solution=s, lattice=C, springs_only=springs_only, published_per_element=pub_per_element,

@@ -341,28 +341,29 @@ def derive() -> Derivation:
 
     gb = groebner_certificate(True)
     d.findings += [
-        ("exact match: conditions", f"\\nu = {L(s[nu_c])},\\ r = {L(s[r])}\\ (\\text{{Gr\\\"obner basis ends in }} "
+        ("exact match: conditions", f"\\nu = {L(s[nu_c])},\\ r = {L(s[r])}\\ (\\text{{Gröbner basis ends in}}\\ "
                                     f"{L(gb.exprs[-2])} = 0,\\ {L(gb.exprs[-1])} = 0)"),
         ("exact match: springs", ",\\ ".join(f"{L(x)} = {L(s[x])}" for x in K_SYM + C_SYM)),
-        ("exact match without prestrain", "\\text{none for any } \\nu, r \\text{ (Gr\\\"obner basis } \\{1\\}"
-         "\\text{); structural zeros of } K_{MSS} \\text{ demand }"
+        ("exact match without prestrain", "\\text{none for any}\\ \\nu, r\\ \\text{(Gröbner basis}\\ \\{1\\}"
+         "\\text{); structural zeros of}\\ K_{\\text{MSS}}\\ \\text{demand}\\ "
          + ",\\ ".join(f"{L(cnd)} = 0" for cnd in zero_entry_conditions())),
-        ("least squares (nu = 1/3): k", ",\\ ".join(f"k_{x} = {L(v)}" for x, v in zip(FAMILIES, fit["k"]))),
-        ("least squares (nu = 1/3): c", ",\\ ".join(f"c_{x} = {L(v)}" for x, v in zip(FAMILIES, fit["c"]))),
-        ("least squares (nu = 1/3): positive k and c", f"{float(lo):.4f} < r < {float(hi):.4f}"),
-        ("least squares (nu = 1/3): residual", f"\\|K_{{FEM}} - K_{{MSS}}\\|_F^2 = {L(fit['residual'])}"),
-        ("least squares (nu = 1/3): relative residual", f"\\epsilon_{{rel}}(r) = {L(fit['relative_residual'])}"),
-        ("least squares (any nu): relative residual",
-         f"\\epsilon_{{rel}}(r, \\nu) = {L(fit_nu['relative_residual'])}"),
+        ("least squares (ν = 1/3): k", ",\\ ".join(f"k_{x} = {L(v)}" for x, v in zip(FAMILIES, fit["k"]))),
+        ("least squares (ν = 1/3): c", ",\\ ".join(f"c_{x} = {L(v)}" for x, v in zip(FAMILIES, fit["c"]))),
+        ("least squares (ν = 1/3): positive k and c", f"r \\in \\left({float(lo):.4f},\\ {float(hi):.4f}\\right)"),
+        ("least squares (ν = 1/3): residual",
+         f"\\lVert K_{{\\text{{FEM}}}} - K_{{\\text{{MSS}}}} \\rVert_F^2 = {L(fit['residual'])}"),
+        ("least squares (ν = 1/3): relative residual", f"\\epsilon_{{\\text{{rel}}}}(r) = {L(fit['relative_residual'])}"),
+        ("least squares (any ν): relative residual",
+         f"\\epsilon_{{\\text{{rel}}}}(r, \\nu) = {L(fit_nu['relative_residual'])}"),
         ("least squares: forces at rest (node 0)",
-         f"f_0 = \\left({L(f_rest[0])},\\ {L(f_rest[1])}\\right) \\ne 0 \\text{{ for }} r \\ne 1"),
-        ("lattice (least squares, nu = 1/3)", f"C = {L(C)},\\ \\sigma_0 = {L(sigma0.T)}"),
+         f"f_0 = \\left({L(f_rest[0])},\\ {L(f_rest[1])}\\right) \\ne 0\\ \\text{{for}}\\ r \\ne 1"),
+        ("lattice (least squares, ν = 1/3)", f"C = {L(C)},\\ \\sigma_0 = {L(sigma0.T)}"),
         ("lattice vs plane stress (least squares)",
          (",\\ ".join(voigt(i, j) for i, j in agree) + " = D;\\ " if agree else "")
          + ",\\ ".join(f"{voigt(i, j)} - D_{{{i + 1}{j + 1}}} = {L(v)}" for (i, j), v in differ.items())),
         ("equilibrium least squares: k", ",\\ ".join(f"k_{x} = {L(v)}" for x, v in zip(FAMILIES, fit_eq["k"]))),
         ("equilibrium least squares: c", ",\\ ".join(f"c_{x} = {L(v)}" for x, v in zip(FAMILIES, fit_eq["c"]))),
-        ("equilibrium least squares: relative residual", f"\\epsilon_{{rel}}(r) = {L(fit_eq['relative_residual'])}"),
+        ("equilibrium least squares: relative residual", f"\\epsilon_{{\\text{{rel}}}}(r) = {L(fit_eq['relative_residual'])}"),
         ("lattice (equilibrium least squares)", f"C = {L(C_eq)},\\ \\sigma_0 = {L(sigma0_eq.T)}"),
         ("lattice vs plane stress (equilibrium least squares)",
          (",\\ ".join(voigt(i, j) for i, j in agree_eq) + " = D;\\ " if agree_eq else "")

@@ -25,6 +25,41 @@ def _errata_md(derivations) -> str:
     return "\n".join(out)
 
 
+def _split_top_level(tex: str, sep: str = ",\\ ") -> list[str]:
+    """``tex`` cut at every ``sep`` outside braces, brackets and parentheses (so that a matrix, a
+    ``\\left( ... \\right)`` or a ``\\text{...}`` is never cut)."""
+    parts, depth, start, i = [], 0, 0, 0
+    while i < len(tex):
+        c = tex[i]
+        if c == "\\":  # a command or an escaped symbol: only \\{ and \\} group (a set)
+            depth += {"{": 1, "}": -1}.get(tex[i + 1:i + 2], 0)
+            i += 2
+            continue
+        if c in "{([":
+            depth += 1
+        elif c in "})]":
+            depth -= 1
+        elif depth == 0 and tex.startswith(sep, i):
+            parts.append(tex[start:i])
+            start = i = i + len(sep)
+            continue
+        i += 1
+    return parts + [tex[start:]]
+
+
+DISPLAY_LENGTH = 90  # findings longer than this (in LaTeX characters) are set as display math
+
+
+def _finding_math(tex: str) -> str:
+    """A finding's LaTeX as Markdown math: inline when short, else display math, one equation
+    per line (an inline formula cannot break across lines in a browser)."""
+    if len(tex) <= DISPLAY_LENGTH and "\\begin{" not in tex:
+        return f"${tex}$"
+    parts = [p.strip() for p in _split_top_level(tex)]
+    lines = [p + "," for p in parts[:-1]] + parts[-1:]
+    return " ".join(f"$${line}$$" for line in lines)
+
+
 def _findings_md(derivations) -> str:
     out = ["## Derivation results", "", "Generated from `derivations/`; do not edit.", ""]
     for m, d in derivations.items():
@@ -32,7 +67,8 @@ def _findings_md(derivations) -> str:
             continue
         out += [f"### {d.title}", "", f"Source: `derivations/{m}.py`", ""]
         for label, text in d.findings:
-            out.append(f"- **{label}**: ${text}$" if "\\" in text or "=" in text else f"- **{label}**: {text}")
+            is_tex = "\\" in text or "=" in text  # LaTeX (words in \\text{}); else plain words
+            out.append(f"- **{label}**: {_finding_math(text)}" if is_tex else f"- **{label}**: {text}")
         out.append("")
     return "\n".join(out)
 

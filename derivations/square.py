@@ -66,6 +66,13 @@ def with_prestrain():
 # spring carries a force: edges are compressed, diagonals stretched, self-equilibrated.
 
 # %%
+def _tension_tex(name: str) -> str:
+    """LaTeX of a spring's tension, from its term name: spring_edge(0,1) -> T_{\\text{edge}\\,(0,1)}
+    (the name's words as text, not as subscripts)."""
+    kind, _, nodes = name.partition("(")
+    return f"T_{{\\text{{{kind.removeprefix('spring_')}}}\\,({nodes}}}"
+
+
 @lru_cache(maxsize=None)
 def derive() -> Derivation:
     sols = with_prestrain().solutions
@@ -82,12 +89,12 @@ def derive() -> Derivation:
         "Per-element constants of the square: edge springs (sum over the squares sharing the edge) and "
         "diagonal springs, with rest length = factor x rest distance. Exact for nu = 1/3."))
     d.findings += [
-        ("without prestrain", "no exact match for any nu" if not without_prestrain().exists else str(without_prestrain().solutions)),
+        ("without prestrain", "\\text{no exact match for any}\\ \\nu" if not without_prestrain().exists else str(without_prestrain().solutions)),
         ("conditions", f"\\nu = {sp.latex(s[nu_c])}"),
         ("k_edge", sp.latex(s[k_e])), ("k_diagonal", sp.latex(s[k_d])),
-        ("rest factors", f"c_e = {sp.latex(s[c_e])}, c_d = {sp.latex(s[c_d])}"),
+        ("rest factors", f"c_e = {sp.latex(s[c_e])},\\ c_d = {sp.latex(s[c_d])}"),
         ("net force at rest", "zero at every node" if f_rest == sp.zeros(*f_rest.shape) else sp.latex(f_rest.T)),
-        ("spring forces at rest", ", ".join(f"{n}: {sp.latex(v)}" for n, v in tensions.items())),
+        ("spring forces at rest", ",\\ ".join(f"{_tension_tex(n)} = {sp.latex(v)}" for n, v in tensions.items())),
         ("lattice", sp.latex(C)),
     ]
     d.data.update(solution=s, forces_at_rest=f_rest, tensions=tensions, lattice=C, sigma0=sigma0,

@@ -109,13 +109,13 @@ def derive() -> Derivation:
         Formula("equivalent_edge_length", (V,), {"l": L_HAT}, "Edge of the regular tetrahedron of volume V (eq. 13)."),
     ]
     d.findings += [
-        ("symmetric blocks", ", ".join(f"\\nu = {sp.latex(s[nu])}" for s in symmetric_blocks_condition())),
-        ("exact match", "none for any nu" if not exact_springs_only().exists else str(exact_springs_only().solutions)),
-        ("k (any nu)", sp.latex(k_gen)), ("k (nu = 1/4)", sp.latex(k_12)),
+        ("symmetric blocks", ",\\ ".join(f"\\nu = {sp.latex(s[nu])}" for s in symmetric_blocks_condition())),
+        ("exact match", "\\text{none for any}\\ \\nu" if not exact_springs_only().exists else str(exact_springs_only().solutions)),
+        ("k (any ν)", sp.latex(k_gen)), ("k (ν = 1/4)", sp.latex(k_12)),
         ("relative residual", sp.latex(sp.factor(ls.relative_residual))),
         ("k with volume energy", sp.latex(sp.factor(k_vol))), ("k_V", sp.latex(sp.factor(kV_vol))),
-        ("k_V at nu = 1/4", sp.latex(sp.simplify(kV_vol.subs(nu, QUARTER)))),
-        ("k_V sign", f"negative for \\nu < {sp.latex(sp.solve(sp.numer(sp.together(kV_vol)), nu)[0])}"),
+        ("k_V at ν = 1/4", sp.latex(sp.simplify(kV_vol.subs(nu, QUARTER)))),
+        ("k_V sign", f"k_V < 0\\ \\text{{for}}\\ \\nu < {sp.latex(sp.solve(sp.numer(sp.together(kV_vol)), nu)[0])}"),
         ("relative residual with volume", sp.latex(sp.factor(lv.relative_residual))),
     ]
     d.data.update(springs_only=ls, with_volume=lv)

@@ -84,7 +84,7 @@ def derive() -> Derivation:
     d.formulas.append(Formula("van_gelder_triangle", (E, t, A_e, l), {"k": VAN_GELDER},
                               "Van Gelder's spring constant, per element: E t A_e / l^2."))
     d.findings += [
-        ("conditions", f"nu = {sp.latex(s[nu_c])}, x_2 = {sp.latex(s[x2])}, y_2 = {sp.latex(s[y2])}"),
+        ("conditions", f"\\nu = {sp.latex(s[nu_c])},\\ x_2 = {sp.latex(s[x2])},\\ y_2 = {sp.latex(s[y2])}"),
         ("k", sp.latex(k_tri)),
         ("lattice", sp.latex(C)),
     ]

@@ -433,7 +433,7 @@ def _add_paper(subparsers) -> None:
 
 def _cmd_paper(args) -> int:
     from msslib.io import StagedOutputs
-    from msslib.paper import expand, render_html
+    from msslib.paper import expand, render_html, title_of
 
     source, out = Path(args.source), Path(args.out)
     twin = out.with_suffix(".md")
@@ -444,10 +444,16 @@ def _cmd_paper(args) -> int:
     except UnicodeDecodeError as exc:
         raise _not_utf8(source, "paper source", exc) from None
     text = expand(main_text, source.parent, source.parent.parent)
-    title = next((line.lstrip("# ").strip() for line in text.splitlines() if line.startswith("# ")), "msslib")
     out.parent.mkdir(parents=True, exist_ok=True)
+    # figures are linked as ../figures/NAME.png (from paper/build/); looked up from the source's
+    # figures/ folder itself ("figures/../figures/NAME.png"), they are found wherever the HTML goes
+    # and embedded in it
+    try:
+        html = render_html(text, title_of(text), resource_dir=source.parent / "figures")
+    except RuntimeError as exc:
+        raise CommandError(f"cannot build the paper from {str(source)!r}: {_one_line(exc)}") from None
     with StagedOutputs() as staged:  # the HTML and its Markdown twin, or neither
-        staged.write_text(out, render_html(text, title), what="output file")
+        staged.write_text(out, html, what="output file")
         staged.write_text(twin, text, what="Markdown twin")
     return 0
 

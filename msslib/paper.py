@@ -1,28 +1,87 @@
-"""Build the paper: Markdown sources with placeholders filled from results, rendered to HTML.
+"""Build the paper: Markdown sources with placeholders filled from results, rendered to a
+self-contained HTML file and a PDF.
 
 Placeholders (in ``paper/*.md.in`` and the files they include):
 
 ``{{include PATH}}``
     the text of ``PATH`` (relative to the paper directory), itself expanded;
 ``{{figure NAME | CAPTION}}``
-    the figure ``figures/NAME.png`` (made by the workflow) with its caption and a PDF link;
+    the figure ``figures/NAME.png`` (made by the workflow) with its caption;
 ``{{value FILE VAR [DIM=LABEL ...] [scale=S] [fmt=F]}}``
     a number read from the NetCDF result ``FILE`` (relative to the project root): variable or
     attribute ``VAR``, selected by labels, multiplied by ``S``, formatted with ``F`` (default .3g).
 
 Numbers in the text therefore come from results: a missing file, variable or label is an error,
-never a blank. ``python -m msslib paper paper/paper.md.in --out paper/build/paper.html``.
+never a blank. The filled Markdown (``paper/build/paper.md``, figures linked as
+``../figures/NAME.png``) is then rendered twice::
+
+    python -m msslib.paper fill paper/paper.md.in --out paper/build/paper.md
+    python -m msslib.paper html paper/build/paper.md --out paper/build/paper.html
+    python -m msslib.paper pdf paper/build/paper.md --out paper/build/paper.pdf
+
+Math is ``$...$`` (inline) and ``$$...$$`` (display) TeX and is converted at build time, so the
+outputs load nothing: no script, no font or style from the network.
+
+Toolchain. pandoc, from the ``pypandoc_binary`` wheel (34 MB download, 155 MB installed: a static
+pandoc 3 binary, no system package, no network), parses the Markdown once with a math-aware reader
+(CommonMark with dollar math, pipe tables and figures), so TeX is never touched by Markdown escapes,
+and writes both outputs: HTML with the math as MathML (``--mathml``; Chromium and Firefox display
+it natively) and every figure and style embedded (``--embed-resources``: one file that opens
+anywhere, offline), and Typst, which the ``typst`` wheel (34 MB download, 81 MB installed: the
+compiler with its fonts built in; system fonts are ignored, so the PDF is the same file on every
+machine) compiles to PDF. pandoc's TeX reader (texmath) converts ``\\begin{matrix}``/``pmatrix``,
+``\\left[ ... \\right]``, ``\\frac``, ``\\sqrt``, ``\\text{}``, ``\\lVert``, ``gathered``/``aligned``
+and sub/superscripts to MathML and to Typst math alike (all formulas of the paper, the derivation
+matrices included, convert without a warning; ``tests/test_paper.py`` checks them); markdown-it
+with latex2mathml would need a second toolchain for the PDF and handles fewer environments.
+Anything pandoc cannot convert (unknown TeX, a missing figure) fails the build instead of leaving
+raw TeX in the paper.
 """
 
 from __future__ import annotations
 
-import html
+import argparse
+import json
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 from msslib.io import write_text
 
 PLACEHOLDER = re.compile(r"\{\{\s*(include|figure|value)\s+(.*?)\s*\}\}", re.S)
+
+#: pandoc's Markdown reader: CommonMark (what the sources are written in) with dollar math, pipe
+#: tables, attributes and figures (an image alone in a paragraph, its alt text the caption); list
+#: and super/subscript extensions that could misread hard-wrapped prose are off.
+READER = "commonmark_x+implicit_figures-fancy_lists-definition_lists-superscript-subscript-emoji"
+
+#: style of the HTML (pandoc's default page style, wider for tables; long display math scrolls)
+CSS = """
+body { max-width: 52em; }
+table { display: block; overflow-x: auto; font-size: 0.85em; margin: 1em 0; }
+th, td { padding: 0.15em 0.6em; }
+figure { margin: 1.5em 0; }
+figure img { max-width: 100%; height: auto; }
+figcaption { font-size: 0.9em; }
+math { font-family: "STIX Two Math", "Latin Modern Math", "Cambria Math", "DejaVu Math TeX Gyre", math; }
+math[display="block"] { overflow-x: auto; overflow-y: hidden; max-width: 100%; padding: 0.2em 0; }
+"""
+
+#: set before pandoc's default Typst template: no date in the PDF (the same sources give the same
+#: file), tables in smaller type with a rule under the header, and display equations wider than
+#: the text scaled down to fit
+TYPST_HEADER = """
+#set document(date: none)
+#set table(stroke: (x, y) => if y == 0 { (bottom: 0.6pt) }, inset: (x: 4pt, y: 3pt))
+#show figure.where(kind: table): set text(size: 0.8em)
+#show table: set par(justify: false)
+#show math.equation.where(block: true): eq => layout(size => {
+  let w = measure(eq).width
+  if w <= size.width { eq } else { scale(x: size.width / w * 100%, y: size.width / w * 100%, reflow: true, eq) }
+})
+"""
 
 
 def _value(root: Path, spec: str) -> str:
@@ -57,6 +116,17 @@ def _value(root: Path, spec: str) -> str:
     return format(val * scale, fmt)
 
 
+def _figure(paper_dir: Path, arg: str) -> str:
+    name, _, caption = (s.strip() for s in arg.partition("|"))
+    if not (paper_dir / "figures" / f"{name}.png").is_file():
+        raise FileNotFoundError(f"{{{{figure {name}}}}}: figures/{name}.png has not been made")
+    if caption.count("[") != caption.count("]") or "\n\n" in caption:
+        raise ValueError(f"{{{{figure {name}}}}}: the caption must be one paragraph with balanced brackets")
+    # alone in its paragraph, an image is a figure with its text as the caption (HTML and PDF);
+    # the path is relative to paper/build/, where the filled Markdown is written
+    return f"\n\n![{caption}](../figures/{name}.png){{#fig-{name}}}\n\n"
+
+
 def expand(text: str, paper_dir: Path, root: Path, depth: int = 0) -> str:
     if depth > 10:
         raise RecursionError("includes nested too deeply")
@@ -69,41 +139,214 @@ def expand(text: str, paper_dir: Path, root: Path, depth: int = 0) -> str:
                 raise FileNotFoundError(f"{{{{include {arg}}}}}: no such file")
             return expand(p.read_text(encoding="utf-8"), paper_dir, root, depth + 1)
         if kind == "figure":
-            name, _, caption = (s.strip() for s in arg.partition("|"))
-            if not (paper_dir / "figures" / f"{name}.png").is_file():
-                raise FileNotFoundError(f"{{{{figure {name}}}}}: figures/{name}.png has not been made")
-            return (f'<figure><img src="../figures/{name}.png" alt="{html.escape(caption)}" style="max-width:100%">'
-                    f'<figcaption>{caption} (<a href="../figures/{name}.pdf">PDF</a>)</figcaption></figure>')
+            return _figure(paper_dir, arg)
         return _value(root, arg)
 
     return PLACEHOLDER.sub(repl, text)
 
 
-def render_html(markdown_text: str, title: str) -> str:
-    from markdown_it import MarkdownIt
-
-    md = MarkdownIt("commonmark", {"html": True}).enable("table")
-    body = md.render(markdown_text)
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>
-<script>window.MathJax = {{tex: {{inlineMath: [['$', '$']]}}}};</script>
-<script async src="https://cdn.jsdelivr.net/npm/mathjax@3/es5/tex-chtml.js"></script>
-<style>body{{max-width:60rem;margin:2rem auto;font-family:sans-serif;line-height:1.5;padding:0 1rem}}
-table{{border-collapse:collapse;font-size:0.9em}}td,th{{border:1px solid #bbb;padding:0.2em 0.5em}}
-figure{{margin:1.5em 0}}figcaption{{font-size:0.9em;color:#333}}</style></head>
-<body>
-{body}
-</body></html>
-"""
+def title_of(markdown_text: str, default: str = "msslib") -> str:
+    """The text of the first level-1 heading."""
+    return next((line[2:].strip() for line in markdown_text.splitlines() if line.startswith("# ")), default)
 
 
-def build(source, out) -> Path:
+def pandoc_path() -> str:
+    try:
+        import pypandoc
+    except ImportError as exc:  # pragma: no cover - a dependency of msslib
+        raise RuntimeError("the paper needs pandoc: python3 -m pip install pypandoc_binary") from exc
+    return pypandoc.get_pandoc_path()
+
+
+def pandoc(text: str, *args: str, reader: str = READER) -> str:
+    """Run pandoc on ``text`` (Markdown read as :data:`READER`, or ``reader``) and return its
+    output. Every warning is an error (TeX it cannot convert, a figure it cannot find, ...)."""
+    # --columns: a pipe table wider than this gets column widths from its dashes (all equal in
+    # generated tables); wider than any table, the columns size to their content instead
+    cmd = [pandoc_path(), "--from", reader, "--fail-if-warnings", "--columns=100000", *args]
+    proc = subprocess.run(cmd, input=text, capture_output=True, text=True, encoding="utf-8")
+    if proc.returncode != 0:
+        raise RuntimeError(f"pandoc failed ({proc.returncode}):\n{proc.stderr.strip()}")
+    return proc.stdout
+
+
+def render_html(markdown_text: str, title: str | None = None, resource_dir=None) -> str:
+    """A standalone HTML page: math as MathML, no script. With ``resource_dir`` (the directory the
+    Markdown's relative paths start from) the figures are embedded as data URIs, so the page opens
+    anywhere; without it they stay links relative to the page."""
+    title = title or title_of(markdown_text)
+    args = ["--to", "html5", "--standalone", "--mathml", "--shift-heading-level-by=-1",
+            "--metadata", f"pagetitle={title}", "--variable", f"header-includes=<style>{CSS}</style>"]
+    if resource_dir is not None:
+        args += ["--embed-resources", f"--resource-path={resource_dir}"]
+    return pandoc(markdown_text, *args)
+
+
+#: a table cell's first word that Typst reads as markup when a space follows ("/ a: b" is a
+#: term list and a syntax error without the colon, "= x" a heading, "- x", "+ x", "1. x" lists);
+#: pandoc escapes it only at the start of a paragraph, so :func:`render_typst` guards table cells
+_CELL_MARKUP = re.compile(r"/|=+|-|\+|\d+\.")
+
+#: tables whose cells' text is longer than this (characters per row) get column widths
+#: proportional to their content in the PDF (Typst's automatic widths squeeze long columns)
+WIDE_TABLE = 90
+
+
+def _table_rows(table):
+    _, _, _, head, bodies, foot = table["c"]
+    return head[1], [row for body in bodies for row in body[2] + body[3]] + foot[1]
+
+
+def _text_length(node) -> int:
+    """Characters of the text in a pandoc syntax tree (math counts by half its TeX)."""
+    if isinstance(node, list):
+        return sum(_text_length(n) for n in node)
+    if isinstance(node, dict):
+        kind, content = node.get("t"), node.get("c")
+        if kind == "Str":
+            return len(content)
+        if kind in ("Space", "SoftBreak"):
+            return 1
+        if kind == "Code":
+            return len(content[1])
+        if kind == "Math":
+            return len(content[1]) // 2
+        return _text_length(content)
+    return 0
+
+
+def _words(node):
+    """The words (``Str``) of a pandoc syntax tree."""
+    if isinstance(node, list):
+        for item in node:
+            yield from _words(item)
+    elif isinstance(node, dict):
+        if node.get("t") == "Str":
+            yield node["c"]
+        else:
+            yield from _words(node.get("c"))
+
+
+def _prepare_table(table) -> None:
+    """Guard cells that start like Typst markup with an empty Typst string (``#""``, which prints
+    nothing), and give a wide table column widths from its content (changed in place)."""
+    head, body = _table_rows(table)
+    for row in head + body:
+        for cell in row[1]:
+            block = next((b for b in cell[4] if b["t"] in ("Plain", "Para")), None)
+            inlines = block["c"] if block else []
+            if (inlines and inlines[0]["t"] == "Str" and _CELL_MARKUP.fullmatch(inlines[0]["c"])
+                    and (len(inlines) == 1 or inlines[1]["t"] in ("Space", "SoftBreak"))):
+                inlines.insert(0, {"t": "RawInline", "c": ["typst", '#""']})
+    colspecs = table["c"][2]
+    natural = [0] * len(colspecs)  # longest body cell, at least the longest header word
+    for row in body:
+        for i, cell in enumerate(row[1][:len(natural)]):
+            natural[i] = max(natural[i], _text_length(cell[4]))
+    for row in head:
+        for i, cell in enumerate(row[1][:len(natural)]):
+            natural[i] = max(natural[i], *(len(w) for w in _words(cell[4])), 1)
+    if sum(natural) > WIDE_TABLE:
+        weights = [min(n, 40) + 2 for n in natural]  # a long note wraps rather than take the page
+        for spec, w in zip(colspecs, weights):
+            spec[1] = {"t": "ColWidth", "c": w / sum(weights)}
+
+
+def _prepare_tables(node) -> None:
+    if isinstance(node, list):
+        for item in node:
+            _prepare_tables(item)
+    elif isinstance(node, dict):
+        if node.get("t") == "Table":
+            _prepare_table(node)
+        for value in node.values():
+            _prepare_tables(value)
+
+
+def render_typst(markdown_text: str, title: str | None = None) -> str:
+    """The Typst source of the PDF (pandoc's default Typst template, A4)."""
+    title = title or title_of(markdown_text)
+    tree = json.loads(pandoc(markdown_text, "--to", "json"))
+    _prepare_tables(tree["blocks"])
+    return pandoc(json.dumps(tree), "--to", "typst", "--standalone", "--wrap=none", "--shift-heading-level-by=-1",
+                  "--metadata", f"pagetitle={title}", "--variable", "papersize=a4",
+                  "--variable", "fontsize=10pt", "--variable", "page-numbering=1",
+                  "--variable", f"header-includes={TYPST_HEADER}", reader="json")
+
+
+def compile_typst(typ: Path, pdf: Path) -> Path:
+    """Compile the Typst file ``typ`` to ``pdf`` with the fonts built into the compiler only;
+    a warning (a missing glyph or font, ...) is an error. Images are read relative to ``typ``."""
+    import typst
+
+    images = [(typ.parent / p).resolve() for p in re.findall(r'image\("([^"]+)"', typ.read_text(encoding="utf-8"))]
+    root = Path(os.path.commonpath([typ.parent.resolve(), *images]))
+    tmp = pdf.with_name(f".{pdf.name}.tmp")
+    try:
+        try:
+            _, warnings = typst.compile_with_warnings(str(typ), output=str(tmp), root=str(root),
+                                                      ignore_system_fonts=True)
+        except typst.TypstError as exc:
+            raise RuntimeError(f"typst: {getattr(exc, 'diagnostic', None) or exc}") from None
+        if warnings:
+            raise RuntimeError("typst: " + "; ".join(w.message for w in warnings))
+        os.replace(tmp, pdf)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return pdf
+
+
+def fill(source, out) -> Path:
+    """Expand ``source`` into the Markdown ``out``."""
     source, out = Path(source), Path(out)
     paper_dir = source.parent
-    root = paper_dir.parent
-    text = expand(source.read_text(encoding="utf-8"), paper_dir, root)
-    title = next((line.lstrip("# ").strip() for line in text.splitlines() if line.startswith("# ")), "msslib")
+    text = expand(source.read_text(encoding="utf-8"), paper_dir, paper_dir.parent)
     out.parent.mkdir(parents=True, exist_ok=True)
-    write_text(out, render_html(text, title))
-    write_text(out.with_suffix(".md"), text)
+    return write_text(out, text)
+
+
+def html_from_markdown(markdown, out) -> Path:
+    markdown, out = Path(markdown), Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return write_text(out, render_html(markdown.read_text(encoding="utf-8"), resource_dir=markdown.parent))
+
+
+def pdf_from_markdown(markdown, out) -> Path:
+    """The PDF, through a Typst file written beside the Markdown (``paper.typ``)."""
+    markdown, out = Path(markdown), Path(out)
+    typ = markdown.with_suffix(".typ")
+    write_text(typ, render_typst(markdown.read_text(encoding="utf-8")))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return compile_typst(typ, out)
+
+
+def build(source, out, pdf=None) -> Path:
+    """Fill ``source`` and write the HTML ``out``, its Markdown twin beside it and, if asked, the PDF."""
+    out = Path(out)
+    markdown = fill(source, out.with_suffix(".md"))
+    html_from_markdown(markdown, out)
+    if pdf is not None:
+        pdf_from_markdown(markdown, pdf)
     return out
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m msslib.paper", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="step", required=True)
+    for step, src, dst in [("fill", "main source, e.g. paper/paper.md.in", "filled Markdown"),
+                           ("html", "filled Markdown", "HTML file"), ("pdf", "filled Markdown", "PDF file")]:
+        s = sub.add_parser(step, help=f"{src} -> {dst}")
+        s.add_argument("source", help=src)
+        s.add_argument("--out", "-o", required=True, help=dst)
+    args = p.parse_args(argv)
+    step = {"fill": fill, "html": html_from_markdown, "pdf": pdf_from_markdown}[args.step]
+    try:
+        step(args.source, args.out)
+    except (OSError, ValueError, KeyError, RuntimeError) as exc:
+        print(f"python -m msslib.paper {args.step}: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

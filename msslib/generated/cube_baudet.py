@@ -1,5 +1,5 @@
 # Generated from derivations/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 3ae6ed7f5d3c50f096b6ed1110334eaefc74c71e35a0c697741746a0bad1a887
+# source-sha256: d7cc31dc0ce36d434a33202e473f1115e047206976caeb030a824061eba769c5
 # body-sha256: a35ff5265d287f0040075799752d846c04cfcc02c51cc80aa3045cf95055a64d
 """Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.).
 

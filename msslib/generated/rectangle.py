@@ -1,5 +1,5 @@
 # Generated from derivations/rectangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 34a7e3ad9f5b16314aa84e256f25c84596dd359b78ba2e72186fa5fd9845774e
+# source-sha256: 14e79909f4a164ad4a9ce9711277fc5f9bd3f3b652a044b68eb8772d0fb4840e
 # body-sha256: a12cb5a0f8c951f64d4017cf31409c8628780887755be05ccb4859e5988cfd00
 """Rectangle of aspect ratio r, plane stress, six prestrained springs (generalising Lloyd et al. Sec. 4.1).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 40aa90c9822618d0c2cc468e5b2400fe61a8661a43680c5ce4feeb35722f54c9
+# source-sha256: 534fab72363102edfd3e7b9acaf106f7e0e7e2a907bc77bafdebb2d97a4feadd
 # body-sha256: 7ecb914d1852416401807e86d947e0367f8126e72b51da001538baf27e8712cf
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 

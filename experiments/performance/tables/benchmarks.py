@@ -9,6 +9,11 @@ from msslib.io import write_text
 INPUTS = ["results/benchmarks.json"]
 
 
+def _md(text):
+    """Text for a Markdown table cell (a bare pipe would split the cell)."""
+    return str(text).replace("|", "\\|")
+
+
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--out", required=True)
@@ -25,7 +30,7 @@ def main():
         r = "-" if f["ratio_to_baseline"] is None else f"{f['ratio_to_baseline']:.3g}"
         met = {None: "-", True: "yes", False: "**no**"}[f.get("met")]
         lines.append(f"| {name} | {f['value']:.4g} | {f['unit']} | {r} | {f['baseline'] or '-'} | "
-                     f"{f.get('target') or '-'} | {met} | {f['note']} |")
+                     f"{f.get('target') or '-'} | {met} | {_md(f['note'])} |")
     write_text(a.out, "\n".join(lines) + "\n")
 
 

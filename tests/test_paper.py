@@ -1,0 +1,219 @@
+"""The paper build (msslib.paper): math rendered at build time, offline HTML, PDF, and the LaTeX
+of the derivation findings. Each test builds a small paper in tmp_path (a second or two)."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+from pathlib import Path
+
+import pytest
+
+from derivations import report
+from msslib import paper
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# Formulas that Markdown alone mangles: backslash escapes (\\, \{), underscores that pair up as
+# emphasis across two formulas, a matrix, a fraction, \nu, \sqrt, \text{} and identifiers with
+# underscores (k_{\text{face}}).
+SECTION = r"""## Springs
+
+The edge spring $k_{e} = \frac{5 E t}{16}$ and the face spring $k_{\text{face}} = \sqrt{2}\, k_{e}$
+hold for $\nu = \frac{1}{3}$; measured: {{value results/demo.nc E_error level=eps10 scale=100 fmt=.2f}} %.
+
+$$C = \left[\begin{matrix}\frac{9 E}{8} & \frac{3 E}{8} & 0\\\frac{3 E}{8} & \frac{9 E}{8} & 0\\0 & 0 & \frac{3 E}{8}\end{matrix}\right],\quad
+\begin{pmatrix}a_{1}\\ a_{2}\end{pmatrix},\quad \{1\},\quad \text{none for any}\ \nu$$
+
+| spring | constant |
+|---|---|
+| edge | $\frac{5 E t}{16}$ |
+| diagonal | $\frac{7 E t}{16}$ |
+
+{{figure demo_plot | A test figure: error of $E$ against $\nu$.}}
+"""
+
+SOURCE = """# A small paper
+
+*Built for the test.*
+
+{{include sections/springs.md}}
+"""
+
+N_FORMULAS = 8  # inline: 3 in the text, 2 in the table, 2 in the caption; display: 1
+
+
+def make_paper(tmp_path: Path, section: str = SECTION) -> Path:
+    """A project in tmp_path: paper/paper.md.in, a section, a figure and a result file."""
+    import numpy as np
+    import xarray as xr
+    from PIL import Image
+
+    (tmp_path / "paper" / "sections").mkdir(parents=True)
+    (tmp_path / "paper" / "figures").mkdir()
+    (tmp_path / "results").mkdir()
+    (tmp_path / "paper" / "sections" / "springs.md").write_text(section, encoding="utf-8")
+    (tmp_path / "paper" / "paper.md.in").write_text(SOURCE, encoding="utf-8")
+    img = Image.new("RGB", (60, 40), "white")
+    img.paste((200, 30, 30), (10, 10, 50, 30))
+    img.save(tmp_path / "paper" / "figures" / "demo_plot.png")
+    xr.Dataset({"E_error": ("level", np.array([0.0123, 0.0456]))},
+               coords={"level": ["eps05", "eps10"]}).to_netcdf(tmp_path / "results" / "demo.nc")
+    return tmp_path / "paper" / "paper.md.in"
+
+
+def visible_text(page: str) -> str:
+    """The HTML without its style, the TeX annotations of the MathML and the tags."""
+    page = re.sub(r"<style.*?</style>", "", page, flags=re.S)
+    page = re.sub(r"<annotation.*?</annotation>", "", page, flags=re.S)
+    return re.sub(r"<[^>]+>", " ", page)
+
+
+def assert_math_rendered(page: str, n_formulas: int) -> None:
+    text = visible_text(page)
+    assert "$" not in text, "raw $ left in the HTML: " + text[max(0, text.find("$") - 80):text.find("$") + 80]
+    assert "merror" not in page
+    for tex in ("\\frac", "\\nu", "\\text", "\\begin", "\\left"):
+        assert tex not in text, f"raw TeX {tex} in the HTML"
+    assert page.count("<math") == n_formulas
+
+
+def assert_offline(page: str) -> None:
+    assert "<script" not in page
+    assert not re.search(r"<link\b", page), "a linked resource"
+    assert not re.search(r"url\(\s*['\"]?(https?:)?//", page), "a style loads from the network"
+    sources = re.findall(r"\bsrc\s*=\s*[\"']([^\"']*)", page)
+    assert all(s.startswith("data:") for s in sources), sources
+
+
+def test_small_paper_html_renders_math_offline(tmp_path):
+    source = make_paper(tmp_path)
+    out = paper.build(source, tmp_path / "paper" / "build" / "paper.html")
+    page = out.read_text(encoding="utf-8")
+    assert_math_rendered(page, N_FORMULAS)
+    assert_offline(page)
+    # the constructs are MathML, not text
+    assert page.count("<mtable") == 2  # the matrix and the pmatrix
+    assert "<mfrac>" in page and "<msqrt>" in page and "<mi>ν</mi>" in page
+    assert re.search(r"<mtext[^>]*>face</mtext>", page)  # \text in a subscript
+    assert re.search(r"<td[^>]*>\s*<math", page)  # math in a table cell
+    # the figure is embedded, with its caption; the number comes from the result file
+    assert re.search(r'<img [^>]*src="data:image/png;base64,', page)
+    assert re.search(r"<figcaption[^>]*>A test figure", page)
+    assert "4.56 %" in visible_text(page)
+    assert "<title>A small paper</title>" in page
+    # the filled Markdown is kept beside the HTML, with the figure relative to it
+    markdown = out.with_suffix(".md").read_text(encoding="utf-8")
+    assert "](../figures/demo_plot.png)" in markdown and "{{" not in markdown
+
+
+def test_small_paper_pdf(tmp_path):
+    source = make_paper(tmp_path)
+    build = tmp_path / "paper" / "build"
+    paper.build(source, build / "paper.html", pdf=build / "paper.pdf")
+    typ = (build / "paper.typ").read_text(encoding="utf-8")
+    assert 'image("../figures/demo_plot.png")' in typ
+    assert "mat(" in typ and "frac(" in typ and "nu" in typ and "\\frac" not in typ
+    pdf = (build / "paper.pdf").read_bytes()
+    assert pdf.startswith(b"%PDF-")
+    assert re.search(rb"/Subtype\s*/Image", pdf)  # the figure
+    assert b"NewCMMath" in pdf  # math typeset with the compiler's math font
+    assert not list(build.glob(".*.tmp"))
+
+
+def test_tables_in_the_pdf(tmp_path):
+    """Cells that start like Typst markup ("/ max |g|" was a syntax error, "- x" a list) print as
+    text, and a wide table gets column widths from its content."""
+    note = "a long note that would take a fair share of the width and more " * 2
+    markdown = ("# Tables\n\n| figure | value | unit |\n|---|---|---|\n| error | 2.6e-15 | / max g |\n"
+                "| ratio | - | = 1 |\n| step | + 3 | 1. of 2 |\n\n"
+                f"| a | b | c |\n|---|---|---|\n| 1 | 2 | {note} |\n")
+    typ = paper.render_typst(markdown)
+    for text in ("/ max g", "-", "= 1", "+ 3", "1. of 2"):
+        assert f'[#""{text}]' in typ, text
+    assert "[2.6e-15]" in typ  # a number is no list
+    widths = re.findall(r"#table\(\s*columns: \(([^)]*)\)", typ)
+    assert len(widths) == 1  # only the wide table
+    assert [float(w.rstrip("%")) for w in widths[0].split(", ")][2] > 50  # the note gets the room
+    (tmp_path / "t.typ").write_text(typ, encoding="utf-8")
+    pdf = paper.compile_typst(tmp_path / "t.typ", tmp_path / "t.pdf")
+    assert pdf.read_bytes().startswith(b"%PDF-")
+
+
+def test_tex_that_cannot_be_converted_fails_the_build(tmp_path):
+    source = make_paper(tmp_path, SECTION + "\nA broken formula $\\frac{1}{\\undefinedmacro}$.\n")
+    with pytest.raises(RuntimeError, match="undefinedmacro"):
+        paper.build(source, tmp_path / "paper" / "build" / "paper.html")
+
+
+def test_missing_figure_fails_the_build(tmp_path):
+    source = make_paper(tmp_path)
+    (tmp_path / "paper" / "figures" / "demo_plot.png").unlink()
+    with pytest.raises(FileNotFoundError, match="demo_plot"):
+        paper.build(source, tmp_path / "paper" / "build" / "paper.html")
+
+
+def _formulas(markdown: str) -> list[str]:
+    return re.findall(r"\$\$.+?\$\$|\$[^$\n]+\$", markdown, flags=re.S)
+
+
+def test_derivation_findings_and_errata_render():
+    """The real derivation matrices and errata, as the workflow writes them, convert without a
+    warning (pandoc fails on any) and leave no raw TeX."""
+    markdown = "\n\n".join((ROOT / "paper" / name).read_text(encoding="utf-8") for name in ("derivations.md", "errata.md"))
+    formulas = _formulas(markdown)
+    assert len(formulas) > 50
+    page = paper.render_html("# Derivations\n\n" + markdown)
+    assert_math_rendered(page, len(formulas))
+    assert page.count("<mtable") >= 8  # the lattice matrices
+    # words are text and nu is a Greek letter, not the letters n and u
+    assert not re.search(r"<mi>n</mi>\s*<mi>u</mi>", page)
+    assert not re.search(r"(<mi>[a-z]</mi>\s*){4}", page), "a word typeset as a product of variables"
+
+
+def test_findings_split_only_at_top_level():
+    tex = (r"f_0 = \left(a,\ b\right),\ C = \left[\begin{matrix}1 & 2\\3 & 4\end{matrix}\right],\ "
+           r"r\ \text{(see a,\ b)},\ \{x,\ y\}")
+    assert report._split_top_level(tex) == [r"f_0 = \left(a,\ b\right)",
+                                            r"C = \left[\begin{matrix}1 & 2\\3 & 4\end{matrix}\right]",
+                                            r"r\ \text{(see a,\ b)}", r"\{x,\ y\}"]
+
+
+def test_findings_math_inline_or_display():
+    assert report._finding_math(r"\nu = \frac{1}{3}") == r"$\nu = \frac{1}{3}$"
+    long = ",\\ ".join(f"k_{i} = \\frac{{E t (r^{{2}} + {i})}}{{16 r (r^{{4}} + 4 r^{{2}} + 1)}}" for i in range(3))
+    assert report._finding_math(long) == " ".join(
+        f"$$k_{i} = \\frac{{E t (r^{{2}} + {i})}}{{16 r (r^{{4}} + 4 r^{{2}} + 1)}}{',' if i < 2 else ''}$$"
+        for i in range(3))
+    matrix = r"\left[\begin{matrix}1 & 0\\0 & 1\end{matrix}\right]"
+    assert report._finding_math(matrix) == f"$${matrix}$$"
+
+
+def _check_render():
+    spec = importlib.util.spec_from_file_location("check_render", ROOT / "paper" / "check_render.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_pdf_pages_render(tmp_path):
+    source = make_paper(tmp_path)
+    build = tmp_path / "paper" / "build"
+    paper.build(source, build / "paper.html", pdf=build / "paper.pdf")
+    pages = _check_render().pages(build / "paper.typ", tmp_path / "render", ppi=30)
+    assert [p.name for p in pages] == ["page-1.png"]
+
+
+@pytest.mark.skipif(_check_render().find_browser() is None, reason="no Chromium or Chrome installed")
+def test_html_screenshot_offline(tmp_path):
+    from PIL import Image
+
+    source = make_paper(tmp_path)
+    html = paper.build(source, tmp_path / "paper" / "build" / "paper.html")
+    png = _check_render().screenshot(html, tmp_path / "shot.png", width=800, height=900)
+    with Image.open(png) as img:
+        gray = img.convert("L")
+        assert gray.size == (800, 900)
+        # text and the embedded red figure are drawn: dark pixels and red pixels
+        assert gray.getextrema()[0] < 80
+        assert (200, 30, 30) in {c for _, c in img.convert("RGB").getcolors(maxcolors=1 << 20)}
