@@ -361,11 +361,20 @@ def _number(path, value, *, low=None, high=None, low_open=True, high_open=True, 
     return number
 
 
-def _integer(path, value, minimum=1):
+def _integer(path, value, minimum=1, maximum=None, why=""):
     number = _number(path, value, what="an integer")
     if number != int(number) or number < minimum:
         _fail(path, f"must be an integer >= {minimum}, got {_show(value)}")
+    if maximum is not None and number > maximum:
+        _fail(path, f"must be at most {maximum:g}{why}, got {_show(value)}")
     return int(number)
+
+
+#: the most load steps, Newton iterations and time steps a scene may ask for: beyond them a run
+#: cannot end in any useful time (a typo such as load_steps: 1e30 fails at once instead)
+MAX_LOAD_STEPS = 10**5
+MAX_NEWTON_ITERATIONS = 10**4
+MAX_TIME_STEPS = 10**9
 
 
 def _boolean(path, value):
@@ -638,9 +647,11 @@ def _solver(path, value, model):
         _mapping(path, value, ("type", "load_steps", "tol", "max_iter"))
         return {
             "type": "static",
-            "load_steps": _integer(f"{path}.load_steps", value.get("load_steps", 1)),
+            "load_steps": _integer(f"{path}.load_steps", value.get("load_steps", 1), maximum=MAX_LOAD_STEPS,
+                                   why=" (each load step is a Newton solve)"),
             "tol": _number(f"{path}.tol", value.get("tol", 1e-8), low=0.0),
-            "max_iter": _integer(f"{path}.max_iter", value.get("max_iter", 50 if model in MSS_MODELS else 30)),
+            "max_iter": _integer(f"{path}.max_iter", value.get("max_iter", 50 if model in MSS_MODELS else 30),
+                                 maximum=MAX_NEWTON_ITERATIONS, why=" (Newton converges in tens of iterations or not at all)"),
         }
     _mapping(path, value, ("type", "method", "dt", "t_end", "damping", "save_every", "allow_unstable"),
              required=("dt", "t_end"))
@@ -653,7 +664,7 @@ def _solver(path, value, model):
         damping = tuple(_number(f"{path}.damping[{j}]", d, low=0.0, low_open=False) for j, d in enumerate(damping))
     else:
         damping = _number(f"{path}.damping", damping, low=0.0, low_open=False)
-    return {
+    out = {
         "type": "dynamic",
         "method": _choice(f"{path}.method", value.get("method", "symplectic_euler"), METHODS, "method"),
         "dt": _number(f"{path}.dt", value["dt"], low=0.0),
@@ -662,6 +673,11 @@ def _solver(path, value, model):
         "save_every": _integer(f"{path}.save_every", value.get("save_every", 1)),
         "allow_unstable": _boolean(f"{path}.allow_unstable", value.get("allow_unstable", False)),
     }
+    n_steps = out["t_end"] / out["dt"]
+    if n_steps > MAX_TIME_STEPS:
+        _fail(f"{path}.dt", f"t_end / dt = {n_steps:.3g} time steps, more than the {MAX_TIME_STEPS:.0e} a run may take "
+              f"(dt = {_show(value['dt'])} s, t_end = {_show(value['t_end'])} s); use a larger dt or a shorter t_end")
+    return out
 
 
 def _output(path, value):

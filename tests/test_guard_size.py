@@ -74,8 +74,8 @@ def test_typo_in_resolution_refused_naming_the_generator():
 
 
 def test_tiny_time_step_refused_naming_the_solver():
-    solver = {"type": "dynamic", "dt": 1.0e-12, "t_end": 0.1}
-    with pytest.raises(ResourceError, match=r"scene\.solver: 1e\+11 saved states .*history: false"):
+    solver = {"type": "dynamic", "dt": 1.0e-9, "t_end": 0.1}
+    with pytest.raises(ResourceError, match=r"scene\.solver: 1e\+08 saved states .*history: false"):
         load_scene(_scene(solver=solver))
     # the same run without a stored history is not refused for its memory
     load_scene(_scene(solver=solver, output={"history": False}))
@@ -141,8 +141,18 @@ def test_file_mesh_checked_after_reading(tmp_path):
 
     path = tmp_path / "m.vtu"
     mesh.write_vtu(path, mesh.hex_grid(1.0, 0.1, 0.1, 4, 1, 1))
-    d = _scene(solver={"type": "dynamic", "dt": 1.0e-12, "t_end": 0.1})
+    d = _scene(solver={"type": "dynamic", "dt": 1.0e-9, "t_end": 0.1})
     d["geometry"] = {"file": "m.vtu"}
     scene = load_scene(d, base_dir=tmp_path)  # size unknown before reading: accepted
-    with pytest.raises(ResourceError, match=r"scene\.solver: 1e\+11 saved states of 20 nodes"):
+    with pytest.raises(ResourceError, match=r"scene\.solver: 1e\+08 saved states of 20 nodes"):
         prepare(scene)
+
+
+@pytest.mark.parametrize("solver, message", [
+    ({"load_steps": 10**30}, r"scene\.solver\.load_steps: must be at most 100000 \(each load step is a Newton solve\)"),
+    ({"max_iter": 10**6}, r"scene\.solver\.max_iter: must be at most 10000"),
+    ({"type": "dynamic", "dt": 1e-12, "t_end": 1.0}, r"scene\.solver\.dt: t_end / dt = 1e\+12 time steps, more than"),
+])
+def test_runs_that_cannot_end_are_refused(solver, message):
+    with pytest.raises(ValueError, match=message):
+        load_scene(_scene(solver=solver, output={"history": False}))
