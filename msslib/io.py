@@ -6,8 +6,48 @@ Results are :class:`xarray.Dataset` objects built by :func:`make_dataset`, writt
 several files as one (all are replaced, or none is); every write goes through it, so temporary
 files are removed on any error, on SIGINT and on SIGTERM.
 
-Schema ``msslib-result-1.0`` (the value of the global attribute ``Conventions``)
-==================================================================================
+Schema ``msslib-result-2.0``: CF-1.11 and UGRID-1.0
+===================================================
+
+A result follows the CF metadata conventions 1.11 and the UGRID conventions 1.0 for unstructured
+meshes (global attribute ``Conventions = "CF-1.11 UGRID-1.0"``, :data:`CONVENTIONS`); the global
+attribute ``msslib_schema`` (:data:`SCHEMA_VERSION`) tells this schema from the older
+``msslib-result-1.0`` (which had ``Conventions = "msslib-result-1.0"``, the material constants as
+global attributes and the per-cell material index in a variable ``material``; such files are still
+read by :func:`mesh_from_result`). ``tests/test_cf.py`` runs the IOOS compliance checker (CF-1.11)
+and checks the UGRID rules listed here.
+
+Units are UDUNITS strings (``m``, ``N``, ``N m-1``, ``Pa``, ``kg m-3``, ``J``, ``s``, ``m s-1``;
+``1`` for dimensionless quantities). Every variable has a ``long_name``; every physical or
+dimensionless quantity has ``units``; connectivity, index, flag and label variables have none (they
+are not quantities). CF standard names are used where one exists and fits: none fits Cartesian
+coordinates of a body (``projection_x_coordinate`` means map projections), displacements, forces,
+spring or material constants, so these have ``long_name`` and ``units`` only. ``time`` has no
+``standard_name`` either: CF's ``time`` needs units ``"<unit> since <date>"``, and a simulation's
+time is elapsed time with no date.
+
+Mesh topology (UGRID)
+---------------------
+
+``mesh`` (a dummy integer, ``cf_role = "mesh_topology"``) describes the mesh of the run:
+``topology_dimension`` 2 (triangles, quads: faces) or 3 (tetrahedra, hexahedra: volumes),
+``node_coordinates = "node_x node_y"`` (2D) or ``"node_x node_y node_z"`` (3D), and
+
+* 2D: ``face_node_connectivity = "cells"``, ``face_dimension = "cell"``;
+* 3D: ``volume_node_connectivity = "cells"``, ``volume_dimension = "cell"``,
+  ``volume_shape_type = "cell_shape"`` (UGRID's 3D section: a flag variable with the shape of every
+  volume; node order per shape is VTK's, which is :mod:`msslib.mesh`'s).
+
+The springs of a mass-spring system are a second topology, ``spring_network``
+(``topology_dimension = 1``, the same ``node_coordinates``, ``edge_node_connectivity = "springs"``,
+``edge_dimension = "spring"``): a 1D network on the same nodes. They are not the edges of ``mesh``
+because many models have springs along face and cell diagonals. Connectivities are 0-based
+(``start_index = 0``); all cells of a mesh have the same number of nodes, so no ``_FillValue`` is
+needed. Variables defined on the mesh carry ``mesh`` and ``location``: ``"node"`` (dimension
+``node``; with ``coordinates = "node_x node_y (node_z)"``, written by xarray), ``"face"`` (2D) or
+``"volume"`` (3D) for dimension ``cell``, and ``mesh = "spring_network"``, ``location = "edge"``
+for dimension ``spring``. :func:`make_dataset` adds these to every variable with one of these
+dimensions (``extra_vars`` included) that does not set them itself.
 
 Dimensions
 ----------
@@ -16,10 +56,11 @@ Dimensions
 dimension      meaning
 ============== ===============================================================================
 ``node``       mesh nodes, in the order of ``Mesh.points``
-``axis``       spatial axes; coordinate variable ``axis`` holds ``"x", "y"`` (2D) or
-               ``"x", "y", "z"`` (3D)
+``axis``       spatial axes x, y (2D) and z (3D); the label variable ``axis_name`` names them
+               (CF coordinate variables are numeric, so there is no coordinate variable ``axis``)
 ``cell``       mesh cells, in the order of ``Mesh.cells``
 ``cell_node``  nodes of one cell (3 triangle, 4 quad, 4 tetra, 8 hexahedron)
+``material``   materials; coordinate variable ``material`` holds ``0, 1, ...``
 ``spring``     springs of a mass-spring system (optional)
 ``spring_end`` the two end nodes of a spring (length 2; optional, with ``spring``)
 ``time``       stored states of a dynamic run; coordinate variable ``time`` [s] (optional)
@@ -27,36 +68,72 @@ dimension      meaning
                coordinate variable ``step`` [1] (optional; used only if ``time`` is not)
 ============== ===============================================================================
 
-Variables (every variable, coordinates included, has the attributes ``units`` and ``long_name``;
-``1`` is the unit of dimensionless quantities and indices)
+Variables
+---------
 
-====================================================== ===== ==========================================
-variable                                               units content
-====================================================== ===== ==========================================
-``axis(axis)``                                         1     axis names (string coordinate)
-``rest_position(node, axis)``                          m     node positions of the undeformed mesh
-``displacement(node, axis)``                           m     displacement of the final state
-``cells(cell, cell_node)``                             1     int64 connectivity, 0-based node indices,
-                                                             node order of :mod:`msslib.mesh`;
-                                                             attribute ``cell_type`` (``triangle``,
-                                                             ``quad``, ``tetra``, ``hexahedron``)
-``material(cell)``                                     1     int64 index into the arrays ``E``/``nu``
-``springs(spring, spring_end)``                        1     int64 end nodes of every spring (optional)
-``spring_constant(spring)``                            N/m   spring stiffness (optional)
-``rest_length(spring)``                                m     spring rest length (optional)
-``reaction_force(node, axis)``                         N     reaction force at the nodes (optional)
-``fixed(node, axis)``                                  1     Dirichlet mask: ``bool`` in memory, stored
-                                                             as ``int8`` 0/1 with attribute
-                                                             ``dtype = "bool"`` (xarray decodes it back
-                                                             to ``bool``) (optional)
-``time(time)``                                         s     time of the stored states (optional)
-``step(step)`` or ``step(time)``                       1     iteration / load-step number (optional)
-``displacement_history(time|step, node, axis)``        m     displacement of every stored state
-                                                             (optional)
-``velocity_history(time|step, node, axis)``            m/s   velocity of every stored state (optional)
-====================================================== ===== ==========================================
+====================================================== ======== ========================================
+variable                                               units    content
+====================================================== ======== ========================================
+``mesh``                                               -        UGRID mesh topology (see above)
+``node_x(node)``, ``node_y(node)``, ``node_z(node)``   m        node coordinates of the undeformed mesh
+                                                                (auxiliary coordinates; ``node_z`` in
+                                                                3D only)
+``axis_name(axis)``                                    -        ``"x"``, ``"y"`` (, ``"z"``): string
+                                                                label (auxiliary coordinate, CF 6.1)
+``rest_position(node, axis)``                          m        the same node positions as one array,
+                                                                for arithmetic with ``displacement``
+``displacement(node, axis)``                           m        displacement of the final state
+``cells(cell, cell_node)``                             -        int64 connectivity, 0-based node
+                                                                indices, node order of
+                                                                :mod:`msslib.mesh`; ``cf_role``
+                                                                ``face_node_connectivity`` (2D) or
+                                                                ``volume_node_connectivity`` (3D),
+                                                                ``start_index = 0``; attribute
+                                                                ``cell_type`` (``triangle``,
+                                                                ``quad``, ``tetra``, ``hexahedron``)
+``cell_shape(cell)``                                   -        3D only: int8 UGRID volume shape flag
+                                                                (``flag_values 0 1 2 3``,
+                                                                ``flag_meanings "tetrahedron pyramid
+                                                                wedge hexahedron"``)
+``material(material)``                                 -        int64 material index (coordinate)
+``cell_material(cell)``                                -        int64 material index of the cell
+``material_E(material)``                               Pa       Young's modulus
+``material_nu(material)``                              1        Poisson's ratio
+``material_density(material)``                         kg m-3   density (optional: only when some
+                                                                material has one; ``_FillValue``
+                                                                9.969209968386869e36, read back as NaN,
+                                                                where a material has none)
+``material_name(material)``                            -        material names (optional)
+``thickness``                                          m        membrane thickness of a 2D (plane
+                                                                stress) mesh (optional, scalar)
+``spring_network``                                     -        UGRID 1D topology of the springs
+                                                                (optional, with ``springs``)
+``springs(spring, spring_end)``                        -        int64 end nodes of every spring,
+                                                                ``cf_role = "edge_node_connectivity"``,
+                                                                ``start_index = 0`` (optional)
+``spring_constant(spring)``                            N m-1    spring stiffness (optional)
+``rest_length(spring)``                                m        spring rest length (optional)
+``reaction_force(node, axis)``                         N        reaction force at the nodes (optional)
+``fixed(node, axis)``                                  -        Dirichlet mask: ``bool`` in memory,
+                                                                stored as ``int8`` 0/1 with attribute
+                                                                ``dtype = "bool"`` (xarray decodes it
+                                                                back to ``bool``), ``flag_values 0 1``,
+                                                                ``flag_meanings "free prescribed"``
+                                                                (optional)
+``time(time)``                                         s        simulated time of the stored states,
+                                                                from the start of the run (optional)
+``step(step)`` or ``step(time)``                       1        iteration / load-step number (optional)
+``displacement_history(time|step, node, axis)``        m        displacement of every stored state
+                                                                (optional)
+``velocity_history(time|step, node, axis)``            m s-1    velocity of every stored state
+                                                                (optional)
+====================================================== ======== ========================================
 
-Further variables may be added with ``extra_vars``; they must carry ``units`` and ``long_name`` too.
+Further variables may be added with ``extra_vars``; they need a ``long_name``, and ``units`` unless
+they are flags (``flag_values`` and ``flag_meanings``) or text. :func:`msslib.scene.run_scene`
+adds ``cell_state(cell)`` (flags, :mod:`msslib.quality`), ``relative_jacobian(cell)`` [1], the
+energies of dynamic runs (``kinetic_energy(time)``, ``potential_energy(time)`` [J]) and the
+potential energy of the final state of static mass-spring runs (scalar ``potential_energy`` [J]).
 
 Global attributes
 -----------------
@@ -64,10 +141,12 @@ Global attributes
 ==================== ==========================================================================
 attribute            content
 ==================== ==========================================================================
-``Conventions``      ``"msslib-result-1.0"`` (:data:`SCHEMA_VERSION`)
+``Conventions``      ``"CF-1.11 UGRID-1.0"`` (:data:`CONVENTIONS`)
+``msslib_schema``    ``"msslib-result-2.0"`` (:data:`SCHEMA_VERSION`)
+``title``            ``"msslib result: <model>"``
+``source``           ``"msslib <version>"``
+``history``          ``"<created> created by msslib <version>"``
 ``model``            model name, e.g. ``"fem_linear"``, ``"lloyd_tetrahedron"``
-``E``                Young's modulus [Pa]; a number, or a 1-D array indexed by ``material``
-``nu``               Poisson's ratio [1]; a number, or a 1-D array indexed by ``material``
 ``scene``            the scene text or name (``""`` if none; a mapping is stored as JSON)
 ``msslib_version``   :data:`msslib.__version__`
 ``git_commit``       ``git rev-parse HEAD`` run in the package's directory, with suffix
@@ -82,10 +161,11 @@ attribute            content
 ==================== ==========================================================================
 
 Attribute values are restricted to what netCDF stores: strings, numbers and 1-D numeric arrays.
-Booleans become the integers 0/1, ``None`` becomes the string ``"None"``, and anything else
-(lists of strings, nested lists, empty lists) becomes its JSON text. A length-1 array attribute reads
-back as a scalar (a netCDF property). Further global attributes may be added with ``extra_attrs``
-(they must not collide with the attributes above).
+Booleans become the integers 0/1; ``None`` (and the string ``"None"``, which older callers passed for
+"no value") drops the attribute; anything else (lists of strings, nested or ragged lists, mappings)
+is stored as its JSON text. A length-1 array attribute reads back as a scalar (a netCDF property).
+Further global attributes may be added with ``extra_attrs`` (they must not collide with the
+attributes above); physical quantities belong in variables, where they carry units.
 """
 
 from __future__ import annotations
@@ -112,6 +192,7 @@ from . import __version__
 from .mesh import CELL_TYPES, Mesh
 
 __all__ = [
+    "CONVENTIONS",
     "SCHEMA_VERSION",
     "git_commit",
     "make_dataset",
@@ -125,16 +206,30 @@ __all__ = [
     "mesh_from_result",
 ]
 
-SCHEMA_VERSION = "msslib-result-1.0"
+#: value of the global attribute ``Conventions``
+CONVENTIONS = "CF-1.11 UGRID-1.0"
+#: value of the global attribute ``msslib_schema``
+SCHEMA_VERSION = "msslib-result-2.0"
+#: the schema before CF/UGRID (its ``Conventions`` attribute); :func:`mesh_from_result` reads it
+LEGACY_SCHEMA_VERSION = "msslib-result-1.0"
 AXIS_NAMES = ("x", "y", "z")
 ENGINE = "netcdf4"
 #: Variables that must be finite for :func:`write_result` to accept a dataset.
 FINITE_VARIABLES = ("rest_position", "displacement", "displacement_history", "velocity_history")
 #: Global attributes set by :func:`make_dataset` (``solver_*`` apart).
 SCHEMA_ATTRS = (
-    "Conventions", "model", "E", "nu", "scene", "msslib_version", "git_commit", "created",
-    "python_version", "numpy_version", "wall_time_s",
+    "Conventions", "msslib_schema", "title", "source", "history", "model", "scene", "msslib_version",
+    "git_commit", "created", "python_version", "numpy_version", "wall_time_s",
 )
+#: the UGRID mesh topology variables
+MESH, SPRING_NETWORK = "mesh", "spring_network"
+#: UGRID volume shapes (flag values of ``cell_shape``) and the msslib cell types they stand for
+VOLUME_SHAPES = ("tetrahedron", "pyramid", "wedge", "hexahedron")
+_VOLUME_SHAPE_OF = {"tetra": "tetrahedron", "hexahedron": "hexahedron"}
+#: the netCDF default fill value of doubles, used where a material has no density
+DOUBLE_FILL = 9.969209968386869e36
+#: variables stored with a ``_FillValue`` (:data:`DOUBLE_FILL`; NaN in memory)
+FILLED_VARIABLES = ("material_density",)
 
 
 # --------------------------------------------------------------------------------------------------
@@ -170,10 +265,15 @@ def git_commit(directory: str | os.PathLike | None = None, *, timeout: float = 1
     return commit + "+dirty" if dirty else commit
 
 
+#: returned by :func:`_attr_value` for values that drop the attribute (``None``, ``"None"``)
+_DROP = object()
+
+
 def _attr_value(value):
-    """Convert ``value`` to something netCDF can store as an attribute (see the module docstring)."""
-    if value is None:
-        return "None"
+    """Convert ``value`` to something netCDF can store as an attribute (see the module docstring);
+    :data:`_DROP` for ``None`` and ``"None"``, which drop the attribute."""
+    if value is None or (isinstance(value, str) and value == "None"):
+        return _DROP
     if isinstance(value, (bool, np.bool_)):
         return int(value)
     if isinstance(value, (str, int, float, np.integer, np.floating)):
@@ -204,23 +304,36 @@ def _json_default(obj):
     return str(obj)
 
 
+def _attrs(mapping: Mapping) -> dict:
+    """``mapping`` with every value converted by :func:`_attr_value`; dropped values left out."""
+    out = {}
+    for key, value in mapping.items():
+        value = _attr_value(value)
+        if value is not _DROP:
+            out[key] = value
+    return out
+
+
 def _flatten(stats: Mapping, prefix: str) -> dict:
-    """Flatten a nested mapping into ``{prefix_key_subkey: netCDF attribute value}``."""
+    """Flatten a nested mapping into ``{prefix_key_subkey: value}`` (values not yet sanitised)."""
     out = {}
     for key, value in stats.items():
         name = f"{prefix}_{key}"
         if isinstance(value, Mapping):
             out.update(_flatten(value, name))
         else:
-            out[name] = _attr_value(value)
+            out[name] = value
     return out
 
 
-def _moduli_attr(value, name: str):
+def _per_material(value, name: str, n_mat: int | None = None) -> np.ndarray:
+    """A number or a 1-D array of one value per material, as a float array."""
     arr = np.asarray(value, dtype=float)
     if arr.ndim > 1 or arr.size == 0:
         raise ValueError(f"{name} must be a number or a non-empty 1-D array, got shape {arr.shape}")
-    return float(arr) if arr.ndim == 0 else arr
+    if arr.ndim == 1 and n_mat is not None and len(arr) < n_mat:
+        raise ValueError(f"{name} has {len(arr)} entries but mesh.material refers to {n_mat} materials")
+    return arr
 
 
 # --------------------------------------------------------------------------------------------------
@@ -235,7 +348,59 @@ def _array(value, shape, name, dtype=float):
 
 
 def _var(dims, data, units, long_name, **attrs):
-    return xr.Variable(dims, data, attrs={"units": units, "long_name": long_name, **attrs})
+    """A variable with ``long_name`` and, unless ``units`` is None, ``units``."""
+    head = {"long_name": long_name} if units is None else {"units": units, "long_name": long_name}
+    return xr.Variable(dims, data, attrs={**head, **attrs})
+
+
+def _is_flag_or_text(var: xr.Variable) -> bool:
+    return ("flag_values" in var.attrs and "flag_meanings" in var.attrs) or var.dtype.kind in "OSU"
+
+
+def _topology(mesh: Mesh, axes: list[str]) -> tuple[dict, dict]:
+    """The UGRID variables of ``mesh``: ``(coordinates, variables)``."""
+    dim = mesh.dim
+    node_coords = [f"node_{a}" for a in axes]
+    coords = {
+        name: _var(("node",), mesh.points[:, i].copy(), "m", f"{a} coordinate of the node in the undeformed mesh")
+        for i, (name, a) in enumerate(zip(node_coords, axes))
+    }
+    topo = {"cf_role": "mesh_topology", "long_name": f"topology of the {dim}D mesh",
+            "topology_dimension": np.int32(dim), "node_coordinates": " ".join(node_coords)}
+    role = "face_node_connectivity" if dim == 2 else "volume_node_connectivity"
+    variables = {}
+    if dim == 2:
+        topo.update(face_node_connectivity="cells", face_dimension="cell")
+    else:
+        topo.update(volume_node_connectivity="cells", volume_dimension="cell", volume_shape_type="cell_shape")
+        code = VOLUME_SHAPES.index(_VOLUME_SHAPE_OF[mesh.cell_type])
+        variables["cell_shape"] = _var(
+            ("cell",), np.full(mesh.n_cells, code, dtype=np.int8), None, "shape of the volume",
+            cf_role="volume_shape_type", flag_values=np.arange(len(VOLUME_SHAPES), dtype=np.int8),
+            flag_meanings=" ".join(VOLUME_SHAPES))
+    variables[MESH] = xr.Variable((), np.int32(0), attrs=topo)
+    variables["cells"] = _var(
+        ("cell", "cell_node"), mesh.cells.copy(), None,
+        f"nodes of the cell (0-based, node order of msslib.mesh: VTK's {mesh.cell_type})",
+        cf_role=role, start_index=np.int64(0), cell_type=mesh.cell_type)
+    return coords, variables
+
+
+def _locate(variables: Mapping, dim: int, has_springs: bool) -> None:
+    """Add UGRID ``mesh``/``location`` to the variables defined on nodes, cells or springs."""
+    cell_location = "face" if dim == 2 else "volume"
+    for var in variables.values():
+        if "cf_role" in var.attrs or "mesh" in var.attrs or "location" in var.attrs:
+            continue
+        on = [d for d in var.dims if d in ("node", "cell", "spring")]
+        if len(on) != 1:
+            continue
+        if on[0] == "node":
+            var.attrs.update(mesh=MESH, location="node")
+        elif on[0] == "cell":
+            var.attrs.update(mesh=MESH, location=cell_location)
+        elif has_springs:
+            var.attrs.update(mesh=SPRING_NETWORK, location="edge")
 
 
 def make_dataset(
@@ -245,6 +410,9 @@ def make_dataset(
     model: str,
     E,
     nu,
+    density=None,
+    material_names=None,
+    thickness: float | None = None,
     scene=None,
     springs=None,
     spring_constant=None,
@@ -261,11 +429,15 @@ def make_dataset(
 
     Parameters
     ----------
-    mesh : the undeformed mesh (``rest_position``, ``cells``, ``material``).
+    mesh : the undeformed mesh (node coordinates, ``cells``, ``cell_material``).
     displacement : ``(n_nodes, dim)`` displacement of the final state [m].
     model : model name (global attribute ``model``).
-    E, nu : Young's modulus [Pa] and Poisson's ratio, numbers or 1-D arrays indexed by
-        ``mesh.material``.
+    E, nu : Young's modulus [Pa] and Poisson's ratio, numbers (every material) or 1-D arrays indexed
+        by ``mesh.material`` (variables ``material_E``, ``material_nu``).
+    density : density [kg/m^3], a number or one value per material, NaN (or None) where a material
+        has none (variable ``material_density``, left out when no material has one).
+    material_names : one name per material (variable ``material_name``).
+    thickness : membrane thickness [m] of a 2D mesh (scalar variable ``thickness``); refused for 3D.
     scene : scene text or name (a mapping is stored as JSON); ``None`` stores ``""``.
     springs : ``(n_springs, 2)`` node indices; ``spring_constant`` [N/m] and ``rest_length`` [m]
         are ``(n_springs,)`` and need ``springs``.
@@ -279,7 +451,9 @@ def make_dataset(
     solver_stats : mapping (possibly nested) stored as ``solver_*`` global attributes.
     wall_time : wall time of the run [s] (``wall_time_s``; NaN if ``None``).
     extra_vars : mapping name -> :class:`xarray.DataArray`/:class:`xarray.Variable` or
-        ``(dims, data, attrs)`` tuple; each needs ``units`` and ``long_name`` attributes.
+        ``(dims, data, attrs)`` tuple; each needs a ``long_name`` attribute, and ``units`` unless it
+        is a flag variable (``flag_values`` and ``flag_meanings``) or text. Those on nodes, cells or
+        springs get the UGRID ``mesh`` and ``location`` attributes.
     extra_attrs : further global attributes (sanitised like ``solver_*``).
     """
     if not isinstance(mesh, Mesh):
@@ -289,20 +463,48 @@ def make_dataset(
     n, dim = mesh.n_nodes, mesh.dim
     axes = list(AXIS_NAMES[:dim])
 
-    E_attr, nu_attr = _moduli_attr(E, "E"), _moduli_attr(nu, "nu")
-    n_mat = int(mesh.material.max()) + 1 if mesh.n_cells else 0
-    for name, value in (("E", E_attr), ("nu", nu_attr)):
-        if isinstance(value, np.ndarray) and len(value) < n_mat:
-            raise ValueError(f"{name} has {len(value)} entries but mesh.material refers to {n_mat} materials")
+    # materials: one entry per material index a cell uses, or more if the tables are longer
+    n_used = int(mesh.material.max()) + 1 if mesh.n_cells else 0
+    E_arr, nu_arr = _per_material(E, "E", n_used), _per_material(nu, "nu", n_used)
+    dens_arr = None
+    if density is not None:
+        dens = np.asarray(density, dtype=object)
+        dens_arr = _per_material(np.array([np.nan if d is None else d for d in dens.ravel()], dtype=float)
+                                 .reshape(dens.shape), "density", n_used)
+    names = None
+    if material_names is not None:
+        names = [str(x) for x in np.atleast_1d(np.asarray(material_names, dtype=object))]
+    n_mat = max([n_used, 1] + [len(a) for a in (E_arr, nu_arr, dens_arr) if a is not None and a.ndim == 1]
+                + ([len(names)] if names is not None else []))
+    for name, arr in (("E", E_arr), ("nu", nu_arr), ("density", dens_arr)):
+        if arr is not None and arr.ndim == 1 and len(arr) != n_mat:
+            raise ValueError(f"{name} has {len(arr)} entries but there are {n_mat} materials")
+    if names is not None and len(names) != n_mat:
+        raise ValueError(f"material_names has {len(names)} entries but there are {n_mat} materials")
 
-    variables = {
+    coords, variables = _topology(mesh, axes)
+    coords["axis_name"] = _var(("axis",), np.array(axes, dtype=object), None, "name of the spatial axis")
+    coords["material"] = _var(("material",), np.arange(n_mat, dtype=np.int64), None, "material index")
+    variables.update({
         "rest_position": _var(("node", "axis"), mesh.points.copy(), "m", "node position of the undeformed mesh"),
         "displacement": _var(("node", "axis"), _array(displacement, (n, dim), "displacement"), "m",
                              "node displacement of the final state"),
-        "cells": _var(("cell", "cell_node"), mesh.cells.copy(), "1", "cell connectivity (0-based node indices)",
-                      cell_type=mesh.cell_type),
-        "material": _var(("cell",), mesh.material.copy(), "1", "material index of the cell"),
-    }
+        "cell_material": _var(("cell",), mesh.material.copy(), None, "material index of the cell"),
+        "material_E": _var(("material",), np.broadcast_to(E_arr, (n_mat,)).copy(), "Pa", "Young's modulus"),
+        "material_nu": _var(("material",), np.broadcast_to(nu_arr, (n_mat,)).copy(), "1", "Poisson's ratio"),
+    })
+    if dens_arr is not None and np.isfinite(dens_arr).any():
+        variables["material_density"] = _var(("material",), np.broadcast_to(dens_arr, (n_mat,)).copy(), "kg m-3",
+                                             "density (missing where the material has none)")
+    if names is not None:
+        variables["material_name"] = _var(("material",), np.array(names, dtype=object), None, "material name")
+    if thickness is not None:
+        if dim != 2:
+            raise ValueError("thickness applies to 2D meshes only")
+        t = float(thickness)
+        if not (math.isfinite(t) and t > 0):
+            raise ValueError(f"thickness must be a positive number, got {thickness!r}")
+        variables["thickness"] = _var((), t, "m", "membrane thickness (plane stress)")
 
     if springs is None:
         if spring_constant is not None or rest_length is not None:
@@ -317,10 +519,15 @@ def make_dataset(
         if springs.size and (springs.min() < 0 or springs.max() >= n):
             raise ValueError("springs refer to nodes that do not exist")
         m = len(springs)
-        variables["springs"] = _var(("spring", "spring_end"), springs, "1", "end nodes of the spring")
+        variables[SPRING_NETWORK] = xr.Variable((), np.int32(0), attrs={
+            "cf_role": "mesh_topology", "long_name": "springs of the mass-spring system (a network on the mesh nodes)",
+            "topology_dimension": np.int32(1), "node_coordinates": variables[MESH].attrs["node_coordinates"],
+            "edge_node_connectivity": "springs", "edge_dimension": "spring"})
+        variables["springs"] = _var(("spring", "spring_end"), springs, None, "end nodes of the spring (0-based)",
+                                    cf_role="edge_node_connectivity", start_index=np.int64(0))
         if spring_constant is not None:
             variables["spring_constant"] = _var(("spring",), _array(spring_constant, (m,), "spring_constant"),
-                                                "N/m", "spring constant")
+                                                "N m-1", "spring constant")
         if rest_length is not None:
             variables["rest_length"] = _var(("spring",), _array(rest_length, (m,), "rest_length"), "m",
                                             "spring rest length")
@@ -333,9 +540,9 @@ def make_dataset(
         if fixed.shape == (n,):
             fixed = np.repeat(fixed[:, None], dim, axis=1)
         fixed = _array(fixed, (n, dim), "fixed", dtype=bool)
-        variables["fixed"] = _var(("node", "axis"), fixed, "1", "displacement component prescribed (Dirichlet)")
+        variables["fixed"] = _var(("node", "axis"), fixed, None, "displacement component prescribed (Dirichlet)",
+                                  flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="free prescribed")
 
-    coords = {"axis": _var(("axis",), np.array(axes, dtype=object), "1", "spatial axis")}
     if history is not None:
         coords_h, vars_h = _history(history, n, dim)
         coords.update(coords_h)
@@ -350,35 +557,42 @@ def make_dataset(
             value = value.variable
         elif not isinstance(value, xr.Variable):
             raise TypeError(f"extra variable {name!r} must be a DataArray, Variable or (dims, data, attrs) tuple")
-        missing = [a for a in ("units", "long_name") if a not in value.attrs]
+        value = value.copy(deep=False)
+        value.attrs = dict(value.attrs)
+        missing = [a for a in ("units", "long_name") if a not in value.attrs
+                   and not (a == "units" and _is_flag_or_text(value))]
         if missing:
             raise ValueError(f"extra variable {name!r} lacks the attribute(s) {missing}")
         variables[name] = value
 
     if isinstance(scene, Mapping):
         scene = json.dumps(scene, default=_json_default, sort_keys=True)
+    created = datetime.now(timezone.utc).isoformat(timespec="seconds")
     attrs = {
-        "Conventions": SCHEMA_VERSION,
+        "Conventions": CONVENTIONS,
+        "msslib_schema": SCHEMA_VERSION,
+        "title": f"msslib result: {model}",
+        "source": f"msslib {__version__}",
+        "history": f"{created} created by msslib {__version__}",
         "model": model,
-        "E": E_attr,
-        "nu": nu_attr,
         "scene": "" if scene is None else str(scene),
         "msslib_version": __version__,
         "git_commit": git_commit(),
-        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "created": created,
         "python_version": platform.python_version(),
         "numpy_version": np.__version__,
         "wall_time_s": math.nan if wall_time is None else float(wall_time),
     }
-    if solver_stats is not None:
-        attrs.update(_flatten(solver_stats, "solver"))
+    extra = dict(_flatten(solver_stats, "solver")) if solver_stats is not None else {}
     for key, value in (extra_attrs or {}).items():
-        if key in attrs:
+        if key in attrs or key in extra:
             raise ValueError(f"extra attribute {key!r} collides with a schema attribute")
-        attrs[key] = _attr_value(value)
+        extra[key] = value
+    attrs.update(_attrs(extra))
 
-    for name, var in variables.items():
-        var.attrs = {k: _attr_value(v) for k, v in var.attrs.items()}
+    _locate(variables, dim, springs is not None)
+    for var in (*variables.values(), *coords.values()):
+        var.attrs = _attrs(var.attrs)
     return xr.Dataset(variables, coords=coords, attrs=attrs)
 
 
@@ -394,7 +608,8 @@ def _history(history: Mapping, n: int, dim: int):
     n_t = len(np.atleast_1d(history[tdim]))
     coords, variables = {}, {}
     if "time" in history:
-        coords["time"] = _var(("time",), _array(history["time"], (n_t,), "history['time']"), "s", "time")
+        coords["time"] = _var(("time",), _array(history["time"], (n_t,), "history['time']"), "s",
+                              "simulated time from the start of the run")
     if "step" in history:
         step = np.asarray(history["step"])
         if step.shape != (n_t,) or (step.size and not np.array_equal(step, np.round(step))):
@@ -407,7 +622,7 @@ def _history(history: Mapping, n: int, dim: int):
     if "velocity" in history:
         variables["velocity_history"] = _var(
             (tdim, "node", "axis"), _array(history["velocity"], (n_t, n, dim), "history['velocity']"),
-            "m/s", "node velocity of every stored state")
+            "m s-1", "node velocity of every stored state")
     return coords, variables
 
 
@@ -416,10 +631,11 @@ def _history(history: Mapping, n: int, dim: int):
 
 
 def _encoding(ds: xr.Dataset) -> dict:
-    """No fill values (results are complete); zlib for numeric arrays."""
+    """No fill values (results are complete) but for :data:`FILLED_VARIABLES`; zlib for numeric
+    arrays."""
     enc = {}
     for name, var in ds.variables.items():
-        e = {"_FillValue": None}
+        e = {"_FillValue": DOUBLE_FILL if name in FILLED_VARIABLES and var.dtype.kind == "f" else None}
         if var.dtype.kind in "biuf" and var.ndim >= 1 and var.size:
             e.update(zlib=True, complevel=4)
         enc[name] = e
@@ -773,17 +989,32 @@ class StagedOutputs:
 def read_result(path: str | os.PathLike) -> xr.Dataset:
     """Read a result file fully into memory and close it.
 
-    ``fixed`` comes back as ``bool``; ``time`` stays plain seconds (no timedelta decoding).
+    ``fixed`` comes back as ``bool``; ``time`` stays plain seconds (no timedelta decoding); the
+    node coordinates ``node_x``, ... are coordinates of the dataset (from the CF ``coordinates``
+    attributes); ``material_density`` is NaN where a material has none.
     """
     return xr.load_dataset(path, engine=ENGINE, decode_timedelta=False)
 
 
+def _cell_material(ds: xr.Dataset):
+    """The per-cell material index: ``cell_material``, or ``material(cell)`` of a
+    ``msslib-result-1.0`` file; None if there is neither."""
+    if "cell_material" in ds.variables:
+        return ds["cell_material"]
+    if "material" in ds.variables and ds["material"].dims == ("cell",):
+        return ds["material"]
+    return None
+
+
 def mesh_from_result(ds: xr.Dataset, *, deformed: bool = False) -> Mesh:
     """The :class:`~msslib.mesh.Mesh` of a result (its rest configuration; ``deformed=True`` adds
-    ``displacement`` to the node positions)."""
-    for name in ("rest_position", "cells", "material"):
+    ``displacement`` to the node positions). Reads ``msslib-result-1.0`` files too."""
+    material = _cell_material(ds)
+    for name in ("rest_position", "cells"):
         if name not in ds.variables:
             raise ValueError(f"dataset has no variable {name!r}; not a {SCHEMA_VERSION} result")
+    if material is None:
+        raise ValueError(f"dataset has no variable 'cell_material'; not a {SCHEMA_VERSION} result")
     cell_type = ds["cells"].attrs.get("cell_type")
     if cell_type not in CELL_TYPES:
         raise ValueError(f"variable 'cells' has no valid cell_type attribute (got {cell_type!r})")
@@ -794,5 +1025,5 @@ def mesh_from_result(ds: xr.Dataset, *, deformed: bool = False) -> Mesh:
         points=np.array(points, dtype=float),
         cells=np.array(ds["cells"].transpose("cell", "cell_node").values, dtype=np.int64),
         cell_type=str(cell_type),
-        material=np.array(ds["material"].values, dtype=np.int64),
+        material=np.array(material.values, dtype=np.int64),
     )

@@ -1,4 +1,4 @@
-"""Meshes: node positions, cells of one type, a material index per cell.
+"""Meshes: node positions, cells of one type, a material index per cell, named groups.
 
 Conventions (shared by every module of msslib):
 
@@ -8,6 +8,8 @@ Conventions (shared by every module of msslib):
   (``det[p1-p0, p2-p0, p3-p0] > 0``); ``hexahedron`` nodes 0-3 the bottom face counter-clockwise
   seen from above, 4-7 the top face, node ``i + 4`` above node ``i``.
 * ``material`` has shape ``(n_cells,)``: an index into the list of materials of a model.
+* ``cell_groups``, ``facet_groups``, ``node_groups``: named groups of cells, boundary facets and
+  nodes from a mesh file (see :class:`Mesh` and :func:`read`).
 
 Contents of this module (all lengths in metres, areas in m^2, volumes in m^3):
 
@@ -19,8 +21,11 @@ Contents of this module (all lengths in metres, areas in m^2, volumes in m^3):
   most ``h``, refined to about 12 elements per full circle on curved boundaries but not below
   ``h / 8``; gmsh runs single-threaded with a fixed random ``seed``, so a call is reproducible;
   the mesh keeps only the nodes its cells use and its simplices are positively oriented;
-* input/output: :func:`read` (every failure one ValueError naming the file), :func:`write_vtu`,
-  :func:`readable_suffixes`, :func:`check_mesh_suffix`;
+* input/output: :func:`read` (every failure one ValueError naming the file; keeps the file's
+  physical groups, cell sets and node sets), :func:`write_vtu`, :func:`readable_suffixes`,
+  :func:`check_mesh_suffix`;
+* groups: :func:`materials_from_groups` (a material index per cell from cell groups),
+  :func:`facet_cell_counts` (is a facet a face of the mesh);
 * topology and geometry: :func:`unique_edges`, :func:`face_diagonals`, :func:`inner_diagonals`,
   :func:`boundary_facets`, :func:`facet_areas`, :func:`cell_measures`, :func:`check_cells`,
   :func:`orient`, :func:`select_nodes`, :func:`lumped_masses`;
@@ -41,7 +46,7 @@ import os
 import threading
 import uuid
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import NamedTuple
 
@@ -58,10 +63,30 @@ COINCIDENT_POLICIES = ("merge", "error", "keep")
 
 @dataclass(frozen=True)
 class Mesh:
+    """Node positions, cells of one type, a material index per cell, and named groups.
+
+    Groups (empty for generated meshes; :func:`read` fills them from the file) are known by name,
+    a group without a name (a gmsh physical group without a name) by its number as a string
+    (``"3"``); the three dicts are separate, so one name may be a group of each kind:
+
+    * ``cell_groups[name]``: sorted unique cell indices, ``(k,)`` int64;
+    * ``facet_groups[name]``: ``(k, nodes_per_facet)`` node indices of lower-dimensional elements
+      of the facet type of the cells (lines of a 2D mesh, triangles of a tetra mesh, quads of a
+      hexahedron mesh), in the order and orientation of the file;
+    * ``node_groups[name]``: sorted unique node indices, ``(k,)`` int64.
+
+    Every group has at least one member.  Group arrays are read-only; functions that renumber
+    nodes (:func:`resolve_coincident_nodes`) or reorder cell nodes (:func:`orient`) carry the
+    groups along.  Use :func:`dataclasses.replace` to change a field and keep the others.
+    """
+
     points: np.ndarray
     cells: np.ndarray
     cell_type: str
     material: np.ndarray = field(default=None)
+    cell_groups: dict = field(default=None)
+    facet_groups: dict = field(default=None)
+    node_groups: dict = field(default=None)
 
     def __post_init__(self):
         if self.cell_type not in CELL_TYPES:
@@ -81,6 +106,10 @@ class Mesh:
         object.__setattr__(self, "points", points)
         object.__setattr__(self, "cells", cells)
         object.__setattr__(self, "material", material)
+        nf = _LOCAL_FACETS[self.cell_type].shape[1]
+        for kind, size, shape in (("cell_groups", len(cells), None), ("facet_groups", len(points), nf),
+                                  ("node_groups", len(points), None)):
+            object.__setattr__(self, kind, _checked_groups(kind, getattr(self, kind), size, shape))
 
     @property
     def dim(self) -> int:
@@ -97,6 +126,37 @@ class Mesh:
     @property
     def nodes_per_cell(self) -> int:
         return self.cells.shape[1]
+
+
+def _checked_groups(kind: str, groups, size: int, facet_nodes: int | None) -> dict:
+    """``groups`` as a dict of read-only int64 arrays: indices below ``size``, sorted and unique
+    (cell and node groups) or rows of ``facet_nodes`` node indices (facet groups)."""
+    if groups is None:
+        return {}
+    if not isinstance(groups, dict):
+        raise ValueError(f"{kind} must be a dict of name -> indices, got {type(groups).__name__}")
+    what = "node" if facet_nodes is not None or kind == "node_groups" else "cell"
+    out = {}
+    for name, members in groups.items():
+        if not isinstance(name, str) or not name:
+            raise ValueError(f"{kind}: group names must be non-empty strings, got {name!r}")
+        a = np.asarray(members)
+        if a.size and a.dtype.kind not in "iu":
+            raise ValueError(f"{kind}[{name!r}]: expected integer {what} indices, got {a.dtype}")
+        a = a.astype(np.int64)
+        if facet_nodes is None:
+            a = np.unique(a.ravel())
+        elif a.ndim != 2 or a.shape[1] != facet_nodes:
+            raise ValueError(f"{kind}[{name!r}]: expected shape (k, {facet_nodes}), got {a.shape}")
+        if a.size == 0:
+            raise ValueError(f"{kind}[{name!r}] is empty; allowed: groups with at least one member")
+        if a.min() < 0 or a.max() >= size:
+            raise ValueError(f"{kind}[{name!r}] refers to {what} {int(a.max() if a.max() >= size else a.min())}, "
+                             f"which does not exist; allowed: {what}s 0 to {size - 1}")
+        a = np.ascontiguousarray(a)
+        a.flags.writeable = False
+        out[name] = a
+    return out
 
 
 __all__ = [
@@ -117,6 +177,8 @@ __all__ = [
     "cone_mesh",
     "l_block_tet",
     "read",
+    "materials_from_groups",
+    "facet_cell_counts",
     "readable_suffixes",
     "check_mesh_suffix",
     "write_vtu",
@@ -215,12 +277,44 @@ def _positive_length(name: str, value) -> float:
     return value
 
 
-def _compact(points: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Drop the nodes no cell uses; keeps the relative order of the remaining nodes."""
+def _compact(points: np.ndarray, cells: np.ndarray, return_map: bool = False):
+    """Drop the nodes no cell uses; keeps the relative order of the remaining nodes.
+
+    Returns ``(points, cells)``, with ``return_map`` also the new number of every old node
+    (-1 for a dropped node)."""
     used = np.zeros(len(points), dtype=bool)
     used[cells.ravel()] = True
-    new_id = np.cumsum(used) - 1
+    new_id = np.where(used, np.cumsum(used) - 1, -1)
+    if return_map:
+        return points[used], new_id[cells], new_id
     return points[used], new_id[cells]
+
+
+def _renumbered_groups(mesh: Mesh, node_map: np.ndarray, source: str) -> dict:
+    """The facet and node groups of ``mesh`` with node ``i`` renumbered ``node_map[i]`` (-1: the
+    node is dropped), as keyword arguments of :class:`Mesh`; the cell groups are unchanged.
+
+    Nodes that are dropped leave their node groups; a facet that loses a node, or whose corners
+    become one node, and a node group left empty, are a ValueError naming the group."""
+    facet_groups, node_groups = {}, {}
+    for name, facets in mesh.facet_groups.items():
+        new = node_map[facets]
+        ordered = np.sort(new, axis=1)
+        bad = np.flatnonzero((new < 0).any(axis=1) | (ordered[:, 1:] == ordered[:, :-1]).any(axis=1))
+        if len(bad):
+            f = facets[bad[0]]
+            raise ValueError(f"{source}: facet group {name!r}: {len(bad)} facet(s) lose a node or collapse when "
+                             f"nodes are merged or dropped, e.g. the facet of nodes {f.tolist()}; allowed: facets on "
+                             f"nodes of the cells with distinct corners")
+        facet_groups[name] = new
+    for name, nodes in mesh.node_groups.items():
+        new = node_map[nodes]
+        new = new[new >= 0]
+        if len(new) == 0:
+            raise ValueError(f"{source}: node group {name!r}: none of its {len(nodes)} node(s) is used by a cell; "
+                             f"allowed: groups of nodes of the cells")
+        node_groups[name] = new
+    return {"facet_groups": facet_groups, "node_groups": node_groups}
 
 
 def _group_pairs(pairs: np.ndarray, cell_ids: np.ndarray, n_nodes: int) -> NodePairs:
@@ -646,6 +740,9 @@ def _meshio_read(path: Path):
                 detail = f"{type(exc).__name__}: {text}" if text else type(exc).__name__
                 if said and said not in detail:
                     detail += f" ({said})"
+            if "Incompatible cell data 'gmsh:physical'" in str(exc):
+                detail += (" (meshio reads gmsh physical groups only when every element is in one: save without "
+                           "Mesh.SaveAll, or put every entity in a physical group)")
             if len(detail) > 300:
                 detail = detail[:297] + "..."
             raise ValueError(f"{path}: cannot read mesh: {detail}; allowed: a valid mesh file in a format meshio "
@@ -662,7 +759,24 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
     one with more cells); blocks of that type are concatenated.  Nodes no chosen cell uses are
     dropped (the others keep their order).  For 2D cells the z coordinate must be constant and is
     dropped.  ``cell_data[material_key]`` (one integer per cell), when present, becomes
-    ``material``.
+    ``material``; otherwise every cell has material 0, also when the file has groups (the scenes
+    assign materials by group, :func:`materials_from_groups`).  Two cells on the same nodes are
+    an error (a gmsh 2 file repeats an element for every physical group it belongs to).
+
+    Groups (:class:`Mesh`): the gmsh physical groups (``cell_data["gmsh:physical"]``, named by
+    ``field_data`` ``{name: [tag, dim]}``; a group without a name is known by its tag, ``"3"``;
+    meshio keeps one physical tag per element, the first) and meshio's ``cell_sets`` (gmsh 4
+    named groups, Abaqus ELSET, ...; sets named ``gmsh:...`` are meshio's bookkeeping and are
+    skipped) become ``cell_groups`` for elements of the chosen cell type, ``facet_groups`` for
+    elements of its facet type (lines in 2D, triangles for tetra, quads for hexahedron cells) and
+    ``node_groups`` (the nodes of the elements) for other lower-dimensional elements (gmsh
+    physical points and curves of a 3D mesh, triangles of a hexahedron mesh); meshio's
+    ``point_sets`` (Abaqus NSET, Exodus node sets) become ``node_groups``.  A group of the same
+    name from both sources is their union.  Elements of other types of the cells' dimension and
+    of higher dimensions are ignored, with their groups.  A facet or node group on a node no chosen
+    cell uses is dropped with a :class:`msslib.errors.MsslibWarning` naming it (it could not carry
+    its load or support).  VTU files hold no sets (meshio writes them as cell data it cannot split
+    back reliably): their groups come from a ``gmsh:physical`` cell data array, by number.
 
     Coincident nodes (closer than ``coincident_rtol`` times the bounding-box diagonal, see
     :func:`resolve_coincident_nodes`) are merged with a :class:`msslib.errors.MsslibWarning`
@@ -673,7 +787,8 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
     everything else: a directory, an unknown suffix (listing the suffixes meshio knows), an empty
     or unreadable file (whatever meshio raises, :class:`SystemExit` included), no cells or no
     supported cell type (naming the types found), cells referring to nodes that do not exist,
-    non-finite coordinates, material values that are not integers, a cell collapsed by merging.
+    non-finite coordinates, material values that are not integers, duplicate cells, a cell
+    collapsed by merging.
     """
     if coincident_nodes not in COINCIDENT_POLICIES:
         raise ValueError(f"coincident_nodes must be one of {', '.join(COINCIDENT_POLICIES)}, got {coincident_nodes!r}")
@@ -689,7 +804,7 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
         raise ValueError(f"{path}: cannot read mesh: the file is empty; allowed: a mesh file with cells")
     m, said, caught = _meshio_read(path)
     try:
-        mesh, used = _mesh_from_meshio(path, m, material_key)
+        mesh, used, notes = _mesh_from_meshio(path, m, material_key)
     except (ValueError, TypeError, IndexError, KeyError) as exc:  # one line naming the file, whatever it is
         text = " ".join(str(exc).split()) or type(exc).__name__
         if not text.startswith(str(path)):
@@ -705,13 +820,19 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
         from msslib.errors import MsslibWarning
 
         warnings.warn(f"{path}: meshio says: {said}", MsslibWarning, stacklevel=2)
+    if notes:
+        from msslib.errors import MsslibWarning
+
+        for note in notes:
+            warnings.warn(f"{path}: {note}", MsslibWarning, stacklevel=2)
     hint = " (coincident_nodes: merge merges them)" if coincident_nodes == "error" else ""
     return resolve_coincident_nodes(mesh, coincident_nodes, coincident_rtol, source=str(path), node_ids=used,
                                     hint=hint)
 
 
 def _mesh_from_meshio(path: Path, m, material_key: str):
-    """The :class:`Mesh` of :func:`read` from a meshio mesh, and the file numbers of its nodes."""
+    """The :class:`Mesh` of :func:`read` from a meshio mesh, the file numbers of its nodes, and the
+    notes on dropped groups to warn about."""
     allowed = f"allowed: {', '.join(CELL_TYPES)} cells"
     blocks_all = [b for b in m.cells if len(b.data)]
     if not blocks_all:
@@ -754,7 +875,9 @@ def _mesh_from_meshio(path: Path, m, material_key: str):
             raise ValueError(f"{path}: cell data {material_key!r} of cell {int(bad[0])} is {values[bad[0]].item()!r}; "
                              f"allowed: integer material indices")
         material = np.rint(values).astype(np.int64)
+    _check_duplicate_cells(path, cells, cell_type)
     used = np.unique(cells)  # file numbers of the nodes the cells use, ascending
+    groups, notes = _file_groups(m, cell_type, blocks, used)
     points = points[used]
     cells = np.searchsorted(used, cells)
     bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
@@ -769,7 +892,124 @@ def _mesh_from_meshio(path: Path, m, material_key: str):
         if len(z) and np.ptp(z) > 1e-9 * scale:
             raise ValueError(f"{path}: {cell_type} cells are not in a plane z = const; cannot make a 2D mesh")
         points = points[:, :2]
-    return Mesh(points, cells, cell_type, material), used
+    return Mesh(points, cells, cell_type, material, **groups), used, notes
+
+
+def _check_duplicate_cells(path: Path, cells: np.ndarray, cell_type: str) -> None:
+    """Two cells on the same nodes (in any order) are a ValueError naming both."""
+    if len(cells) < 2:
+        return
+    keys = np.sort(cells, axis=1)
+    _, first, inverse, counts = np.unique(keys, axis=0, return_index=True, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    dup = np.flatnonzero(counts[inverse] > 1)
+    dup = dup[dup != first[inverse[dup]]]
+    if len(dup):
+        c = int(dup[0])
+        raise ValueError(f"{path}: {cell_type} cells {int(first[inverse[c]])} and {c} have the same nodes ({len(dup)} "
+                         f"duplicate cell(s)); allowed: each cell once (a gmsh 2 file repeats an element for every "
+                         f"physical group it belongs to: save it in gmsh format 4 or put each element in one group)")
+
+
+#: topological dimension of meshio cell types that may carry groups (others are looked up in meshio)
+_TOPOLOGICAL_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
+                    "quad9": 2, "polygon": 2, "tetra": 3, "tetra10": 3, "hexahedron": 3, "hexahedron20": 3,
+                    "hexahedron27": 3, "wedge": 3, "pyramid": 3}
+
+#: the element type of the facets of each cell type
+_FACET_TYPE = {"triangle": "line", "quad": "line", "tetra": "triangle", "hexahedron": "quad"}
+
+
+def _block_dim(cell_type: str) -> int | None:
+    if cell_type in _TOPOLOGICAL_DIM:
+        return _TOPOLOGICAL_DIM[cell_type]
+    try:
+        from meshio._mesh import topological_dimension
+    except ImportError:  # pragma: no cover - depends on meshio's internals
+        return None
+    return topological_dimension.get(cell_type)
+
+
+def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray) -> tuple[dict, list]:
+    """The groups of a meshio mesh (see :func:`read`) as keyword arguments of :class:`Mesh` (cell
+    indices into the concatenated ``blocks``, node indices into ``used``), and the notes on the
+    groups dropped because they touch nodes no chosen cell uses."""
+    dim = CELL_TYPES[cell_type][0]
+    offsets = {}
+    start = 0
+    for k in blocks:
+        offsets[k] = start
+        start += len(m.cells[k].data)
+    names = {}  # (dim, tag) -> name, from gmsh's $PhysicalNames
+    for name, value in (m.field_data or {}).items():
+        value = np.asarray(value).ravel()
+        if value.size == 2 and value.dtype.kind in "iu":
+            names[(int(value[1]), int(value[0]))] = str(name)
+    physical = (m.cell_data or {}).get("gmsh:physical")
+    cell_sets = {str(k): v for k, v in (m.cell_sets or {}).items() if not str(k).startswith("gmsh:")}
+    cells_acc, facets_acc, nodes_acc = {}, {}, {}
+    for k, block in enumerate(m.cells):
+        n = len(block.data)
+        if n == 0:
+            continue
+        bdim = _block_dim(block.type)
+        if block.type == cell_type:
+            if k not in offsets:
+                continue
+            target = cells_acc
+        elif bdim is None or bdim >= dim:
+            continue  # another cell type of the same or a higher dimension: not in the mesh
+        else:
+            target = facets_acc if (bdim == dim - 1 and block.type == _FACET_TYPE[cell_type]) else nodes_acc
+        members = []  # (group name, element indices in the block)
+        if physical is not None and k < len(physical):
+            tags = np.asarray(physical[k]).reshape(n, -1)[:, 0]
+            if tags.dtype.kind in "iuf":
+                for tag in np.unique(tags):
+                    if tag != int(tag):
+                        continue
+                    members.append((names.get((bdim, int(tag)), str(int(tag))), np.flatnonzero(tags == tag)))
+        for name, per_block in cell_sets.items():
+            if k < len(per_block) and per_block[k] is not None and len(per_block[k]):
+                members.append((name, np.asarray(per_block[k], dtype=np.int64).ravel()))
+        data = np.asarray(block.data)
+        for name, idx in members:
+            if target is cells_acc:
+                cells_acc.setdefault(name, []).append(offsets[k] + idx)
+            elif target is facets_acc:
+                facets_acc.setdefault(name, []).append(data[idx].reshape(len(idx), -1))
+            else:
+                nodes_acc.setdefault(name, []).append(data[idx].ravel())
+    for name, nodes in (m.point_sets or {}).items():
+        if not str(name).startswith("gmsh:") and len(nodes):
+            nodes_acc.setdefault(str(name), []).append(np.asarray(nodes, dtype=np.int64).ravel())
+
+    notes = []
+
+    def to_mesh_nodes(kind, name, file_nodes):
+        """File node numbers -> mesh node indices; None (and a note) if one is not a mesh node."""
+        file_nodes = np.asarray(file_nodes, dtype=np.int64)
+        pos = np.clip(np.searchsorted(used, file_nodes), 0, len(used) - 1)
+        missing = used[pos] != file_nodes
+        if missing.any():
+            notes.append(f"{kind} group {name!r} dropped: {int(missing.sum())} of its node entries (e.g. node "
+                         f"{int(file_nodes[missing].ravel()[0])}) belong to no {cell_type} cell, so it could not "
+                         f"carry its loads or supports")
+            return None
+        return pos
+
+    facet_groups, node_groups = {}, {}
+    for name, parts in facets_acc.items():
+        facets = to_mesh_nodes("facet", name, np.concatenate(parts))
+        if facets is not None:
+            _, first = np.unique(np.sort(facets, axis=1), axis=0, return_index=True)
+            facet_groups[name] = facets[np.sort(first)]  # a facet in the group twice (two sources) once
+    for name, parts in nodes_acc.items():
+        nodes = to_mesh_nodes("node", name, np.unique(np.concatenate(parts)))
+        if nodes is not None:
+            node_groups[name] = nodes
+    cell_groups = {name: np.unique(np.concatenate(parts)) for name, parts in cells_acc.items()}
+    return {"cell_groups": cell_groups, "facet_groups": facet_groups, "node_groups": node_groups}, notes
 
 
 def _pad_columns(a: np.ndarray, dim: int) -> np.ndarray:
@@ -862,16 +1102,89 @@ def _facet_table(mesh: Mesh):
     return facets, counts[inverse.ravel()]
 
 
-def boundary_facets(mesh: Mesh) -> np.ndarray:
+def boundary_facets(mesh: Mesh, return_cells: bool = False):
     """Facets belonging to exactly one cell, outward oriented.
 
     2D: ``(n, 2)`` edges with the mesh on their left (counter-clockwise around the outer boundary;
     outward normal ``(dy, -dx)``).  3D: ``(n, 3)`` triangles (tetra) or ``(n, 4)`` quads
     (hexahedron) whose right-hand-rule normal points out of the mesh.  Assumes positively oriented
-    cells (see :func:`orient`).  Facets are listed cell by cell in local facet order.
+    cells (see :func:`orient`).  Facets are listed cell by cell in local facet order.  With
+    ``return_cells``, also the cell of each facet: ``(facets, cells)``.
     """
     facets, counts = _facet_table(mesh)
-    return facets[counts == 1]
+    on = counts == 1
+    if return_cells:
+        n_local = len(_LOCAL_FACETS[mesh.cell_type])
+        return facets[on], np.flatnonzero(on) // n_local
+    return facets[on]
+
+
+def facet_cell_counts(mesh: Mesh, facets) -> np.ndarray:
+    """For each facet of ``facets`` (``(k, nodes_per_facet)`` node indices, any order and
+    orientation), the number of cells of ``mesh`` it is a face of: 0 (not a face: on no cell, or
+    across one), 1 (a boundary facet) or 2 (an interior facet)."""
+    facets = np.asarray(facets, dtype=np.int64)
+    local = _LOCAL_FACETS[mesh.cell_type]
+    if facets.ndim != 2 or facets.shape[1] != local.shape[1]:
+        raise ValueError(f"facets of {mesh.cell_type} cells must have shape (k, {local.shape[1]}), got {facets.shape}")
+    own = np.sort(mesh.cells[:, local].reshape(-1, local.shape[1]), axis=1)
+    keys = np.concatenate([own, np.sort(facets, axis=1)])
+    _, inverse = np.unique(keys, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    counts = np.bincount(inverse[:len(own)], minlength=int(inverse.max(initial=-1)) + 1)
+    return counts[inverse[len(own):]]
+
+
+def _fmt_names(names) -> str:
+    return ", ".join(sorted(names)) if names else "none"
+
+
+def materials_from_groups(mesh: Mesh, keys, source: str = "materials") -> np.ndarray:
+    """Material index of every cell from cell groups: ``material[c] = i`` for the cells of
+    ``mesh.cell_groups[keys[i]]``.
+
+    Every cell must be in exactly one of the groups: a group the mesh lacks (naming the cell
+    groups it has), cells in none of them or in two of them (counted, with an example cell and
+    its centroid) are a ValueError starting with ``source``.
+    """
+    keys = [str(k) for k in keys]
+    groups = mesh.cell_groups
+    for key in keys:
+        if key not in groups:
+            import difflib
+
+            hint = difflib.get_close_matches(key, list(groups), n=1)
+            did = f" (did you mean {hint[0]!r}?)" if hint else ""
+            raise ValueError(f"{source}: the mesh has no cell group {key!r}{did}; its cell groups: "
+                             f"{_fmt_names(groups)}")
+    count = np.zeros(mesh.n_cells, dtype=np.int64)
+    material = np.zeros(mesh.n_cells, dtype=np.int64)
+    for i, key in enumerate(keys):
+        count[groups[key]] += 1
+        material[groups[key]] = i
+
+    def contains(cells, c):  # cells sorted
+        return bool(len(cells)) and cells[min(np.searchsorted(cells, c), len(cells) - 1)] == c
+
+    def example(c):
+        others = [name for name, cells in groups.items() if name not in keys and contains(cells, c)]
+        where = f" (in the group(s) {_fmt_names(others)})" if others else ""
+        centroid = mesh.points[mesh.cells[c]].mean(axis=0)
+        return f"cell {c} at {_fmt_point(centroid)}{where}"
+
+    many = np.flatnonzero(count > 1)
+    if len(many):
+        c = int(many[0])
+        which = [key for key in keys if contains(groups[key], c)]
+        raise ValueError(f"{source}: {len(many)} of {mesh.n_cells} cell(s) are in two or more of the groups "
+                         f"{', '.join(keys)}, e.g. {example(c)} in {', '.join(which)}; allowed: every cell in "
+                         f"exactly one of them")
+    none = np.flatnonzero(count == 0)
+    if len(none):
+        raise ValueError(f"{source}: {len(none)} of {mesh.n_cells} cell(s) are in none of the groups "
+                         f"{', '.join(keys)}, e.g. {example(int(none[0]))}; allowed: every cell in exactly one of "
+                         f"them (the mesh's cell groups: {_fmt_names(groups)})")
+    return material
 
 
 def facet_areas(mesh: Mesh, facets: np.ndarray) -> np.ndarray:
@@ -980,7 +1293,7 @@ def orient(mesh: Mesh) -> Mesh:
         return mesh
     cells = mesh.cells.copy()
     cells[flip] = cells[flip][:, _FLIP[mesh.cell_type]]
-    return Mesh(mesh.points, cells, mesh.cell_type, mesh.material)
+    return replace(mesh, cells=cells)  # material and groups unchanged (cell and node numbers are kept)
 
 
 def select_nodes(mesh: Mesh, box=None, plane=None, tol: float = 1e-9) -> np.ndarray:
@@ -1091,7 +1404,8 @@ def resolve_coincident_nodes(mesh: Mesh, policy: str = "merge", rtol: float = CO
 
     ``"merge"``: every node is replaced by its lowest-numbered twin in the cells, the nodes no cell
     uses any more are dropped (the others keep their order, so indices above a dropped node shift
-    down), the material of each cell is kept, and one :class:`msslib.errors.MsslibWarning` names
+    down), the material and cell groups of each cell are kept, the facet and node groups follow
+    their nodes (:class:`Mesh`), and one :class:`msslib.errors.MsslibWarning` names
     how many nodes were merged and the first ``max_report`` of them with their coordinates.
     ``"error"``: a ValueError naming them.  ``"keep"``: nothing is checked.  The mesh is returned
     unchanged when no node has a twin.
@@ -1131,10 +1445,11 @@ def resolve_coincident_nodes(mesh: Mesh, policy: str = "merge", rtol: float = CO
 
     from msslib.errors import MsslibWarning
 
-    points, cells = _compact(mesh.points, merged)
+    points, cells, new_id = _compact(mesh.points, merged, return_map=True)
+    groups = _renumbered_groups(mesh, new_id[rep], source)
     warnings.warn(f"{source}: merged {what}; cells renumbered to the lower-numbered node, {len(points)} nodes left",
                   MsslibWarning, stacklevel=2)
-    return Mesh(points, cells, mesh.cell_type, mesh.material)
+    return Mesh(points, cells, mesh.cell_type, mesh.material, cell_groups=mesh.cell_groups, **groups)
 
 
 def connected_parts(mesh: Mesh) -> tuple[int, np.ndarray]:

@@ -391,7 +391,7 @@ def guard(mesh: Mesh, displacement, *, history_displacement=None, history_time=N
         "relative_jacobian": (("cell",), final.ratio, {
             "units": "1", "long_name": "smallest det J / det J_rest over the cell's sample points, final state"}),
         "cell_state": (("cell",), final.state, {
-            "units": "1", "long_name": "cell state in the final state", "flag_values": FLAG_VALUES,
+            "long_name": "cell state in the final state", "flag_values": FLAG_VALUES,  # flags: no units
             "flag_meanings": FLAG_MEANINGS, "collapse_threshold": float(threshold)}),
     }
     hist = None

@@ -23,6 +23,7 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
       # file: meshes/part.vtu          # or any file meshio reads, relative to the scene file
     materials:                         # material i applies to the cells with material index i
       - {E: 1.0e6, nu: 0.3, density: 1000.0}
+      # or keyed by the cell groups of a mesh file: {soft: {E: ..., nu: ...}, stiff: {...}}
     regions:                           # optional; later entries win
       - {box: [[0.05, null, null], [null, null, null]], material: 1}
     thickness: 0.01                    # 2D meshes only (default 1.0)
@@ -43,14 +44,39 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     unknown or missing arguments are errors).  ``file`` is a mesh file read by
     :func:`msslib.mesh.read`, relative to the directory of the scene file (or of ``base_dir`` for a
     scene given as a dict); an integer cell data array ``material`` becomes the material index.
+    The file's groups are kept (gmsh physical groups, cell sets, node sets; see
+    :func:`msslib.mesh.read`): groups of its cells for ``materials``, groups of boundary facets
+    (gmsh physical surfaces of a 3D mesh, curves of a 2D mesh) and nodes for ``select``.  A group
+    is known by its name, a gmsh physical group without a name by its number (``3`` or ``"3"``).
 ``materials``
     A non-empty list (every material used by some cell) of ``{E, nu, density}``: Young's modulus ``E > 0`` (Pa), Poisson's ratio
     ``-1 < nu < 0.5`` and the density (kg/m^3, > 0).  ``density`` may be omitted unless the scene
     has gravity or is dynamic.  Note that the triangle and square MSS models are exact only for
     ``nu = 1/3``, Lloyd's tetrahedron without volume term for ``nu = 1/4``.
+
+    Or a mapping from the cell groups of a mesh file to their materials, which assigns each
+    group's cells its material (the file's ``material`` cell data is then not used); every cell
+    must be in exactly one of the groups named (cells in none or in two are an error counting
+    them, with an example cell), and a group the mesh lacks is an error naming the groups it has.
+    Material ``i`` is the ``i``-th entry as written; the result names them (``material_name``)::
+
+        geometry: {file: meshes/two_materials.msh}   # physical volumes soft, stiff; surfaces base, top
+        materials:
+          soft: {E: 1.0e6, nu: 0.45, density: 1100.0}
+          stiff: {E: 2.0e8, nu: 0.3, density: 7800.0}
+        boundary:
+          - {select: {group: base}}
+        loads:
+          - {type: traction, select: {group: top}, traction: [0.0, 0.0, -1.0e4]}
+
+    With the list form, material ``i`` applies to the cells of material index ``i`` (cell data
+    ``material``, ``regions``); a mesh file with cell groups but no material index (every cell 0)
+    and a list of several materials is an error asking for the mapping form (or ``regions``), and
+    one material for the whole mesh is fine.
 ``regions``
     Optional list of ``{box: [[xmin, ymin(, zmin)], [xmax, ymax(, zmax)]], material: i}``: cells
-    whose centroid lies in the box (``null`` bounds are unbounded) get material ``i``.
+    whose centroid lies in the box (``null`` bounds are unbounded) get material ``i`` (with
+    materials keyed by group, ``material`` names one of the keys), after the groups.
 ``thickness``
     Membrane thickness (m) of a 2D mesh (plane stress); an error for 3D meshes.
 ``model``
@@ -78,7 +104,8 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     Baudet's ``correction`` is computed from the traction and nodal-force loads (not gravity); it
     is non-conservative, so the static solver's line search works on the residual norm.
 ``boundary``
-    List of ``{select: SELECTION, fix: [x, y(, z)] | all, displacement: [...]}``.  ``fix``
+    List of ``{select: SELECTION, fix: [x, y(, z)] | all, displacement: [...]}``, e.g.
+    ``{select: {group: base}, fix: all}`` for a gmsh physical surface ``base``.  ``fix``
     (default ``all``) lists the constrained axes of the selected nodes; ``displacement`` (optional)
     gives one value per axis (m), ``null`` or 0 for the axes not fixed.  A dof fixed twice with two
     different displacements is an error.  Static solves ramp prescribed displacements with the
@@ -86,17 +113,23 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     every part of its mesh: a floating part or a free rigid-body mode (a translation or rotation
     the fixed dofs do not stop) is an error naming the part and the mode.
 ``SELECTION``
-    ``all``, or a mapping with ``plane: [axis, value]`` (axis ``x``, ``y`` or ``z``) and/or
-    ``box: [[xmin, ...], [xmax, ...]]`` (``null`` = unbounded, either corner may be ``null``);
-    with both, the intersection.  ``tol`` (m) widens the bounds; default ``1e-8`` times the
-    diagonal of the mesh's bounding box.  Selecting no node is an error.
+    ``all``, or a mapping with ``plane: [axis, value]`` (axis ``x``, ``y`` or ``z``),
+    ``box: [[xmin, ...], [xmax, ...]]`` (``null`` = unbounded, either corner may be ``null``)
+    and/or ``group: NAME`` (a group of the mesh file: the nodes of its facets, or its nodes, or
+    for a group of cells the nodes of those cells; a name that is a group of cells and also of
+    facets or nodes selects the latter, with a warning); with several, the intersection, e.g.
+    ``{group: top, box: [[0.0, null, null], [0.05, null, null]]}``.  ``tol`` (m) widens the
+    bounds; default ``1e-8`` times the diagonal of the mesh's bounding box.  Selecting no node is
+    an error, and so is a group the mesh lacks (naming the groups it has).
 ``loads``
     List of load entries, all proportional to the load factor of the static solver:
 
     * ``{type: gravity, g: [0, 0, -9.81]}`` — weight of the lumped node masses (m/s^2);
     * ``{type: traction, select: SELECTION, traction: [tx, ty(, tz)]}`` — a dead traction (Pa) on
       the boundary facets whose nodes are all selected (consistent nodal forces; in 2D per unit
-      area of the edge times ``thickness``);
+      area of the edge times ``thickness``); with ``group``, on the facets of that facet group
+      (each must be a boundary facet) or the boundary facets of the cells of that cell group,
+      those all of whose nodes lie in ``plane``/``box`` when given;
     * ``{type: nodal_force, select: SELECTION, total: [Fx, Fy(, Fz)]}`` — a total force (N) split
       equally over the selected nodes.
 ``solver``
@@ -121,11 +154,13 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
 
 Result
 ------
-:func:`run_scene` returns :func:`msslib.io.make_dataset`'s dataset: rest positions, final
-displacement, reactions, fixed mask, springs with constants and rest lengths (MSS), the history
-(time, displacement, velocity, kinetic energy) of dynamic runs, solver statistics (``solver_*``),
-wall time, the scene text, the model name, ``E`` and ``nu`` (one value per material), plus the
-attributes ``scene_name``, ``scene_description``, ``density`` and ``thickness``.
+:func:`run_scene` returns :func:`msslib.io.make_dataset`'s dataset (CF-1.11 and UGRID-1.0, see
+:mod:`msslib.io`): rest positions, final displacement, reactions, fixed mask, the materials as
+variables (``material_E``, ``material_nu``, ``material_density``, ``material_name`` when they are
+keyed by group), ``thickness`` (2D), springs with constants and rest lengths (MSS), the history
+(time, displacement, velocity, kinetic energy) of dynamic runs, the cell check of
+:mod:`msslib.quality`, solver statistics (``solver_*``), wall time, the scene text, the model name,
+plus the attributes ``scene_name`` and ``scene_description``.
 """
 
 from __future__ import annotations
@@ -137,7 +172,7 @@ import sys
 import time
 import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable
 
@@ -215,6 +250,8 @@ class Scene:
     ``model_options`` holds ``published`` (bool), ``A`` (float), ``terms`` (tuple of names) and
     ``plane``; ``boundary``, ``loads``, ``solver`` and ``output`` are normalised mappings.
     ``text`` is the scene source (YAML), ``path`` its file (None for a dict).
+    ``material_groups``: the mesh groups of the materials (mapping form of ``materials``), one per
+    material in index order; None for the list form.
     """
 
     name: str
@@ -232,6 +269,7 @@ class Scene:
     checks: dict = field(default_factory=lambda: dict(_DEFAULT_CHECKS))  # see "checks" above
     text: str = ""
     path: Path | None = None
+    material_groups: tuple[str, ...] | None = None
 
     @property
     def is_fem(self) -> bool:
@@ -432,15 +470,24 @@ def _box(path, value):
     return corners
 
 
+def _group_key(path, value):
+    """A mesh group named in a scene: a name, or the number of a group without name."""
+    if isinstance(value, bool) or not isinstance(value, (str, int)) or value == "":
+        _fail(path, f"expected the name of a mesh group (or the number of an unnamed one), got {value!r}")
+    return str(value)
+
+
 def _selection(path, value):
     if value == "all":
         return {"all": True}
     if not isinstance(value, Mapping):
-        _fail(path, f"expected 'all' or a mapping with plane and/or box, got {value!r}")
-    _mapping(path, value, ("plane", "box", "tol"))
-    if "plane" not in value and "box" not in value:
-        _fail(path, "give plane and/or box (or write select: all)")
+        _fail(path, f"expected 'all' or a mapping with plane, box and/or group, got {value!r}")
+    _mapping(path, value, ("plane", "box", "group", "tol"))
+    if "plane" not in value and "box" not in value and "group" not in value:
+        _fail(path, "give plane, box and/or group (or write select: all)")
     out = {}
+    if "group" in value:
+        out["group"] = _group_key(f"{path}.group", value["group"])
     if "plane" in value:
         plane = value["plane"]
         if not isinstance(plane, (list, tuple)) or len(plane) != 2:
@@ -518,27 +565,49 @@ def _generator_arg(path, value):
 
 
 def _materials(path, value):
-    if not isinstance(value, list) or not value:
-        _fail(path, f"expected a non-empty list of {{E, nu, density}}, got {value!r}")
+    """``(materials, groups)``: the list form gives ``groups = None``, the mapping form (mesh group
+    -> material) the group keys in the order written, one per material."""
+    if isinstance(value, Mapping) and value:
+        entries, groups = [], []
+        for key, m in value.items():
+            name = _group_key(f"{path}.{key}", key)
+            if name in groups:
+                _fail(f"{path}.{key}", f"group {name!r} is given twice")
+            groups.append(name)
+            entries.append((f"{path}.{name}", m))
+    elif isinstance(value, list) and value:
+        entries, groups = [(f"{path}[{i}]", m) for i, m in enumerate(value)], None
+    else:
+        _fail(path, f"expected a non-empty list of {{E, nu, density}}, or a mapping of mesh group names to them, "
+              f"got {value!r}")
     out = []
-    for i, m in enumerate(value):
-        p = f"{path}[{i}]"
+    for p, m in entries:
         _mapping(p, m, ("E", "nu", "density"), required=("E", "nu"))
         E = _number(f"{p}.E", m["E"], low=0.0)
         nu = _number(f"{p}.nu", m["nu"], low=-1.0, high=0.5)
         density = None if m.get("density") is None else _number(f"{p}.density", m["density"], low=0.0)
         out.append(Material(E, nu, density))
-    return out
+    return out, None if groups is None else tuple(groups)
 
 
-def _regions(path, value, n_materials):
+def _regions(path, value, n_materials, groups=None):
+    """Regions; with materials keyed by group (``groups``), ``material`` names one of the keys."""
     out = []
     for i, r in enumerate(_list(path, value)):
         p = f"{path}[{i}]"
         _mapping(p, r, ("box", "material"), required=("box", "material"))
-        material = _integer(f"{p}.material", r["material"], minimum=0)
-        if material >= n_materials:
-            _fail(f"{p}.material", f"material index {material} does not exist ({n_materials} material(s) given)")
+        if groups is not None:
+            key = _group_key(f"{p}.material", r["material"])
+            if key not in groups:
+                hint = difflib.get_close_matches(key, list(groups), n=1)
+                did = f" (did you mean {hint[0]!r}?)" if hint else ""
+                _fail(f"{p}.material", f"unknown material {key!r}{did}; expected one of the keys of scene.materials, "
+                      f"{', '.join(groups)}")
+            material = groups.index(key)
+        else:
+            material = _integer(f"{p}.material", r["material"], minimum=0)
+            if material >= n_materials:
+                _fail(f"{p}.material", f"material index {material} does not exist ({n_materials} material(s) given)")
         out.append({"box": _box(f"{p}.box", r["box"]), "material": material})
     return out
 
@@ -770,8 +839,12 @@ def load_scene(source, *, base_dir=None) -> Scene:
     description = raw.get("description")
     description = "" if description is None else _string(f"{root}.description", description)
     geometry = _geometry(f"{root}.geometry", raw["geometry"], base)
-    materials = _materials(f"{root}.materials", raw["materials"])
-    regions = _regions(f"{root}.regions", raw.get("regions"), len(materials))
+    materials, material_groups = _materials(f"{root}.materials", raw["materials"])
+    if material_groups is not None and "generator" in geometry:
+        _fail(f"{root}.materials", f"keyed by mesh group ({', '.join(material_groups)}), but the generated mesh "
+              f"({geometry['generator']}) has no groups; allowed: a list of materials (with scene.regions), or "
+              f"groups of a mesh file")
+    regions = _regions(f"{root}.regions", raw.get("regions"), len(materials), material_groups)
     thickness = None
     if raw.get("thickness") is not None:
         thickness = _number(f"{root}.thickness", raw["thickness"], low=0.0)
@@ -795,10 +868,11 @@ def load_scene(source, *, base_dir=None) -> Scene:
         for i, m in enumerate(materials):
             if m.density is None:
                 why = "dynamic runs" if solver["type"] == "dynamic" else "gravity loads"
-                _fail(f"{root}.materials[{i}].density", f"required for {why}")
+                where = f"[{i}]" if material_groups is None else f".{material_groups[i]}"
+                _fail(f"{root}.materials{where}.density", f"required for {why}")
     return Scene(name=name, description=description, geometry=geometry, materials=materials, model=model,
                  model_options=options, regions=regions, thickness=thickness, boundary=boundary, loads=loads,
-                 solver=solver, output=output, checks=checks, text=text, path=path)
+                 solver=solver, output=output, checks=checks, text=text, path=path, material_groups=material_groups)
 
 
 def _plain(value, path="scene"):
@@ -842,7 +916,29 @@ def _build_mesh(scene: Scene) -> _mesh.Mesh:
             _fail("scene.geometry", f"{geo['generator']}: {exc}")
     if scene.thickness is not None and mesh.dim == 3:
         _fail("scene.thickness", "applies to 2D meshes only; the mesh is 3D")
-    material = mesh.material.copy()
+    groups = scene.material_groups
+    if groups is not None:
+        if not mesh.cell_groups:
+            what = f"the mesh file {geo['file'].name}" if "file" in geo else f"the generated mesh ({geo['generator']})"
+            _fail("scene.materials", f"keyed by mesh group ({', '.join(groups)}), but {what} has no groups of its "
+                  f"{mesh.cell_type} cells (its groups: {_group_names(mesh)}); allowed: a list of materials, or a "
+                  f"mesh file with physical groups or cell sets of its cells")
+        for key in groups:
+            if key not in mesh.cell_groups:
+                _fail(f"scene.materials.{key}", _no_group(mesh, key, "cell"))
+        try:
+            material = _mesh.materials_from_groups(mesh, groups, source="scene.materials")
+        except ValueError as exc:
+            raise ValueError(str(exc)) from None
+    else:
+        material = mesh.material.copy()
+        if len(scene.materials) > 1 and mesh.cell_groups and not scene.regions and not material.any():
+            shown = ", ".join(f"{k} ({len(v)} cells)" for k, v in sorted(mesh.cell_groups.items()))
+            names = sorted(mesh.cell_groups)
+            example = ", ".join([f"{names[0]}: {{E: ..., nu: ...}}"] + [f"{k}: {{...}}" for k in names[1:3]])
+            _fail("scene.materials", f"{len(scene.materials)} materials listed, but the mesh gives every cell "
+                  f"material 0 (the file has no 'material' cell data, or only zeros) and has the cell groups "
+                  f"{shown}; key the materials by group, e.g. materials: {{{example}}}, or assign them with scene.regions")
     if scene.regions:
         centroids = mesh.points[mesh.cells].mean(axis=1)
         for i, region in enumerate(scene.regions):
@@ -853,7 +949,47 @@ def _build_mesh(scene: Scene) -> _mesh.Mesh:
               f"only {len(scene.materials)} material(s) given")
     if mesh.n_cells and material.min() < 0:
         _fail("scene.geometry", f"the mesh has a negative material index {int(material.min())}")
-    return _mesh.Mesh(mesh.points, mesh.cells, mesh.cell_type, material)
+    return replace(mesh, material=material)  # the groups stay
+
+
+def _group_names(mesh) -> str:
+    """The groups of a mesh, by kind, for messages."""
+    parts = [f"{', '.join(sorted(groups))} ({kind})" for kind, groups in
+             (("cells", mesh.cell_groups), ("boundary facets", mesh.facet_groups), ("nodes", mesh.node_groups))
+             if groups]
+    return "; ".join(parts) if parts else "none"
+
+
+def _no_group(mesh, key, kind=None) -> str:
+    """The message for a group ``key`` the mesh lacks (``kind`` "cell": among its cell groups)."""
+    pool = list(mesh.cell_groups) if kind == "cell" else [*mesh.facet_groups, *mesh.node_groups, *mesh.cell_groups]
+    hint = difflib.get_close_matches(key, pool, n=1)
+    did = f" (did you mean {hint[0]!r}?)" if hint else ""
+    if not (mesh.cell_groups or mesh.facet_groups or mesh.node_groups):
+        return (f"the mesh has no group {key!r}: it has no groups at all (generated meshes have none; a mesh file "
+                f"gives its gmsh physical groups, cell sets and node sets)")
+    return f"the mesh has no {'cell ' if kind == 'cell' else ''}group {key!r}{did}; its groups: {_group_names(mesh)}"
+
+
+def _group_members(path, mesh, key):
+    """``(kind, members, nodes)`` of the group ``key`` for a selection: its boundary facets
+    (``kind`` "facets", ``members`` the facets) or nodes ("nodes", None) when it is a group of
+    facets or nodes, else its cells ("cells", the cell indices); ``nodes`` the sorted nodes."""
+    in_facets, in_nodes, in_cells = (key in g for g in (mesh.facet_groups, mesh.node_groups, mesh.cell_groups))
+    if not (in_facets or in_nodes or in_cells):
+        _fail(path, _no_group(mesh, key))
+    if in_facets or in_nodes:
+        if in_cells:
+            from msslib.errors import MsslibWarning
+
+            used = "boundary facets" if in_facets else "nodes"
+            warnings.warn(f"{path}: {key!r} names a group of cells and a group of {used} of the mesh; the group of "
+                          f"{used} is selected", MsslibWarning, stacklevel=3)
+        facets = mesh.facet_groups.get(key)
+        parts = ([facets.ravel()] if in_facets else []) + ([mesh.node_groups[key]] if in_nodes else [])
+        return ("facets" if in_facets else "nodes"), facets, np.unique(np.concatenate(parts))
+    cells = mesh.cell_groups[key]
+    return "cells", cells, np.unique(mesh.cells[cells])
 
 
 def _in_box(path, x, box, dim, tol):
@@ -869,9 +1005,22 @@ def _in_box(path, x, box, dim, tol):
     return keep
 
 
-def _select(path, mesh, sel, default_tol):
+def _select(path, mesh, sel, default_tol, group=None):
+    """Sorted ids of the selected nodes (``group``: the :func:`_group_members` of ``sel["group"]``
+    if already looked up)."""
     if sel.get("all"):
         return np.arange(mesh.n_nodes)
+    if "group" in sel:
+        group = _group_members(f"{path}.group", mesh, sel["group"]) if group is None else group
+        if "plane" not in sel and "box" not in sel:
+            return group[2]
+        nodes = np.intersect1d(_select(path, mesh, {k: v for k, v in sel.items() if k != "group"}, default_tol),
+                               group[2])
+        if len(nodes) == 0:
+            where = " and ".join(f"plane [{sel['plane'][0]}, {sel['plane'][1]:g}]" if k == "plane" else f"box {sel[k]}"
+                                 for k in ("plane", "box") if k in sel)
+            _fail(path, f"group {sel['group']!r} ({len(group[2])} nodes) has no node in {where}")
+        return nodes
     tol = sel.get("tol", default_tol)
     if "plane" in sel and AXES.index(sel["plane"][0]) >= mesh.dim:
         _fail(f"{path}.plane", f"axis {sel['plane'][0]!r} does not exist on a {mesh.dim}D mesh")
@@ -886,6 +1035,40 @@ def _select(path, mesh, sel, default_tol):
         lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
         _fail(path, f"selects no node: {shown} (tol {tol:.3g} m; the mesh spans {np.round(lo, 6).tolist()} to "
               f"{np.round(hi, 6).tolist()})")
+
+
+def _loaded_facets(path, mesh, sel, default_tol, cache):
+    """The facets a traction acts on: the facets of a facet group (each must be a boundary facet),
+    the boundary facets of the cells of a cell group, else the boundary facets whose nodes are all
+    selected; with plane and/or box, only those whose nodes are all in them too."""
+    if "boundary" not in cache:
+        cache["boundary"] = _mesh.boundary_facets(mesh, return_cells=True)
+    candidates, facet_cell = cache["boundary"]
+    group = None
+    if "group" in sel:
+        group = _group_members(f"{path}.group", mesh, sel["group"])
+        kind, members, _ = group
+        if kind == "facets":
+            counts = _mesh.facet_cell_counts(mesh, members)
+            bad = np.flatnonzero(counts != 1)
+            if len(bad):
+                f = members[bad[0]]
+                where = "is a face of no cell" if counts[bad[0]] == 0 else "lies between two cells"
+                centroid = np.round(mesh.points[f].mean(axis=0), 6).tolist()
+                _fail(f"{path}.group", f"{len(bad)} of the {len(members)} facets of group {sel['group']!r} are not on "
+                      f"the boundary of the mesh: the facet of nodes {f.tolist()} at {centroid} {where}; allowed: a "
+                      f"traction on boundary facets")
+            candidates = members
+        elif kind == "cells":
+            candidates = candidates[np.isin(facet_cell, members)]
+    nodes = _select(path, mesh, sel, default_tol, group)
+    selected = np.zeros(mesh.n_nodes, dtype=bool)
+    selected[nodes] = True
+    on = selected[candidates].all(axis=1) if len(candidates) else np.zeros(0, dtype=bool)
+    if not on.any():
+        of = f" of group {sel['group']!r}" if "group" in sel else ""
+        _fail(path, f"no boundary facet{of} has all its nodes selected ({len(nodes)} node(s) selected)")
+    return candidates[on]
 
 
 def _check_dim(path, vec, dim):
@@ -964,7 +1147,7 @@ def prepare(scene: Scene) -> Setup:
 
     surface = np.zeros((n, dim))
     gravity = None
-    facets = None
+    facet_cache = {}
     for i, load in enumerate(scene.loads):
         p = f"scene.loads[{i}]"
         if load["type"] == "gravity":
@@ -978,15 +1161,8 @@ def prepare(scene: Scene) -> Setup:
             from msslib.terms import Traction
 
             traction = _check_dim(f"{p}.traction", load["traction"], dim)
-            nodes = _select(f"{p}.select", mesh, load["select"], default_tol)
-            if facets is None:
-                facets = _mesh.boundary_facets(mesh)
-            selected = np.zeros(n, dtype=bool)
-            selected[nodes] = True
-            on = selected[facets].all(axis=1)
-            if not on.any():
-                _fail(f"{p}.select", f"no boundary facet has all its nodes selected ({len(nodes)} node(s) selected)")
-            surface += Traction(mesh, facets[on], traction, thickness if dim == 2 else 1.0).nodal
+            loaded = _loaded_facets(f"{p}.select", mesh, load["select"], default_tol, facet_cache)
+            surface += Traction(mesh, loaded, traction, thickness if dim == 2 else 1.0).nodal
 
     setup = Setup(scene=scene, mesh=mesh, fixed=fixed, prescribed=prescribed, surface_forces=surface,
                   gravity=gravity, cell_density=cell_density, masses=masses)
@@ -1063,11 +1239,21 @@ class TextProgress:
     """A one-line text progress bar on ``stream`` (default stderr), ``callable(fraction, text)``.
 
     Nothing is shown during the first ``delay`` seconds (short runs stay quiet); then the line is
-    redrawn at most every ``interval`` seconds.  :meth:`close` ends the line.
+    redrawn at most every ``interval`` seconds on a terminal, and written as a whole line at most
+    every 5 s elsewhere (a log file gets no carriage returns).  :meth:`close` ends the line.
+
+    The line shows the elapsed time, the rate since the first report and the time left at that
+    rate: ``(3.1 s, 12.3 steps/s, 0:42 left)`` when ``total`` (the number of ``unit`` in the whole
+    run) is given, ``(3.1 s, 2.5 %/s, 0:42 left)`` otherwise.
     """
 
-    def __init__(self, label: str = "", stream=None, width: int = 30, delay: float = 0.5, interval: float = 0.1):
+    def __init__(self, label: str = "", stream=None, width: int = 30, delay: float = 0.5, interval: float = 0.1,
+                 total: float | None = None, unit: str = "steps"):
         self.label = label
+        self.total = total
+        self.unit = unit
+        self.first = None  # (time, fraction) of the first report: the rate is measured from there
+        self.drawn = 0  # length of the line on a terminal
         self.stream = stream
         self.width = width
         self.delay = delay
@@ -1082,6 +1268,8 @@ class TextProgress:
         self.fraction = min(max(float(fraction), 0.0), 1.0)
         self.text = text
         now = time.perf_counter()
+        if self.first is None:
+            self.first = (now, self.fraction)
         interval = self.interval if self._tty() else max(self.interval, 5.0)
         if now - self.start < self.delay or now - self.last < interval:
             return
@@ -1101,13 +1289,30 @@ class TextProgress:
         stream = self._stream()
         filled = int(round(self.fraction * self.width))
         bar = "#" * filled + "." * (self.width - filled)
-        line = f"{self.label} [{bar}] {100 * self.fraction:5.1f}% {self.text} ({now - self.start:.1f} s)"
+        line = f"{self.label} [{bar}] {100 * self.fraction:5.1f}% {self.text} ({now - self.start:.1f} s{self._pace(now)})"
         if self._tty():
-            stream.write("\r" + line.ljust(99))
+            stream.write("\r" + line.ljust(max(99, self.drawn)))
+            self.drawn = len(line)
         else:  # a log file: whole lines, no carriage returns
             stream.write(line + "\n")
         stream.flush()
         self.shown = True
+
+    def _pace(self, now) -> str:
+        """``", 12.3 steps/s, 0:42 left"``, or "" before any progress."""
+        if self.first is None:
+            return ""
+        t0, f0 = self.first
+        if self.fraction <= f0 or now <= t0:
+            return ""
+        rate = (self.fraction - f0) / (now - t0)  # fraction per second
+        pace = f"{rate * self.total:.3g} {self.unit}/s" if self.total else f"{100 * rate:.3g} %/s"
+        if self.fraction >= 1.0:
+            return f", {pace}"
+        minutes, seconds = divmod(math.ceil((1.0 - self.fraction) / rate), 60)
+        hours, minutes = divmod(minutes, 60)
+        left = f"{hours}:{minutes:02d}:{seconds:02d}" if hours else f"{minutes}:{seconds:02d}"
+        return f", {pace}, {left} left"
 
     def close(self, fraction: float | None = None) -> None:
         if self.shown:
@@ -1269,18 +1474,24 @@ def run_scene(scene, progress=True):
             k = np.concatenate([t.k for t in sp])
             rest = np.concatenate([t.rest_length for t in sp])
     E, nu = _moduli(scene)
-    dens = [np.nan if m.density is None else m.density for m in scene.materials]
+    extra_attrs = dict(out.get("extra_attrs", {}))
+    energy = extra_attrs.pop("potential_energy", None)  # static MSS: a number, or "None" without one
     attrs = {"scene_name": scene.name, "scene_description": scene.description,
-             "density": dens[0] if len(dens) == 1 else np.array(dens),
-             "thickness": setup.thickness if setup.mesh.dim == 2 else "None",
              "model_published": scene.model_options.get("published", False),
-             "model_terms": list(scene.model_options["terms"]) if scene.model_options.get("terms") else "None",
-             **out.get("extra_attrs", {}), **guard_attrs}
+             "model_terms": list(scene.model_options["terms"]) if scene.model_options.get("terms") else None,
+             **extra_attrs, **guard_attrs}
     if scene.model_options.get("A") is not None:
         attrs["model_A"] = scene.model_options["A"]
+    extra_vars = {**(out.get("extra_vars") or {}), **guard_vars}
+    if energy is not None and not isinstance(energy, str):
+        extra_vars["potential_energy"] = ((), float(energy), {
+            "units": "J", "long_name": "potential energy of the final state (internal minus load work)"})
     return make_dataset(
         setup.mesh, out["displacement"], model=scene.model, E=E, nu=nu, scene=scene.text,
+        density=[m.density for m in scene.materials],
+        material_names=None if scene.material_groups is None else list(scene.material_groups),
+        thickness=setup.thickness if setup.mesh.dim == 2 else None,
         springs=springs, spring_constant=k, rest_length=rest, reaction=out["reaction"], fixed=setup.fixed,
         history=out.get("history"), solver_stats=out["stats"], wall_time=wall,
-        extra_vars={**(out.get("extra_vars") or {}), **guard_vars}, extra_attrs=attrs,
+        extra_vars=extra_vars, extra_attrs=attrs,
     )

@@ -8,6 +8,7 @@ import xarray as xr
 
 import msslib
 from msslib.io import (
+    CONVENTIONS,
     SCHEMA_VERSION,
     git_commit,
     make_dataset,
@@ -66,28 +67,43 @@ def full_dataset():
     return mesh, ds
 
 
+#: variables that are not quantities (topology, connectivity, indices, flags, labels): no units
+NOT_QUANTITIES = {"mesh", "spring_network", "cells", "springs", "cell_shape", "cell_material", "material",
+                  "fixed", "axis_name"}
+
+
 def test_make_dataset_schema():
     mesh, ds = full_dataset()
     for name, var in ds.variables.items():
-        assert "units" in var.attrs and "long_name" in var.attrs, name
+        assert var.attrs.get("long_name"), name
+        assert ("units" in var.attrs) == (name not in NOT_QUANTITIES), name
     assert ds["rest_position"].dims == ("node", "axis")
-    assert list(ds["axis"].values) == ["x", "y", "z"]
+    assert list(ds["axis_name"].values) == ["x", "y", "z"]
+    for i, a in enumerate("xyz"):
+        np.testing.assert_array_equal(ds[f"node_{a}"].values, mesh.points[:, i])
     assert ds["cells"].attrs["cell_type"] == "tetra"
+    np.testing.assert_array_equal(ds["cell_material"].values, [0, 1])
+    np.testing.assert_array_equal(ds["material_E"].values, [1e6, 2e6])
+    np.testing.assert_array_equal(ds["material_nu"].values, [0.3, 0.25])
+    assert ds["material_E"].attrs["units"] == "Pa" and ds["material_nu"].attrs["units"] == "1"
+    assert "material_density" not in ds and "thickness" not in ds  # not given
     assert ds["displacement_history"].dims == ("time", "node", "axis")
     assert ds["step"].dims == ("time",)
     assert ds["springs"].dims == ("spring", "spring_end") and ds.sizes["spring_end"] == 2
-    assert ds["spring_constant"].attrs["units"] == "N/m"
-    for key in ("Conventions", "model", "E", "nu", "scene", "msslib_version", "git_commit", "created",
-                "python_version", "numpy_version", "wall_time_s"):
+    assert ds["spring_constant"].attrs["units"] == "N m-1"
+    for key in ("Conventions", "msslib_schema", "title", "source", "history", "model", "scene", "msslib_version",
+                "git_commit", "created", "python_version", "numpy_version", "wall_time_s"):
         assert key in ds.attrs, key
-    assert ds.attrs["Conventions"] == SCHEMA_VERSION
+    assert "E" not in ds.attrs and "nu" not in ds.attrs  # material constants are variables with units
+    assert ds.attrs["Conventions"] == CONVENTIONS == "CF-1.11 UGRID-1.0"
+    assert ds.attrs["msslib_schema"] == SCHEMA_VERSION
     assert ds.attrs["msslib_version"] == msslib.__version__
     assert ds.attrs["numpy_version"] == np.__version__
     assert COMMIT_RE.match(ds.attrs["git_commit"])
     assert re.match(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\+00:00$", ds.attrs["created"])
     assert ds.attrs["solver_iterations"] == 12
     assert ds.attrs["solver_converged"] == 1
-    assert ds.attrs["solver_message"] == "None"
+    assert "solver_message" not in ds.attrs  # None drops the attribute
     assert ds.attrs["solver_newton_line_search"] == "armijo"
     assert ds.attrs["solver_newton_steps"] == 3
     assert ds.attrs["solver_flags"] == '["a", "b"]'
@@ -101,10 +117,10 @@ def test_round_trip(tmp_path):
     back = read_result(path)
     xr.testing.assert_identical(back, ds)  # data, dims, coords, variable and global attrs
     for name, var in back.variables.items():
-        assert var.attrs["units"] and var.attrs["long_name"], name
+        assert var.attrs["long_name"] and (name in NOT_QUANTITIES or var.attrs["units"]), name
     assert back["fixed"].dtype == bool
     assert back["cells"].dtype == np.int64
-    np.testing.assert_array_equal(back.attrs["E"], [1e6, 2e6])
+    np.testing.assert_array_equal(back["material_E"].values, [1e6, 2e6])
     assert back.attrs["scene"] == ds.attrs["scene"]
     assert back.attrs["wall_time_s"] == 1.25
     assert COMMIT_RE.match(back.attrs["git_commit"])
@@ -114,7 +130,8 @@ def test_round_trip(tmp_path):
     # on disk, fixed is int8
     with netCDF4.Dataset(tmp_path / "moved.nc") as nc:
         assert nc["fixed"].dtype == np.int8
-        assert nc.getncattr("Conventions") == SCHEMA_VERSION
+        assert nc.getncattr("Conventions") == CONVENTIONS
+        assert nc.getncattr("msslib_schema") == SCHEMA_VERSION
     m = mesh_from_result(back)
     np.testing.assert_array_equal(m.points, mesh.points)
     np.testing.assert_array_equal(m.cells, mesh.cells)
@@ -132,13 +149,13 @@ def test_minimal_2d_round_trip_step_history(tmp_path):
     u = np.array([[0, 0], [0.1, 0], [0.1, -0.02], [0, -0.02]])
     ds = make_dataset(mesh, u, model="fem_linear", E=1e5, nu=0.3,
                       history={"step": [0, 1], "displacement": [u / 2, u]}, fixed=[True, False, False, True])
-    assert list(ds["axis"].values) == ["x", "y"]
+    assert list(ds["axis_name"].values) == ["x", "y"]
     assert ds["displacement_history"].dims == ("step", "node", "axis")
     assert ds.attrs["scene"] == "" and np.isnan(ds.attrs["wall_time_s"])
     assert ds["fixed"].values.tolist() == [[True, True], [False, False], [False, False], [True, True]]
     back = read_result(write_result(tmp_path / "q.nc", ds))
     xr.testing.assert_identical(back, ds)
-    assert back.attrs["E"] == 1e5 and back.attrs["model"] == "fem_linear"
+    assert back["material_E"].values.tolist() == [1e5] and back.attrs["model"] == "fem_linear"
     assert mesh_from_result(back).cell_type == "quad"
 
 
@@ -157,6 +174,12 @@ def test_make_dataset_validation():
         make_dataset(mesh, u, model="m", E=1.0, nu=0.3, extra_attrs={"git_commit": "x"})
     with pytest.raises(ValueError, match="history"):
         make_dataset(mesh, u, model="m", E=1.0, nu=0.3, history={"displacement": u[None]})
+    with pytest.raises(ValueError, match="2D meshes only"):
+        make_dataset(mesh, u, model="m", E=1.0, nu=0.3, thickness=0.01)
+    with pytest.raises(ValueError, match="material_names"):
+        make_dataset(mesh, u, model="m", E=1.0, nu=0.3, material_names=["only one"])
+    with pytest.raises(ValueError, match="E has 2 entries but there are 3 materials"):  # 3 densities
+        make_dataset(mesh, u, model="m", E=[1.0, 2.0], nu=0.3, density=[1.0, 2.0, 3.0])
 
 
 def test_refuses_non_finite_displacement(tmp_path):

@@ -107,7 +107,7 @@ def test_fem_twins_run(name, model, tmp_path):
 def test_mss_membrane_agrees_with_fem_linear():
     mss = run_scene(SCENES / "membrane_lloyd_stretch.yaml", progress=False)
     fem = run_scene(SCENES / "membrane_fem_stretch.yaml", progress=False)
-    assert mss.attrs["nu"] == pytest.approx(1 / 3)
+    assert mss["material_nu"].values == pytest.approx([1 / 3])
     np.testing.assert_array_equal(mss["rest_position"].values, fem["rest_position"].values)
     u_mss, u_fem = mss["displacement"].values, fem["displacement"].values
     assert np.abs(u_mss - u_fem).max() <= 0.03 * np.abs(u_fem).max()
@@ -174,7 +174,7 @@ def test_mesh_file_and_regions(tmp_path):
     assert setup.surface_forces[:, 0].sum() == pytest.approx(0.2)
     out = tmp_path / "strip.nc"
     assert main(["run", str(scene_path), "--out", str(out), "--quiet"]) == 0
-    np.testing.assert_allclose(read_result(out).attrs["E"], [1.0e6, 2.0e6])
+    np.testing.assert_allclose(read_result(out)["material_E"].values, [1.0e6, 2.0e6])
 
 
 # --------------------------------------------------------------------------------------------
