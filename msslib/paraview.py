@@ -1,0 +1,256 @@
+"""ParaView export of msslib results: the final state as one VTU file, or every saved state as a
+time series (a ``.pvd`` collection of VTU files).
+
+:func:`write` (and :func:`stage`, which adds the files to a :class:`msslib.io.StagedOutputs`)
+decides by the suffix of the path:
+
+``OUT.vtu``
+    The final state (:func:`write_state`): the mesh at rest with the point data ``displacement``
+    (m), ``reaction_force`` (N) and ``fixed`` (0/1), and the cell data ``material``,
+    ``cell_state`` and ``relative_jacobian`` (the final state's cell check, :mod:`msslib.quality`).
+``OUT.pvd``
+    Every saved state (:func:`write_series`), written together (all files, or none):
+
+    * ``OUT.pvd``: the collection, one ``DataSet`` per state with its ``timestep``: the time (s)
+      of a dynamic run's saved states, the step number of a result stored along ``step``; a result
+      without history (a static solve, a dynamic run with ``output: {history: false}``) is one
+      state, at ``t = 0`` for a static result and at the end time ``n_steps * dt`` for a dynamic one.
+    * ``OUT_0000.vtu``, ``OUT_0001.vtu``, ... beside it (four digits, more when there are more
+      states), the mesh at rest with the point data ``displacement`` (m) of the state,
+      ``velocity`` (m/s) when the result stores velocities, ``reaction_force_final`` (N: results
+      store the reaction of the final state only, so every file carries that one, and says so)
+      and ``fixed``; the cell data ``material``, and ``cell_state`` and ``relative_jacobian`` of
+      that state (:func:`msslib.quality.check_state`, at the result's ``collapse_threshold``).
+    * ``OUT_springs.vtu`` (results with springs): one line cell (VTK_LINE) per spring between
+      the rest positions, with the cell data ``spring_constant`` (N/m) and ``rest_length`` (m).
+      It is a file of its own, not part of the collection (cells of two types in one grid would
+      need cell data for both), and has no time: open it beside the ``.pvd``.
+
+    In ParaView, open the ``.pvd`` and apply *Warp By Vector* (``displacement``) to see the
+    deformed states.  Files of an earlier, longer series with the same name are not removed; the
+    ``.pvd`` lists only the new ones.
+"""
+
+from __future__ import annotations
+
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["SUFFIXES", "check_suffix", "is_series", "states", "series_files", "in_series", "write_state",
+           "write_series", "stage", "write"]
+
+#: suffix -> what is written
+SUFFIXES = {".vtu": "the final state (one VTU file)", ".pvd": "every saved state (ParaView series)"}
+
+
+def check_suffix(path, what: str = "ParaView file") -> Path:
+    """``path`` if it ends in ``.vtu`` or ``.pvd`` (any case), else a one-line ValueError."""
+    path = Path(path)
+    if path.suffix.lower() not in SUFFIXES:
+        allowed = "; ".join(f"{s} for {w}" for s, w in SUFFIXES.items())
+        raise ValueError(f"{what} {str(path)!r}: unknown suffix {path.suffix or '(none)'!r}; allowed: {allowed}")
+    return path
+
+
+def is_series(path) -> bool:
+    """True for a ``.pvd`` path (a time series), False for anything else."""
+    return Path(path).suffix.lower() == ".pvd"
+
+
+# --------------------------------------------------------------------------------------------
+# what a result holds
+# --------------------------------------------------------------------------------------------
+
+
+def _nodes_axes(ds, name):
+    return np.asarray(ds[name].transpose(..., "node", "axis").values, dtype=float)
+
+
+def states(ds):
+    """``(times, displacements, velocities)`` of every state of the result ``ds``.
+
+    ``times`` ``(n_states,)``, ``displacements`` ``(n_states, n_nodes, dim)`` (m), ``velocities``
+    the same shape (m/s) or None; see the module docstring for the times of each kind of result.
+    """
+    if "displacement_history" in ds:
+        var = ds["displacement_history"]
+        state_dim = var.dims[0]
+        u = _nodes_axes(ds, "displacement_history")
+        times = np.asarray(ds[state_dim].values if state_dim in ds.variables else np.arange(len(u)), dtype=float)
+        v = None
+        if "velocity_history" in ds and ds["velocity_history"].dims[0] == state_dim:
+            v = _nodes_axes(ds, "velocity_history")
+        return times, u, v
+    t = 0.0
+    if ds.attrs.get("solver_type") == "dynamic":
+        try:
+            t = float(ds.attrs["solver_n_steps"]) * float(ds.attrs["solver_dt"])
+        except (KeyError, TypeError, ValueError):
+            t = 0.0
+    return np.array([t]), _nodes_axes(ds, "displacement")[None], None
+
+
+def _digits(n_states: int) -> int:
+    return max(4, len(str(max(n_states - 1, 0))))
+
+
+def series_files(path, n_states: int, springs: bool) -> list[tuple[str, Path]]:
+    """The files of a series written at ``path`` (a ``.pvd``): ``[(what, path), ...]``, the
+    collection first, then the states, then the springs (when ``springs``)."""
+    pvd = Path(path)
+    width = _digits(n_states)
+    files = [("ParaView series", pvd)]
+    files += [("VTU file of the series", pvd.with_name(f"{pvd.stem}_{i:0{width}d}.vtu")) for i in range(n_states)]
+    if springs:
+        files.append(("springs VTU file", pvd.with_name(f"{pvd.stem}_springs.vtu")))
+    return files
+
+
+def in_series(pvd, path) -> bool:
+    """Whether ``path`` is, or would be, one of the files of a series written at ``pvd`` whatever
+    its number of states: the ``.pvd`` itself, ``STEM_NNNN.vtu`` or ``STEM_springs.vtu`` in its
+    directory (also through a symbolic link).  Used to refuse an export that would overwrite an
+    input before anything runs."""
+    pvd = Path(pvd)
+    pattern = re.compile(re.escape(pvd.stem) + r"_(\d{4,}|springs)\.vtu")
+    try:
+        directory = pvd.parent.resolve()
+    except (OSError, RuntimeError):
+        return False
+    candidates = [Path(path)]
+    try:
+        candidates.append(Path(path).resolve())
+    except (OSError, RuntimeError):
+        pass
+    for p in candidates:
+        try:
+            same_dir = p.parent.resolve() == directory
+        except (OSError, RuntimeError):
+            continue
+        if same_dir and (p.name == pvd.name or pattern.fullmatch(p.name)):
+            return True
+    return False
+
+
+# --------------------------------------------------------------------------------------------
+# writers (each writes one file at the path it is given: a temporary file when staged)
+# --------------------------------------------------------------------------------------------
+
+
+def _mesh(ds):
+    from msslib.io import mesh_from_result
+
+    return mesh_from_result(ds)
+
+
+def _fixed(ds):
+    return np.asarray(ds["fixed"].transpose("node", "axis").values, dtype=np.int8)
+
+
+def write_state(path, ds) -> Path:
+    """Write the final state of the result ``ds`` as one VTU file (see the module docstring)."""
+    from msslib.mesh import write_vtu
+
+    mesh = _mesh(ds)
+    point_data = {"displacement": _nodes_axes(ds, "displacement")}
+    if "reaction_force" in ds:
+        point_data["reaction_force"] = _nodes_axes(ds, "reaction_force")
+    if "fixed" in ds:
+        point_data["fixed"] = _fixed(ds)
+    # the final state's cell check (msslib.quality): ParaView can threshold on the inverted cells
+    cell_data = {name: np.asarray(ds[name].values) for name in ("cell_state", "relative_jacobian") if name in ds}
+    return write_vtu(path, mesh, point_data=point_data, cell_data=cell_data or None)
+
+
+def _state_writer(mesh, u, v, reaction, fixed, threshold):
+    def write(path):
+        from msslib.mesh import write_vtu
+        from msslib.quality import check_state
+
+        point_data = {"displacement": u}
+        if v is not None:
+            point_data["velocity"] = v
+        if reaction is not None:
+            point_data["reaction_force_final"] = reaction
+        if fixed is not None:
+            point_data["fixed"] = fixed
+        check = check_state(mesh, mesh.points + u, threshold=threshold)
+        cell_data = {"cell_state": check.state, "relative_jacobian": check.ratio}
+        write_vtu(path, mesh, point_data=point_data, cell_data=cell_data)
+    return write
+
+
+def _springs_writer(ds):
+    def write(path):
+        import meshio
+
+        points = np.asarray(ds["rest_position"].transpose("node", "axis").values, dtype=float)
+        if points.shape[1] == 2:
+            points = np.column_stack([points, np.zeros(len(points))])
+        lines = np.asarray(ds["springs"].transpose("spring", "spring_end").values, dtype=np.int64)
+        cell_data = {name: [np.asarray(ds[name].values, dtype=float)] for name in ("spring_constant", "rest_length")
+                     if name in ds}
+        meshio.write(Path(path), meshio.Mesh(points, [("line", lines)], cell_data=cell_data), file_format="vtu")
+    return write
+
+
+def _collection(times, names) -> str:
+    root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
+    collection = ET.SubElement(root, "Collection")
+    for t, name in zip(times, names):
+        ET.SubElement(collection, "DataSet", timestep=repr(float(t)), group="", part="0", file=name)
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _stage_series(staged, path, ds) -> list[Path]:
+    times, u, v = states(ds)
+    if not np.all(np.isfinite(times)):
+        raise ValueError(f"ParaView series {str(path)!r}: the result's state times are not all finite")
+    mesh = _mesh(ds)
+    reaction = _nodes_axes(ds, "reaction_force") if "reaction_force" in ds else None
+    fixed = _fixed(ds) if "fixed" in ds else None
+    from msslib.quality import COLLAPSE_THRESHOLD
+
+    threshold = float(ds.attrs.get("collapse_threshold", COLLAPSE_THRESHOLD))
+    files = series_files(path, len(times), "springs" in ds)
+    pvd, state_files = files[0][1], files[1:1 + len(times)]
+    for i, (what, dest) in enumerate(state_files):
+        staged.write(dest, _state_writer(mesh, u[i], None if v is None else v[i], reaction, fixed, threshold),
+                     what=what)
+    if "springs" in ds:
+        what, dest = files[-1]
+        staged.write(dest, _springs_writer(ds), what=what)
+    staged.write_text(pvd, _collection(times, [dest.name for _, dest in state_files]), what=files[0][0])
+    return [dest for _, dest in files]
+
+
+def stage(staged, path, ds) -> list[Path]:
+    """Add the ParaView export of ``ds`` at ``path`` (``.vtu``: the final state, ``.pvd``: every
+    saved state) to ``staged`` (a :class:`msslib.io.StagedOutputs`); returns the files."""
+    path = check_suffix(path)
+    if is_series(path):
+        return _stage_series(staged, path, ds)
+    staged.write(path, lambda tmp: write_state(tmp, ds), what="VTU file")
+    return [path]
+
+
+def write_series(path, ds) -> list[Path]:
+    """Write every saved state of ``ds`` as a ParaView series at ``path`` (a ``.pvd``): all its
+    files are replaced together, or none is.  Returns the files, the ``.pvd`` first."""
+    if not is_series(path):
+        raise ValueError(f"ParaView series {str(path)!r}: the collection must end in .pvd")
+    return write(path, ds)
+
+
+def write(path, ds) -> list[Path]:
+    """Write the ParaView export of the result ``ds`` at ``path`` (the suffix decides, see the
+    module docstring), all files together or none; returns the files written."""
+    from msslib.io import StagedOutputs
+
+    with StagedOutputs() as staged:
+        files = stage(staged, path, ds)
+    return files
