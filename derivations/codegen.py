@@ -9,6 +9,14 @@ the element module) and of its own body. ``--check`` recomputes both: a changed 
 hand edit makes it fail, without re-deriving. ``--full`` re-derives and compares byte for byte.
 The errata collected from the derivations are written to ``paper/errata.md`` and the symbolic
 findings to ``paper/derivations.md``.
+
+A full run also writes one C99 header, ``msslib/generated/msslib_mss.h`` (:data:`C_HEADER`): every
+formula of every module (spring constants, rest-length factors, volume coefficients, and the
+energy, gradient and Hessian kernels) printed from the same SymPy expressions and the same common
+subexpressions as the Python modules, by SymPy's C99 printer. Its functions are ``static inline``
+unless ``MSSLIB_API`` is defined before the header is included (define it empty to compile the
+header into a library). It carries the same two hash lines, over the engine and every module, and
+``--check`` checks it like the Python modules.
 """
 
 from __future__ import annotations
@@ -20,18 +28,30 @@ import sys
 from pathlib import Path
 
 import sympy as sp
+from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "msslib" / "generated"
 ENGINE = ["__init__.py", "elasticity.py", "fem.py", "mss.py", "match.py", "lattice.py", "records.py", "codegen.py"]
 MODULES = ["triangle", "square", "rectangle", "tetrahedron", "cube_baudet", "cube_golec", "kernels"]
+C_HEADER = "msslib_mss.h"  # in OUT; generated from every module in MODULES
 
 
 def source_hash(module: str) -> str:
     h = hashlib.sha256()
     here = Path(__file__).resolve().parent
     for name in ENGINE + [f"{module}.py"]:
+        h.update(name.encode())
+        h.update((here / name).read_bytes())
+    return h.hexdigest()
+
+
+def c_source_hash() -> str:
+    """SHA-256 of the engine and of every module the C header is printed from."""
+    h = hashlib.sha256()
+    here = Path(__file__).resolve().parent
+    for name in ENGINE + [f"{m}.py" for m in MODULES]:
         h.update(name.encode())
         h.update((here / name).read_bytes())
     return h.hexdigest()
@@ -78,6 +98,97 @@ def render(module: str, derivation=None) -> str:
     return header + text
 
 
+class _CPrinter(C99CodePrinter):
+    """SymPy's C99 printer without the non-standard ``M_SQRT2``-style macros."""
+
+    def __init__(self):
+        super().__init__({"math_macros": {}})
+
+
+def _c_comment(text: str) -> str:
+    return " ".join(text.split()).replace("*/", "* /").replace("/*", "/ *")
+
+
+def _c_function_code(f, prefix: str = "msslib_") -> str:
+    """One C function from a :class:`~derivations.records.Formula`, with the common subexpressions
+    of the Python module (same ``sp.cse`` call). A single output is returned; several are written
+    to ``out[0..n-1]`` in the order of ``f.outputs``."""
+    printer = _CPrinter()
+    names = list(f.outputs)
+    exprs = [f.outputs[n] for n in names]
+    subs, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_c"), optimizations="basic")
+    args = [f"double {a}" for a in f.args]
+    doc = [f"/* {f.name}: {_c_comment(f.doc)}"]
+    if len(names) == 1:
+        doc.append(f" * Returns {names[0]}. */")
+        head = f"MSSLIB_API double {prefix}{f.name}({', '.join(args)})"
+    else:
+        doc.append(f" * Writes out[0..{len(names) - 1}] = ({', '.join(names)}). */")
+        head = f"MSSLIB_API void {prefix}{f.name}({', '.join(args + ['double *out'])})"
+    lines = doc + [head, "{"]
+    for sym, e in subs:
+        lines.append(f"    const double {sym} = {printer.doprint(e)};")
+    if len(names) == 1:
+        lines.append(f"    return {printer.doprint(reduced[0])};")
+    else:
+        for i, e in enumerate(reduced):
+            lines.append(f"    out[{i}] = {printer.doprint(e)};")
+    lines.append("}")
+    return "\n".join(lines)
+
+
+def _c_index_macros(f, prefix: str = "MSSLIB_") -> list[str]:
+    """``#define`` of the output count and (for named outputs, not g0/h0 kernel entries) of each
+    output's index."""
+    names = list(f.outputs)
+    if len(names) == 1:
+        return []
+    base = f"{prefix}{f.name.upper()}"
+    out = [f"#define {base}_N_OUT {len(names)}"]
+    if not all(n[:1] in "gh" and n[1:].isdigit() for n in names):
+        out += [f"#define {base}_{n.upper()} {i}" for i, n in enumerate(names)]
+    return out
+
+
+def render_c_header(derivations=None) -> str:
+    """The text of :data:`C_HEADER` (``derivations``: module name -> ``derive()``, default: derive)."""
+    derivations = dict(derivations or {})
+    for m in MODULES:
+        if m not in derivations:
+            derivations[m] = importlib.import_module(f"derivations.{m}").derive()
+    guard = "MSSLIB_MSS_H"
+    body = ["/* Spring constants, rest-length factors, volume coefficients and the energy, gradient and",
+            " * Hessian kernels of msslib's mass-spring models, in C99.",
+            " *",
+            " * Printed by SymPy's C99 printer from the expressions that the Python modules of",
+            " * msslib/generated are printed from (the modules of derivations/), with the same common",
+            " * subexpressions; `python -m derivations.codegen` writes both, do not edit.",
+            " * SI units: E in Pa, lengths in m, spring constants in N/m, energies in J, gradients in N,",
+            " * Hessians in N/m (row-major, node by node: x0, y0(, z0), x1, ...).",
+            " * Functions are `static inline` unless MSSLIB_API is defined before this header is",
+            " * included (define it empty to compile them with external linkage, e.g. into a library).",
+            " * Link with -lm. */",
+            f"#ifndef {guard}", f"#define {guard}", "", "#include <math.h>", "",
+            "#ifndef MSSLIB_API", "#define MSSLIB_API static inline", "#endif", "",
+            "#ifdef __cplusplus", 'extern "C" {', "#endif"]
+    seen = set()
+    for m in MODULES:
+        d = derivations[m]
+        body += ["", f"/* ---- derivations/{m}.py: {_c_comment(d.title)} ---- */"]
+        for f in d.formulas + d.published:
+            if f.name in seen:
+                raise ValueError(f"formula {f.name!r} is defined twice; C names must be unique")
+            seen.add(f.name)
+            macros = _c_index_macros(f)
+            body += [""] + macros + ([""] if macros else []) + [_c_function_code(f)]
+    body += ["", "#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */"]
+    text = "\n".join(body) + "\n"
+    digest = hashlib.sha256(text.encode()).hexdigest()
+    header = ("// Generated from derivations/ by `python -m derivations.codegen`. Do not edit.\n"
+              f"// source-sha256: {c_source_hash()}\n// body-sha256: {digest}\n")
+    return header + text
+
+
 def _read_header(path: Path):
     lines = path.read_text().splitlines(keepends=True)
     src = lines[1].split(":", 1)[1].strip() if len(lines) > 2 else ""
@@ -99,6 +210,17 @@ def check(full: bool = False) -> list[str]:
             problems.append(f"{path.relative_to(ROOT)} was edited by hand")
         if full and path.read_text() != render(m):
             problems.append(f"{path.relative_to(ROOT)} differs from a fresh derivation")
+    path = OUT / C_HEADER
+    if not path.exists():
+        problems.append(f"{path.relative_to(ROOT)} is missing")
+    else:
+        src, body, text = _read_header(path)
+        if src != c_source_hash():
+            problems.append(f"{path.relative_to(ROOT)} is stale: a derivation module or the engine changed")
+        if body != hashlib.sha256(text.encode()).hexdigest():
+            problems.append(f"{path.relative_to(ROOT)} was edited by hand")
+        if full and path.read_text() != render_c_header():
+            problems.append(f"{path.relative_to(ROOT)} differs from a fresh derivation")
     return problems
 
 
@@ -113,10 +235,13 @@ def write_all(modules=MODULES) -> None:
         (OUT / f"{m}.py").write_text(render(m, derivations[m]))
         print(f"wrote msslib/generated/{m}.py", flush=True)
     if set(modules) == set(MODULES):
+        (OUT / C_HEADER).write_text(render_c_header(derivations))
+        print(f"wrote msslib/generated/{C_HEADER}", flush=True)
         from derivations import report
         report.write(derivations)
-    else:  # the paper's errata and findings need every module: leave them to a full run
-        print("paper/errata.md and paper/derivations.* not rewritten (only some modules derived)")
+    else:  # the paper's errata and findings and the C header need every module: leave them to a full run
+        print(f"paper/errata.md, paper/derivations.* and msslib/generated/{C_HEADER} not rewritten "
+              f"(only some modules derived)")
 
 
 def main(argv=None) -> int:

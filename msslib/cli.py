@@ -2,10 +2,12 @@
 
 Commands
 --------
-``run SCENE.yaml --out OUT.nc [--vtu OUT.vtu] [--quiet]``
+``run SCENE.yaml --out OUT.nc [--vtu OUT.vtu|OUT.pvd] [--quiet]``
     Validate, build and solve a scene (:mod:`msslib.scene`) and write the result atomically as
     NetCDF (:func:`msslib.io.write_result`); with ``--vtu`` (or ``output: {vtu: ...}`` in the scene)
-    also a VTU file for ParaView.  Output directories are checked before the run; on any failure no
+    also for ParaView (:mod:`msslib.paraview`; the suffix decides): ``.vtu`` the final state,
+    ``.pvd`` every saved state as a time series (``OUT_0000.vtu``, ... and ``OUT_springs.vtu``
+    beside it).  Output directories are checked before the run; on any failure no
     output file is left behind.  A progress bar is drawn on stderr for runs longer than half a
     second unless ``--quiet``.
 ``validate SCENE.yaml``
@@ -15,16 +17,23 @@ Commands
     (:mod:`msslib.experiment`).
 ``plan SCENE.yaml --max-error E``
     The cheapest measured (model, resolution) within an error budget (:mod:`msslib.planning`).
-``vtu RESULT.nc --out OUT.vtu``
-    Export any result to VTU for ParaView.
+``vtu RESULT.nc --out OUT.vtu|OUT.pvd``
+    Export any result for ParaView: ``.vtu`` the final state, ``.pvd`` every saved state.
+``export SCENE.yaml --out DIR/|STEM [--format csv,json,vtu,mjcf,sofa,c]``
+    The complete mass-spring system of a scene, without solving (:mod:`msslib.export`): springs,
+    volume and correction terms, masses, fixed nodes and loads as CSV/JSON and VTU, a MuJoCo model,
+    a SOFA scene and the C header of the derived formulas and kernels.
 ``paper SOURCE --out OUT.html``
     Build the paper (:mod:`msslib.paper`).
 
 Inputs and outputs: an output that is one of the command's inputs (the scene, its mesh file, the
 experiment, the result or front read) or another of its outputs is refused before anything runs
-(same resolved path, or :func:`os.path.samefile`: hard and symbolic links too).  A command that
+(same resolved path, or :func:`os.path.samefile`: hard and symbolic links too); a ParaView series
+is refused before the run when a file it writes beside the ``.pvd`` would be an input.  A command that
 writes several files writes them together (:class:`msslib.io.StagedOutputs`): all are replaced,
 or none is; temporary files are removed on any error, on SIGINT and on SIGTERM.
+
+``--version`` prints ``msslib X.Y.Z``.
 
 Exit codes: 0 success, 1 bad input or a failed solve (a one-line ``msslib: error: ...`` message on
 stderr, no traceback), 2 bad command-line usage (argparse), 130 interrupted (SIGINT), 143
@@ -162,7 +171,7 @@ def _choice(option: str, value: str, allowed, what: str) -> str:
 
 
 #: the variables a result needs for ``vtu`` and ``experiment compare``
-RESULT_VARIABLES = ("rest_position", "displacement", "cells", "material")
+RESULT_VARIABLES = ("rest_position", "displacement", "cells")
 
 
 def _read_result(path: Path, what: str = "result file", required=RESULT_VARIABLES):
@@ -177,8 +186,8 @@ def _read_result(path: Path, what: str = "result file", required=RESULT_VARIABLE
         raise CommandError(f"{what} {str(path)!r} is not a NetCDF file msslib can read ({detail})") from None
     missing = [v for v in required if v not in ds.variables]
     if missing:
-        conv = ds.attrs.get("Conventions")
-        kind = "an msslib result" if conv == SCHEMA_VERSION else f"a {SCHEMA_VERSION} result"
+        ours = ds.attrs.get("msslib_schema") == SCHEMA_VERSION
+        kind = "an msslib result" if ours else f"a {SCHEMA_VERSION} result"
         raise CommandError(f"{what} {str(path)!r} is not {kind} with a mesh: no variable "
                            f"{', '.join(map(repr, missing))}")
     for name in ("rest_position", "displacement"):
@@ -207,20 +216,52 @@ def _vtu_path(scene, out: Path, cli_vtu: str | None) -> Path | None:
 
 
 def _write_vtu(path: Path, ds) -> None:
-    import numpy as np
+    """The final state as one VTU file (:func:`msslib.paraview.write_state`)."""
+    from msslib.paraview import write_state
 
-    from msslib.io import mesh_from_result
-    from msslib.mesh import write_vtu
+    write_state(path, ds)
 
-    mesh = mesh_from_result(ds)
-    point_data = {"displacement": ds["displacement"].transpose("node", "axis").values}
-    if "reaction_force" in ds:
-        point_data["reaction_force"] = ds["reaction_force"].transpose("node", "axis").values
-    if "fixed" in ds:
-        point_data["fixed"] = np.asarray(ds["fixed"].transpose("node", "axis").values, dtype=np.int8)
-    # the final state's cell check (msslib.quality): ParaView can threshold on the inverted cells
-    cell_data = {name: np.asarray(ds[name].values) for name in ("cell_state", "relative_jacobian") if name in ds}
-    write_vtu(path, mesh, point_data=point_data, cell_data=cell_data or None)
+
+def _paraview_what(path: Path) -> str:
+    from msslib.paraview import is_series
+
+    return "ParaView series" if is_series(path) else "VTU file"
+
+
+def _check_paraview(path: Path, others) -> None:
+    """Refuse, before anything runs, a ParaView output whose suffix is neither .vtu nor .pvd, or a
+    series whose files beside the .pvd (STEM_NNNN.vtu, STEM_springs.vtu) would be one of
+    ``others`` (pairs ``(what, path)``: the inputs and the other outputs)."""
+    from msslib.paraview import check_suffix, in_series, is_series
+
+    try:
+        check_suffix(path, _paraview_what(path))
+    except ValueError as exc:
+        raise CommandError(_one_line(exc)) from None
+    if is_series(path):
+        for what, other in others:
+            if other is not None and in_series(path, other):
+                raise CommandError(f"{what} {str(other)!r} would be overwritten by the ParaView series {str(path)!r} "
+                                   f"(it writes {path.stem}_NNNN.vtu and {path.stem}_springs.vtu beside it); "
+                                   f"give another .pvd name")
+
+
+def _paraview_files(path: Path, ds) -> list:
+    """Every file of the ParaView export of ``ds`` at ``path``, pairs ``(what, path)``."""
+    from msslib.paraview import is_series, series_files, states
+
+    if not is_series(path):
+        return [("VTU file", path)]
+    return series_files(path, len(states(ds)[0]), "springs" in ds)
+
+
+def _stage_paraview(staged, path: Path, ds) -> None:
+    from msslib.paraview import is_series, stage
+
+    if is_series(path):
+        stage(staged, path, ds)
+    else:
+        staged.write(path, lambda tmp: _write_vtu(tmp, ds), what="VTU file")
 
 
 # --------------------------------------------------------------------------------------------
@@ -233,7 +274,8 @@ def _add_run(subparsers) -> None:
                               description="Run a scene and write its result atomically.")
     p.add_argument("scene", help="scene file (YAML)")
     p.add_argument("--out", "-o", required=True, help="result file (NetCDF, .nc)")
-    p.add_argument("--vtu", help="also write the final state as a VTU file (ParaView)")
+    p.add_argument("--vtu", help="also write for ParaView: OUT.vtu the final state, OUT.pvd every saved state "
+                                 "(OUT_0000.vtu, ... and OUT_springs.vtu beside it)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary line")
     p.set_defaults(func=_cmd_run)
 
@@ -245,18 +287,25 @@ def _cmd_run(args) -> int:
     scene = _load_scene(args.scene)
     out = Path(args.out)
     vtu = _vtu_path(scene, out, args.vtu)
-    outputs = [("output file", out), ("VTU file", vtu)]
-    _check_distinct(outputs, [("scene file", Path(args.scene)), *_mesh_input(scene)])
+    inputs = [("scene file", Path(args.scene)), *_mesh_input(scene)]
+    outputs = [("output file", out), (_paraview_what(vtu) if vtu is not None else "VTU file", vtu)]
+    _check_distinct(outputs, inputs)
+    if vtu is not None:
+        _check_paraview(vtu, [*inputs, ("output file", out)])
     for what, path in outputs:
         if path is not None:
             _check_writable(path, what)
     ds = run_scene(scene, progress=not args.quiet)
-    with StagedOutputs() as staged:  # both files, or neither
+    files = _paraview_files(vtu, ds) if vtu is not None else []
+    _check_distinct([("output file", out), *files], inputs)  # every file of a series, links included
+    with StagedOutputs() as staged:  # every file, or none
         staged.write_result(out, ds)
         if vtu is not None:
-            staged.write(vtu, lambda tmp: _write_vtu(tmp, ds), what="VTU file")
+            _stage_paraview(staged, vtu, ds)
     if not args.quiet:
         extra = f" and {vtu}" if vtu is not None else ""
+        if len(files) > 1:
+            extra += f" (with {len(files) - 1} VTU files beside it)"
         umax = float(abs(ds["displacement"]).max())
         print(f"{scene.name}: {ds.attrs['model']}, {ds.sizes['node']} nodes, max |u_i| {umax:.4g} m, "
               f"{ds.attrs['wall_time_s']:.2f} s -> {out}{extra}", file=sys.stderr)
@@ -403,10 +452,13 @@ def _cmd_experiment_list(args) -> int:
 
 
 def _add_vtu(subparsers) -> None:
-    p = subparsers.add_parser("vtu", help="export a NetCDF result to VTU (ParaView)",
-                              description="Write the final state of any msslib result file as a VTU file.")
+    p = subparsers.add_parser("vtu", help="export a NetCDF result for ParaView (.vtu or .pvd)",
+                              description="Write any msslib result file for ParaView: OUT.vtu the final state, "
+                                          "OUT.pvd every saved state (a time series).")
     p.add_argument("result", help="result file (NetCDF) written by msslib")
-    p.add_argument("--out", "-o", required=True, help="VTU file")
+    p.add_argument("--out", "-o", required=True,
+                   help="OUT.vtu (the final state) or OUT.pvd (every saved state: OUT_0000.vtu, ... and "
+                        "OUT_springs.vtu beside it)")
     p.set_defaults(func=_cmd_vtu)
 
 
@@ -416,11 +468,14 @@ def _cmd_vtu(args) -> int:
     src, out = Path(args.result), Path(args.out)
     if not src.exists():
         raise CommandError(f"result file not found: {str(src)!r}")
-    _check_distinct([("VTU file", out)], [("result file", src)])
-    _check_writable(out, "VTU file")
+    what = _paraview_what(out)
+    _check_distinct([(what, out)], [("result file", src)])
+    _check_paraview(out, [("result file", src)])
+    _check_writable(out, what)
     ds = _read_result(src)
-    with StagedOutputs() as staged:
-        staged.write(out, lambda tmp: _write_vtu(tmp, ds), what="VTU file")
+    _check_distinct(_paraview_files(out, ds), [("result file", src)])
+    with StagedOutputs() as staged:  # every file of a series, or none
+        _stage_paraview(staged, out, ds)
     return 0
 
 
@@ -561,12 +616,93 @@ def _cmd_plan(args) -> int:
     return 0
 
 
+def _add_export(subparsers) -> None:
+    from msslib.export import FORMATS
+
+    p = subparsers.add_parser(
+        "export", help="write a scene's mass-spring system without solving it (CSV, JSON, VTU, MuJoCo, SOFA, C)",
+        description="Build a scene's model without solving and write it (msslib.export): the springs (nodes, "
+                    "stiffness N/m, rest length m), volume terms and Baudet's correction with their constants, node "
+                    "masses and rest positions, fixed nodes, prescribed displacements, loads and gravity. csv: one "
+                    "table per file, header row with units; json: one document with a schema version; vtu: springs as "
+                    "line cells; mjcf: a MuJoCo model; sofa: a SOFA scene (.scn); c: the generated C header. MuJoCo "
+                    "and SOFA cannot carry volume terms: by default they are written only for models without them.")
+    p.add_argument("scene", help="scene file (YAML)")
+    p.add_argument("--out", "-o", required=True,
+                   help="a directory (existing, or ending in '/': the files are named after the scene) or a path "
+                        "prefix STEM: STEM_TABLE.csv, STEM.json, STEM.vtu, STEM_mujoco.xml, STEM.scn, msslib_mss.h")
+    p.add_argument("--format", "-f", dest="formats", metavar="LIST",
+                   help=f"formats separated by commas, from {','.join(FORMATS)} (default: every format that carries "
+                        f"the whole model)")
+    p.add_argument("--quiet", "-q", action="store_true", help="no summary line")
+    p.set_defaults(func=_cmd_export)
+
+
+def _cmd_export(args) -> int:
+    import warnings
+
+    from msslib import export
+    from msslib.errors import MsslibWarning
+    from msslib.io import StagedOutputs
+
+    try:
+        formats = export.parse_formats(args.formats)
+    except ValueError as exc:
+        raise CommandError(_one_line(exc)) from None
+    scene_path = Path(args.scene)
+    scene = _load_scene(scene_path)
+    if scene.is_fem:
+        raise CommandError(f"scene file {str(scene_path)!r}: model {scene.model} is a FEM reference; export writes "
+                           f"the mass-spring models")
+    out = Path(args.out)
+    directory = out.is_dir() or str(args.out).endswith(("/", os.sep))
+    if directory and out.exists() and not out.is_dir():
+        raise CommandError(f"--out {str(args.out)!r} is not a directory")
+    exp = export.build(scene)
+    chosen = formats if formats is not None else export.default_formats(exp)
+    stem = export.stem_for(out, scene.name, directory)
+    planned = export.output_paths(exp, stem, chosen)
+    inputs = [("scene file", scene_path), *_mesh_input(scene)]
+    if "c" in chosen:
+        inputs.append(("generated C header", export.C_HEADER_PATH))
+    _check_distinct([(what, path) for _, what, path, _ in planned], inputs)
+    if directory and not out.exists():
+        _check_writable(out, "output directory")
+    else:
+        for _, what, path, _ in planned:
+            _check_writable(path, what)
+    skipped = [f for f in export.SPRINGS_ONLY_FORMATS if formats is None and f not in chosen]
+    if skipped:
+        warnings.warn(f"{scene.name}: {' and '.join(skipped)} not written: the model {scene.model} has "
+                      f"{'; '.join(exp.volume_terms)}, which MuJoCo and SOFA cannot express; --format "
+                      f"{','.join(skipped)} writes the rest of the model with a note", MsslibWarning, stacklevel=2)
+    for fmt in chosen:
+        missing = export.not_carried(exp, fmt) if fmt in export.SPRINGS_ONLY_FORMATS else []
+        if missing:
+            warnings.warn(f"{scene.name}: the {fmt} output does not carry {'; '.join(missing)} (said in the file; "
+                          f"the csv and json outputs carry everything)", MsslibWarning, stacklevel=2)
+    if directory:
+        out.mkdir(parents=True, exist_ok=True)
+    with StagedOutputs() as staged:  # every file, or none
+        for fmt, what, path, table in planned:
+            staged.write(path, export.file_writer(exp, fmt, table), what=what)
+    if not args.quiet:
+        extra = f", {'; '.join(exp.volume_terms)}" if exp.volume_terms else ""
+        print(f"{scene.name}: {scene.model}, {exp.n_nodes} nodes, {len(exp.pairs)} springs{extra} -> "
+              f"{len(planned)} files ({', '.join(chosen)}) at {stem}", file=sys.stderr)
+    return 0
+
+
 #: subparser builders, in the order of the help text
-COMMANDS = [_add_run, _add_validate, _add_experiment, _add_paper, _add_plan, _add_vtu]
+COMMANDS = [_add_run, _add_validate, _add_experiment, _add_paper, _add_plan, _add_vtu, _add_export]
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from msslib import __version__
+
     parser = argparse.ArgumentParser(prog="msslib", description="Mass-spring systems and their FEM references.")
+    parser.add_argument("--version", action="version", version=f"msslib {__version__}",
+                        help="print the version (msslib X.Y.Z) and exit")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for add in COMMANDS:
         add(subparsers)

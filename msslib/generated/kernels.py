@@ -1,5 +1,5 @@
 # Generated from derivations/kernels.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 5ea662896dd3f94ffe6bf5d8d69f4315ef54d51cab28ead9d03dbadffdc7523e
+# source-sha256: 2b68a7fe76422dbe2aa7c04555faca72cefd5a4226efa778cf75748123f22f3b
 # body-sha256: 697db20548f54e3fa8340025635f2b0c82ddf3f46b91b62364777ff0a18ee566
 """Energy, gradient and Hessian kernels.
 

@@ -1,5 +1,5 @@
 # Generated from derivations/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 534fab72363102edfd3e7b9acaf106f7e0e7e2a907bc77bafdebb2d97a4feadd
+# source-sha256: 6994b30138988a7e17af29b5a52acd3ac38e4b7ee413b025f72c724bbe7a2060
 # body-sha256: 7ecb914d1852416401807e86d947e0367f8126e72b51da001538baf27e8712cf
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 

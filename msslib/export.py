@@ -1,0 +1,851 @@
+"""Export a scene's complete mass-spring system without solving it.
+
+:func:`build` reads a scene (:mod:`msslib.scene`), builds its mesh, boundary conditions, loads and
+model exactly as ``run`` would, and collects everything that defines the model in an
+:class:`MssExport`: the springs (nodes, stiffness, rest length), the volume terms and Baudet's
+correction with their constants, the node masses and rest positions, the fixed dofs and prescribed
+displacements, the loads and gravity. The writers turn it into
+
+``csv``
+    One file per table, a header row with the units (``name [unit]``): ``nodes`` (rest position,
+    mass), ``springs``, ``fixed`` (fixed axes and prescribed displacements), ``loads`` (surface
+    loads at load factor 1), ``gravity``, and when the model has them ``tet_volume`` (Lloyd),
+    ``hex_volume`` (Golec), ``baudet_correction`` (factor and face forces per cell) and
+    ``baudet_correction_forces`` (the nodal forces it adds at load factor 1). Node indices are
+    0-based. Floats are written with ``repr`` (they read back bit for bit): :func:`read_csv`.
+``json``
+    One document with the same tables, a schema name and version (:data:`SCHEMA`,
+    :data:`SCHEMA_VERSION`), the units, the energy of every term, the scene text: :func:`read_json`.
+``vtu``
+    The springs as line cells (cell data ``stiffness``, ``rest_length``) on the rest positions,
+    with the point data ``mass``, ``fixed``, ``prescribed_displacement``, ``load`` (and
+    ``baudet_correction``): for ParaView. The volume terms are in the tables only.
+``mjcf``
+    A MuJoCo model (:func:`mjcf_text`): one body per node with a slide joint per free axis (a node
+    fixed on every axis has none: it is welded to the world; prescribed displacements move the
+    body), its mass as a point mass, a site at the node; one spatial tendon per spring between the
+    two sites with ``stiffness`` = k and ``springlength`` = the rest length, i.e. the force
+    ``k (|x_j - x_i| - L)`` along the spring, exactly msslib's spring; gravity in ``<option>``;
+    surface loads and Baudet's correction (constant at load factor 1) as ``<general>`` actuators
+    with a constant affine bias on the joints; mass-proportional damping ``alpha`` as joint damping
+    ``alpha m``. Volume terms cannot be expressed: an XML comment and the command say so.
+``sofa``
+    A SOFA scene (:func:`sofa_text`, ``.scn`` XML) made only of the components and attributes of
+    :data:`SOFA_COMPONENTS`: MechanicalObject, DiagonalMass (``vertexMass``), SpringForceField
+    (``spring``: ``i j ks kd L`` per spring), Fixed/PartialFixedProjectiveConstraint,
+    ConstantForceField, StaticSolver (static scenes) or EulerImplicitSolver (dynamic scenes,
+    Rayleigh damping), CGLinearSolver. Volume terms: not carried, said in a comment.
+``c``
+    The generated C header ``msslib_mss.h`` (:mod:`derivations.codegen`): the spring-constant
+    formulas and the energy, gradient and Hessian kernels, copied beside the outputs.
+
+Units are SI throughout.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import re
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["FORMATS", "SPRINGS_ONLY_FORMATS", "SCHEMA", "SCHEMA_VERSION", "SOFA_COMPONENTS", "SOFA_TARGET",
+           "C_HEADER_PATH", "Column", "Table", "MssExport", "build", "from_setup", "parse_formats", "default_formats",
+           "not_carried", "output_paths", "stem_for", "file_writer", "csv_text", "read_csv", "json_document",
+           "json_text", "read_json", "write_vtu", "time_step", "mjcf_text", "sofa_text"]
+
+#: every format, in the order outputs are written
+FORMATS = ("csv", "json", "vtu", "mjcf", "sofa", "c")
+#: formats that cannot express volume terms (they get the springs-only part, with a note)
+SPRINGS_ONLY_FORMATS = ("mjcf", "sofa")
+SCHEMA = "msslib-mss-export"
+SCHEMA_VERSION = 1
+C_HEADER_PATH = Path(__file__).resolve().parent / "generated" / "msslib_mss.h"
+
+AXES = "xyz"
+UNITS = {"length": "m", "mass": "kg", "force": "N", "stiffness": "N/m", "pressure": "Pa", "energy": "J",
+         "volume": "m^3", "acceleration": "m/s^2", "time": "s", "damping_alpha": "1/s", "damping_beta": "s"}
+
+#: SOFA components and the attributes the scene uses, for SOFA v24.06 and later: for each component
+#: class the plugin that registers it, its Data names (the XML attributes, as declared by
+#: ``initData`` in the SOFA sources) and the source file that declares them (sofa-framework/sofa).
+#: For example SpringForceField's Data ``spring`` holds ``m1 m2 ks kd initpos`` per spring
+#: (LinearSpring), FixedProjectiveConstraint's ``indices``. :func:`sofa_text` writes nothing else.
+SOFA_TARGET = "SOFA v24.06 or later"
+_SRC = "Sofa/Component/"
+SOFA_COMPONENTS = {
+    "Node": {"plugin": None, "attributes": ("name", "gravity", "dt"),
+             "source": "Sofa/framework/Core/src/sofa/core/objectmodel/Context.cpp"},
+    "RequiredPlugin": {"plugin": None, "attributes": ("name",),
+                       "source": "Sofa/framework/Simulation/Core/src/sofa/simulation/RequiredPlugin.cpp"},
+    "DefaultAnimationLoop": {"plugin": "Sofa.Simulation.Core", "attributes": ("name",),
+                             "source": "Sofa/framework/Simulation/Core/src/sofa/simulation/DefaultAnimationLoop.cpp"},
+    "StaticSolver": {"plugin": "Sofa.Component.ODESolver.Backward",
+                     "attributes": ("name", "newton_iterations", "relative_residual_tolerance_threshold",
+                                    "absolute_residual_tolerance_threshold", "relative_correction_tolerance_threshold",
+                                    "absolute_correction_tolerance_threshold"),
+                     "source": _SRC + "ODESolver/Backward/src/sofa/component/odesolver/backward/StaticSolver.cpp"},
+    "EulerImplicitSolver": {"plugin": "Sofa.Component.ODESolver.Backward",
+                            "attributes": ("name", "rayleighMass", "rayleighStiffness"),
+                            "source": _SRC + "ODESolver/Backward/src/sofa/component/odesolver/backward/"
+                                             "EulerImplicitSolver.cpp"},
+    "CGLinearSolver": {"plugin": "Sofa.Component.LinearSolver.Iterative",
+                       "attributes": ("name", "iterations", "tolerance", "threshold"),
+                       "source": _SRC + "LinearSolver/Iterative/src/sofa/component/linearsolver/iterative/"
+                                        "CGLinearSolver.inl"},
+    "MeshTopology": {"plugin": "Sofa.Component.Topology.Container.Constant",
+                     "attributes": ("name", "position", "triangles", "quads", "tetrahedra", "hexahedra"),
+                     "source": _SRC + "Topology/Container/Constant/src/sofa/component/topology/container/constant/"
+                                      "MeshTopology.cpp"},
+    "MechanicalObject": {"plugin": "Sofa.Component.StateContainer",
+                         "attributes": ("name", "template", "position", "rest_position"),
+                         "source": _SRC + "StateContainer/src/sofa/component/statecontainer/MechanicalObject.inl"},
+    "DiagonalMass": {"plugin": "Sofa.Component.Mass", "attributes": ("name", "vertexMass"),
+                     "source": _SRC + "Mass/src/sofa/component/mass/DiagonalMass.inl"},
+    "SpringForceField": {"plugin": "Sofa.Component.SolidMechanics.Spring", "attributes": ("name", "spring"),
+                         "source": _SRC + "SolidMechanics/Spring/src/sofa/component/solidmechanics/spring/"
+                                          "SpringForceField.inl"},
+    "FixedProjectiveConstraint": {"plugin": "Sofa.Component.Constraint.Projective", "attributes": ("name", "indices"),
+                                  "source": _SRC + "Constraint/Projective/src/sofa/component/constraint/projective/"
+                                                   "FixedProjectiveConstraint.inl"},
+    "PartialFixedProjectiveConstraint": {"plugin": "Sofa.Component.Constraint.Projective",
+                                         "attributes": ("name", "indices", "fixedDirections"),
+                                         "source": _SRC + "Constraint/Projective/src/sofa/component/constraint/"
+                                                          "projective/PartialFixedProjectiveConstraint.inl"},
+    "ConstantForceField": {"plugin": "Sofa.Component.MechanicalLoad", "attributes": ("name", "indices", "forces"),
+                           "source": _SRC + "MechanicalLoad/src/sofa/component/mechanicalload/ConstantForceField.inl"},
+}
+_SOFA_CELLS = {"triangle": "triangles", "quad": "quads", "tetra": "tetrahedra", "hexahedron": "hexahedra"}
+
+
+# --------------------------------------------------------------------------------------------
+# tables
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass
+class Column:
+    """One column: ``name``, ``unit`` (None for indices and flags; ``"1"`` for dimensionless
+    numbers), ``values`` (1D int or float array) and a description."""
+
+    name: str
+    unit: str | None
+    values: np.ndarray
+    description: str = ""
+
+    @property
+    def header(self) -> str:
+        return self.name if self.unit is None else f"{self.name} [{self.unit}]"
+
+
+@dataclass
+class Table:
+    name: str
+    description: str
+    columns: list[Column] = field(default_factory=list)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        for c in self.columns:
+            if c.name == name:
+                return c.values
+        raise KeyError(f"table {self.name!r} has no column {name!r}; it has {', '.join(self.names)}")
+
+    @property
+    def names(self) -> list[str]:
+        return [c.name for c in self.columns]
+
+    @property
+    def n_rows(self) -> int:
+        return len(self.columns[0].values) if self.columns else 0
+
+
+def _col(name, unit, values, description="", dtype=float):
+    return Column(name, unit, np.ascontiguousarray(values, dtype=dtype), description)
+
+
+# --------------------------------------------------------------------------------------------
+# the model
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass
+class MssExport:
+    """Everything that defines a scene's mass-spring system (SI units, rest configuration).
+
+    ``points`` (n, dim) rest positions; ``masses`` (n,); ``fixed`` (n, dim) bool and
+    ``prescribed`` (n, dim) displacements at load factor 1; ``pairs`` (s, 2), ``stiffness`` (s,),
+    ``rest_length`` (s,); ``tet_volume`` / ``hex_volume`` / ``correction`` the model's
+    :class:`msslib.terms.TetVolume`, :class:`~msslib.terms.HexVolume`,
+    :class:`~msslib.terms.BaudetCorrection` (or None); ``loads`` (n, dim) surface loads at load
+    factor 1; ``gravity`` (dim,) or None; ``damping`` (alpha, beta) of a dynamic scene.
+    """
+
+    scene: object
+    setup: object
+    model: object
+    points: np.ndarray
+    masses: np.ndarray
+    mass_source: str
+    fixed: np.ndarray
+    prescribed: np.ndarray
+    pairs: np.ndarray
+    stiffness: np.ndarray
+    rest_length: np.ndarray
+    tet_volume: object = None
+    hex_volume: object = None
+    correction: object = None
+    loads: np.ndarray | None = None
+    gravity: np.ndarray | None = None
+    damping: tuple = (0.0, 0.0)
+    _tables: dict | None = field(default=None, repr=False)
+    _time_step: float | None = field(default=None, repr=False)
+
+    @property
+    def dim(self) -> int:
+        return self.points.shape[1]
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.points)
+
+    @property
+    def volume_terms(self) -> list[str]:
+        """One phrase per volume term of the model (what MuJoCo and SOFA cannot carry)."""
+        out = []
+        if self.tet_volume is not None:
+            out.append(f"Lloyd's tetrahedron volume energy k_v/(2 V0^2) (V - V0)^2 on {len(self.tet_volume)} "
+                       f"cells (table tet_volume)")
+        if self.hex_volume is not None:
+            out.append(f"Golec's volume energy kappa/(2 V0) (V - V0)^2 on {len(self.hex_volume)} cells "
+                       f"(table hex_volume)")
+        return out
+
+    def tables(self) -> dict[str, Table]:
+        """The tables of the CSV and JSON outputs, by name (built once)."""
+        if self._tables is None:
+            self._tables = _tables(self)
+        return self._tables
+
+
+def build(scene) -> MssExport:
+    """Load (a path, a dict or a :class:`msslib.scene.Scene`), prepare and collect a scene's MSS.
+
+    ValueError for a FEM scene (there is no mass-spring system to export) and for anything
+    :func:`msslib.scene.prepare` refuses."""
+    from msslib.scene import load_scene, prepare
+
+    scene = load_scene(scene)
+    if scene.is_fem:
+        raise ValueError(f"scene.model: {scene.model} is a FEM reference; export writes mass-spring models "
+                         f"(the models of msslib.scene.MSS_MODELS)")
+    return from_setup(prepare(scene))
+
+
+def from_setup(setup) -> MssExport:
+    """Collect the MSS of a prepared scene (:class:`msslib.scene.Setup`); the model's terms are read
+    as they are (a term of an unknown kind is an error: nothing is left out silently)."""
+    from msslib.terms import BaudetCorrection, Gravity, HexVolume, NodalForces, Springs, TetVolume
+
+    model = setup.model
+    if model is None:
+        raise ValueError("the scene has no mass-spring model to export")
+    springs, tet, hexv, corr = [], None, None, None
+    for t in model.terms:
+        if isinstance(t, Springs):
+            springs.append(t)
+        elif isinstance(t, TetVolume):
+            tet = t if tet is None else _merge_error("TetVolume")
+        elif isinstance(t, HexVolume):
+            hexv = t if hexv is None else _merge_error("HexVolume")
+        elif isinstance(t, BaudetCorrection):
+            corr = t if corr is None else _merge_error("BaudetCorrection")
+        elif isinstance(t, (NodalForces, Gravity)):
+            pass  # the scene's surface loads and gravity, taken from the setup below
+        else:
+            raise ValueError(f"cannot export a term of type {type(t).__name__}")
+    dim = model.dim
+    pairs = np.concatenate([s.pairs for s in springs]) if springs else np.zeros((0, 2), dtype=np.int64)
+    k = np.concatenate([s.k for s in springs]) if springs else np.zeros(0)
+    rest = np.concatenate([s.rest_length for s in springs]) if springs else np.zeros(0)
+    if setup.masses is not None:
+        masses, source = np.asarray(setup.masses, dtype=float), "lumped from the scene's densities"
+    else:
+        masses, source = np.asarray(model.node_masses, dtype=float), \
+            "lumped with unit density (the scene gives no density; only dynamics would use them)"
+    scene = setup.scene
+    damping = (0.0, 0.0)
+    if scene.is_dynamic:
+        d = scene.solver.get("damping", 0.0)
+        damping = (float(d), 0.0) if np.ndim(d) == 0 else (float(d[0]), float(d[1]))
+    gravity = None if setup.gravity is None else np.asarray(setup.gravity, dtype=float)
+    return MssExport(scene=scene, setup=setup, model=model, points=np.asarray(setup.mesh.points, dtype=float),
+                     masses=masses, mass_source=source, fixed=np.asarray(setup.fixed, dtype=bool).reshape(-1, dim),
+                     prescribed=np.asarray(setup.prescribed, dtype=float).reshape(-1, dim), pairs=pairs,
+                     stiffness=k, rest_length=rest, tet_volume=tet, hex_volume=hexv, correction=corr,
+                     loads=np.asarray(setup.surface_forces, dtype=float).reshape(-1, dim), gravity=gravity,
+                     damping=damping)
+
+
+def _merge_error(kind):
+    raise ValueError(f"the model has two {kind} terms; export expects one")
+
+
+def _tables(exp: MssExport) -> dict[str, Table]:
+    from msslib.terms import _HEX_FACES
+
+    dim, n = exp.dim, exp.n_nodes
+    axes = AXES[:dim]
+    nodes = np.arange(n)
+    out = {}
+    out["nodes"] = Table("nodes", f"node rest positions and masses ({exp.mass_source})", [
+        _col("node", None, nodes, "node index (0-based)", int),
+        *[_col(a, "m", exp.points[:, i], f"rest position, {a}") for i, a in enumerate(axes)],
+        _col("mass", "kg", exp.masses, "node mass"),
+    ])
+    out["springs"] = Table("springs", "springs k/2 (|x_j - x_i| - L)^2 between node_i and node_j", [
+        _col("spring", None, np.arange(len(exp.pairs)), "spring index", int),
+        _col("node_i", None, exp.pairs[:, 0], "first node", int),
+        _col("node_j", None, exp.pairs[:, 1], "second node", int),
+        _col("stiffness", "N/m", exp.stiffness, "spring constant k, summed over the elements sharing the pair"),
+        _col("rest_length", "m", exp.rest_length, "rest length L (differs from the node distance for "
+                                                  "prestrained springs)"),
+    ])
+    held = np.flatnonzero(exp.fixed.any(axis=1))
+    out["fixed"] = Table("fixed", "nodes with fixed axes (1 fixed, 0 free) and the displacements prescribed "
+                                  "on the fixed axes at load factor 1 (0 on free axes)", [
+        _col("node", None, held, "node index", int),
+        *[_col(f"fixed_{a}", None, exp.fixed[held, i].astype(int), f"axis {a} fixed", int) for i, a in enumerate(axes)],
+        *[_col(f"u_{a}", "m", exp.prescribed[held, i], f"prescribed displacement, {a}") for i, a in enumerate(axes)],
+    ])
+    loaded = np.flatnonzero(np.any(exp.loads != 0, axis=1))
+    out["loads"] = Table("loads", "surface loads (tractions and nodal forces of the scene) on the nodes at load "
+                                  "factor 1, dead loads (gravity is in table gravity)", [
+        _col("node", None, loaded, "node index", int),
+        *[_col(f"f_{a}", "N", exp.loads[loaded, i], f"force, {a}") for i, a in enumerate(axes)],
+    ])
+    g = np.zeros(dim) if exp.gravity is None else exp.gravity
+    out["gravity"] = Table("gravity", "gravitational acceleration (each node carries its mass times it; zero: "
+                                      "no gravity)", [_col(f"g_{a}", "m/s^2", [g[i]], f"gravity, {a}")
+                                                      for i, a in enumerate(axes)])
+    if exp.tet_volume is not None:
+        t = exp.tet_volume
+        out["tet_volume"] = Table("tet_volume", "Lloyd's tetrahedron volume energy k_v/(2 V0^2) (V - V0)^2, V the "
+                                                "signed volume of (node_0, ..., node_3) (C: msslib_tet_signed_volume)", [
+            _col("cell", None, np.arange(len(t)), "cell index", int),
+            *[_col(f"node_{a}", None, t.conn[:, a], f"node {a} of the tetrahedron", int) for a in range(4)],
+            _col("k_v", "J", t.k_v, "volume coefficient k_v (may be negative)"),
+            _col("V0", "m^3", t.V0, "rest volume of the cell"),
+        ])
+    if exp.hex_volume is not None:
+        h = exp.hex_volume
+        out["hex_volume"] = Table("hex_volume", "Golec's volume energy kappa/(2 V0) (V - V0)^2, V the averaged-edge-"
+                                                "vector volume of the hexahedron (node_0, ..., node_7) in VTK order "
+                                                "(C: msslib_hex_averaged_volume)", [
+            _col("cell", None, np.arange(len(h)), "cell index", int),
+            *[_col(f"node_{a}", None, h.conn[:, a], f"node {a} of the hexahedron", int) for a in range(8)],
+            _col("kappa", "Pa", h.kappa, "volume coefficient kappa (may be negative)"),
+            _col("V0", "m^3", h.V0, "rest (averaged) volume of the cell"),
+        ])
+    if exp.correction is not None:
+        c = exp.correction
+        cells = exp.setup.mesh.cells
+        faces = "; ".join(f"face {f}: local nodes {' '.join(map(str, nodes_))}" for f, nodes_ in enumerate(_HEX_FACES))
+        out["baudet_correction"] = Table("baudet_correction", "Baudet's orthogonal correction per cube: factor c "
+                                         "(F_perp = c F_i) and the elongation force of each face at load factor 1 "
+                                         f"({faces}; msslib.terms.BaudetCorrection)", [
+            _col("cell", None, np.arange(len(cells)), "cell index", int),
+            *[_col(f"node_{a}", None, cells[:, a], f"node {a} of the hexahedron", int) for a in range(8)],
+            _col("factor", "1", c.factor, "correction factor c"),
+            *[_col(f"face_force_{f}", "N", c.face_force[:, f], f"elongation force of face {f} (> 0 tension)")
+              for f in range(6)],
+        ])
+        fc = c.nodal
+        on = np.flatnonzero(np.any(fc != 0, axis=1))
+        out["baudet_correction_forces"] = Table(
+            "baudet_correction_forces", "nodal forces of Baudet's correction at load factor 1 (they scale with the "
+                                        "load; constant in the reference configuration)", [
+                _col("node", None, on, "node index", int),
+                *[_col(f"f_{a}", "N", fc[on, i], f"force, {a}") for i, a in enumerate(axes)],
+            ])
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# formats and file names
+# --------------------------------------------------------------------------------------------
+
+
+def parse_formats(text: str | None) -> tuple[str, ...] | None:
+    """``"csv,mjcf"`` -> ``("csv", "mjcf")`` in :data:`FORMATS` order; None for None (the default).
+    ValueError naming an unknown or repeated format."""
+    if text is None:
+        return None
+    items = [s.strip() for s in text.split(",")]
+    if not text.strip() or any(not s for s in items):
+        raise ValueError(f"--format {text!r}: give formats separated by commas, from {','.join(FORMATS)}")
+    for s in items:
+        if s not in FORMATS:
+            raise ValueError(f"--format {text!r}: {s!r} is not a format; expected some of {','.join(FORMATS)}")
+        if items.count(s) > 1:
+            raise ValueError(f"--format {text!r}: {s!r} is given twice")
+    return tuple(f for f in FORMATS if f in items)
+
+
+def default_formats(exp: MssExport) -> tuple[str, ...]:
+    """Every format that carries the whole model: MuJoCo and SOFA only without volume terms."""
+    return tuple(f for f in FORMATS if not (f in SPRINGS_ONLY_FORMATS and exp.volume_terms))
+
+
+def not_carried(exp: MssExport, fmt: str) -> list[str]:
+    """What of the model ``fmt`` leaves out (an empty list: all of it)."""
+    out = []
+    if fmt in SPRINGS_ONLY_FORMATS:
+        out += exp.volume_terms
+        if fmt == "mjcf" and exp.damping[1] != 0.0:
+            out.append(f"the stiffness-proportional damping beta = {exp.damping[1]!r} s (only the mass-proportional "
+                       f"alpha is carried, as joint damping)")
+    elif fmt == "vtu" and (exp.volume_terms or exp.correction is not None):
+        out += [v.split(" (table")[0] for v in exp.volume_terms]
+        if exp.correction is not None:
+            out.append("Baudet's per-cell correction factors (the nodal correction forces are carried)")
+    return out
+
+
+def _safe_name(name: str) -> str:
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "scene"
+
+
+def output_paths(exp: MssExport, stem: Path, formats) -> list[tuple[str, str, Path, str | None]]:
+    """``(format, what, path, table)`` of every file the formats write (``table``: the table of a
+    CSV file, else None), ``stem`` the path prefix: CSV ``STEM_TABLE.csv``, JSON ``STEM.json``, VTU
+    ``STEM.vtu``, MuJoCo ``STEM_mujoco.xml``, SOFA ``STEM.scn``, C ``msslib_mss.h`` in the stem's
+    directory."""
+    stem = Path(stem)
+    out = []
+    for fmt in formats:
+        if fmt == "csv":
+            out += [("csv", f"CSV table {name}", stem.with_name(f"{stem.name}_{name}.csv"), name)
+                    for name in exp.tables()]
+        elif fmt == "json":
+            out.append(("json", "JSON document", stem.with_name(f"{stem.name}.json"), None))
+        elif fmt == "vtu":
+            out.append(("vtu", "VTU file", stem.with_name(f"{stem.name}.vtu"), None))
+        elif fmt == "mjcf":
+            out.append(("mjcf", "MuJoCo model", stem.with_name(f"{stem.name}_mujoco.xml"), None))
+        elif fmt == "sofa":
+            out.append(("sofa", "SOFA scene", stem.with_name(f"{stem.name}.scn"), None))
+        elif fmt == "c":
+            out.append(("c", "C header", stem.with_name(C_HEADER_PATH.name), None))
+        else:
+            raise ValueError(f"unknown format {fmt!r}")
+    return out
+
+
+def file_writer(exp: MssExport, fmt: str, table: str | None = None):
+    """``writer(path)`` that writes one output of ``fmt`` (for :class:`msslib.io.StagedOutputs`,
+    which then names the destination in any error)."""
+    def text(make):
+        def write(path):
+            Path(path).write_text(make(), encoding="utf-8")
+        return write
+
+    if fmt == "csv":
+        return text(lambda: csv_text(exp.tables()[table]))
+    if fmt == "json":
+        return text(lambda: json_text(exp))
+    if fmt == "vtu":
+        return lambda path: write_vtu(path, exp)
+    if fmt == "mjcf":
+        return text(lambda: mjcf_text(exp))
+    if fmt == "sofa":
+        return text(lambda: sofa_text(exp))
+    if fmt == "c":
+        return text(lambda: C_HEADER_PATH.read_text(encoding="utf-8"))
+    raise ValueError(f"unknown format {fmt!r}")
+
+
+def stem_for(out: Path, scene_name: str, directory: bool) -> Path:
+    """The path prefix of the outputs: ``out / NAME`` in a directory, else ``out`` itself."""
+    return Path(out) / _safe_name(scene_name) if directory else Path(out)
+
+
+# --------------------------------------------------------------------------------------------
+# CSV and JSON
+# --------------------------------------------------------------------------------------------
+
+
+def _cell(v) -> str:
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    v = float(v)
+    if not math.isfinite(v):
+        raise ValueError(f"cannot export the non-finite value {v!r}")
+    return repr(v)
+
+
+def csv_text(table: Table) -> str:
+    """A table as CSV: a header row ``name [unit]``, one row per entry, floats by ``repr``."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow([c.header for c in table.columns])
+    cols = [c.values.tolist() for c in table.columns]
+    for row in zip(*cols):
+        w.writerow([_cell(v) for v in row])
+    return buf.getvalue()
+
+
+_HEADER = re.compile(r"^(?P<name>[^\[\]]+?)(?: \[(?P<unit>[^\[\]]+)\])?$")
+
+
+def read_csv(path, name: str | None = None) -> Table:
+    """Read a table written by :func:`csv_text` (integer columns as ints, the rest as floats)."""
+    path = Path(path)
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    if not rows:
+        raise ValueError(f"{path}: empty CSV file, expected a header row")
+    columns = []
+    for j, head in enumerate(rows[0]):
+        m = _HEADER.match(head)
+        if m is None:
+            raise ValueError(f"{path}: column header {head!r} is not 'name [unit]'")
+        raw = [r[j] for r in rows[1:]]
+        is_int = all(re.fullmatch(r"-?\d+", s) for s in raw) and (m["unit"] is None)
+        values = np.array([int(s) for s in raw], dtype=np.int64) if is_int else np.array([float(s) for s in raw])
+        columns.append(Column(m["name"], m["unit"], values))
+    return Table(name or path.stem, "", columns)
+
+
+def json_document(exp: MssExport) -> dict:
+    """The export as one JSON-able document (see the module docstring)."""
+    scene = exp.scene
+    terms = [{"kind": "springs", "count": int(len(exp.pairs)), "table": "springs",
+              "energy": "k/2 (|x_j - x_i| - L)^2", "conservative": True, "scales_with_load": False}]
+    if exp.tet_volume is not None:
+        terms.append({"kind": "tet_volume", "count": len(exp.tet_volume), "table": "tet_volume",
+                      "energy": "k_v/(2 V0^2) (V - V0)^2, V signed tetrahedron volume", "conservative": True,
+                      "scales_with_load": False})
+    if exp.hex_volume is not None:
+        terms.append({"kind": "hex_volume", "count": len(exp.hex_volume), "table": "hex_volume",
+                      "energy": "kappa/(2 V0) (V - V0)^2, V averaged-edge-vector hexahedron volume",
+                      "conservative": True, "scales_with_load": False})
+    if exp.correction is not None:
+        terms.append({"kind": "baudet_correction", "count": int(len(exp.correction.factor)),
+                      "table": "baudet_correction", "forces_table": "baudet_correction_forces",
+                      "energy": None, "conservative": False, "scales_with_load": True})
+    tables = {}
+    for name, t in exp.tables().items():
+        tables[name] = {"description": t.description,
+                        "columns": [{"name": c.name, "unit": c.unit, "description": c.description,
+                                     "values": c.values.tolist()} for c in t.columns]}
+    opts = {k: (list(v) if isinstance(v, tuple) else v) for k, v in scene.model_options.items()}
+    return {
+        "schema": SCHEMA, "schema_version": SCHEMA_VERSION,
+        "generator": f"msslib {_version()}",
+        "scene": {"name": scene.name, "description": scene.description, "model": scene.model,
+                  "model_options": opts, "solver": _plain(scene.solver), "text": scene.text},
+        "dim": exp.dim, "index_base": 0, "units": UNITS,
+        "n_nodes": exp.n_nodes, "mass_source": exp.mass_source,
+        "gravity": None if exp.gravity is None else exp.gravity.tolist(),
+        "load_factor": 1.0,
+        "damping": {"alpha": exp.damping[0], "beta": exp.damping[1],
+                    "meaning": "Rayleigh damping C = alpha M + beta K of a dynamic scene (0 for static scenes)"},
+        "terms": terms, "tables": tables,
+    }
+
+
+def _plain(value):
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _version() -> str:
+    from msslib import __version__
+
+    return __version__
+
+
+def json_text(exp: MssExport) -> str:
+    return json.dumps(json_document(exp), indent=1, allow_nan=False) + "\n"
+
+
+def read_json(path) -> tuple[dict, dict[str, Table]]:
+    """``(document, tables)`` of a JSON export; ValueError if it is not one of this schema."""
+    doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
+        raise ValueError(f"{path}: not an {SCHEMA} document")
+    if doc.get("schema_version") != SCHEMA_VERSION:
+        raise ValueError(f"{path}: schema version {doc.get('schema_version')!r}, this msslib reads {SCHEMA_VERSION}")
+    tables = {}
+    for name, t in doc["tables"].items():
+        cols = []
+        for c in t["columns"]:
+            v = c["values"]
+            arr = np.array(v, dtype=np.int64) if all(isinstance(x, int) for x in v) and c["unit"] is None \
+                else np.array(v, dtype=float)
+            cols.append(Column(c["name"], c["unit"], arr, c.get("description", "")))
+        tables[name] = Table(name, t.get("description", ""), cols)
+    return doc, tables
+
+
+# --------------------------------------------------------------------------------------------
+# VTU
+# --------------------------------------------------------------------------------------------
+
+
+def _pad3(a):
+    a = np.asarray(a)
+    if a.ndim == 2 and a.shape[1] < 3:
+        a = np.hstack([a, np.zeros((len(a), 3 - a.shape[1]), dtype=a.dtype)])
+    return a
+
+
+def write_vtu(path, exp: MssExport) -> Path:
+    """The springs as VTK line cells with cell data ``stiffness`` (N/m) and ``rest_length`` (m), on
+    the rest positions, with point data ``mass`` (kg), ``fixed`` (0/1 per axis),
+    ``prescribed_displacement`` (m), ``load`` (N) and ``baudet_correction`` (N, when present)."""
+    import meshio
+
+    point_data = {"mass": exp.masses, "fixed": _pad3(exp.fixed.astype(np.int8)),
+                  "prescribed_displacement": _pad3(exp.prescribed), "load": _pad3(exp.loads)}
+    if exp.correction is not None:
+        point_data["baudet_correction"] = _pad3(exp.correction.nodal)
+    mesh = meshio.Mesh(_pad3(exp.points), [("line", exp.pairs.astype(np.int64))], point_data=point_data,
+                       cell_data={"stiffness": [exp.stiffness], "rest_length": [exp.rest_length]})
+    meshio.write(path, mesh, file_format="vtu")
+    return Path(path)
+
+
+# --------------------------------------------------------------------------------------------
+# MuJoCo
+# --------------------------------------------------------------------------------------------
+
+
+def _f(v) -> str:
+    v = float(v)
+    if not math.isfinite(v):
+        raise ValueError(f"cannot export the non-finite value {v!r}")
+    return repr(v)
+
+
+def _vec(v) -> str:
+    return " ".join(_f(x) for x in v)
+
+
+def _springs_only_model(exp: MssExport):
+    from msslib.model import Model
+    from msslib.terms import Springs
+
+    return Model(exp.setup.mesh, [Springs(exp.pairs, exp.stiffness, exp.rest_length, exp.dim)],
+                 fixed=exp.fixed, masses=exp.masses)
+
+
+def time_step(exp: MssExport) -> float:
+    """The scene's time step (dynamic scenes), else half the explicit stability limit ``2/omega_max``
+    of the springs with the node masses at rest (:func:`msslib.solvers.explicit_stability_limit`)."""
+    if exp._time_step is None:
+        exp._time_step = _time_step(exp)
+    return exp._time_step
+
+
+def _time_step(exp: MssExport) -> float:
+    if exp.scene.is_dynamic:
+        return float(exp.scene.solver["dt"])
+    from msslib.solvers import explicit_stability_limit
+
+    if len(exp.pairs) == 0 or not (~exp.fixed).any():
+        return 1e-3
+    model = _springs_only_model(exp)
+    limit = explicit_stability_limit(model, model.apply_prescribed(model.x0, 1.0))
+    return 0.5 * limit if math.isfinite(limit) else 1e-3
+
+
+def _header_lines(exp: MssExport, fmt: str) -> list[str]:
+    scene = exp.scene
+    lines = [f"Generated by `msslib export` (msslib {_version()}) from scene {scene.name!r}, model {scene.model}; "
+             f"SI units (m, kg, s, N). Node i is body/site node{{i}}, spring s is tendon spring{{s}} "
+             f"(0-based, the rows of the CSV/JSON tables)." if fmt == "mjcf" else
+             f"Generated by `msslib export` (msslib {_version()}) from scene {scene.name!r}, model {scene.model}; "
+             f"SI units (m, kg, s, N); written for {SOFA_TARGET}. Node indices are those of the CSV/JSON tables."]
+    missing = not_carried(exp, fmt)
+    if missing:
+        lines.append("NOT CARRIED (cannot be expressed here; this file holds the rest of the model, which is "
+                     "therefore NOT the scene's model): " + "; ".join(missing) + ". The CSV/JSON export carries "
+                     "them.")
+    else:
+        lines.append("This file carries the whole mass-spring system of the scene.")
+    return lines
+
+
+def mjcf_text(exp: MssExport) -> str:
+    """The MuJoCo model (MJCF XML) of the MSS; see the module docstring for the mapping."""
+    dim, n = exp.dim, exp.n_nodes
+    lengths = exp.rest_length if len(exp.rest_length) else np.array([1.0])
+    h = float(np.min(lengths))
+    root = ET.Element("mujoco", model=_safe_name(exp.scene.name))
+    for line in _header_lines(exp, "mjcf"):
+        root.append(ET.Comment(f" {_xml_comment(line)} "))
+    root.append(ET.Comment(" Springs: spatial tendons with stiffness k (N/m) and springlength L (m): force "
+                           "k (|x_j - x_i| - L) along the spring. Nodes: bodies with a point mass (the "
+                           "rotational inertia is immaterial, the bodies only slide) and one slide joint per "
+                           "free axis; a node fixed on every axis has no joint (welded to the world). "
+                           "Prescribed displacements (load factor 1) are in the bodies' positions. Loads at "
+                           "load factor 1 are general actuators with a constant force (gainprm 0, affine "
+                           "biasprm F 0 0). The scene's static solve ramps the loads; MuJoCo reaches the same "
+                           "equilibrium when damped to rest. "))
+    ET.SubElement(root, "compiler", angle="radian", autolimits="true")
+    g = np.zeros(3)
+    if exp.gravity is not None:
+        g[:dim] = exp.gravity
+    option = ET.SubElement(root, "option", timestep=_f(time_step(exp)), gravity=_vec(g), integrator="implicitfast")
+    ET.SubElement(option, "flag", contact="disable")
+    world = ET.SubElement(root, "worldbody")
+    pos = _pad3(exp.points + exp.prescribed)
+    alpha = exp.damping[0]
+    for i in range(n):
+        body = ET.SubElement(world, "body", name=f"node{i}", pos=_vec(pos[i]))
+        m = float(exp.masses[i])
+        free = ~exp.fixed[i]
+        if free.any() and not m > 0:
+            raise ValueError(f"node {i} has free axes but mass {m!r} kg: MuJoCo needs a positive mass")
+        if m > 0:
+            inertia = max(m * (0.1 * h) ** 2, 1e-12)
+            ET.SubElement(body, "inertial", pos="0 0 0", mass=_f(m), diaginertia=_vec([inertia] * 3))
+        for a in range(dim):
+            if free[a]:
+                attrs = {"name": f"node{i}_{AXES[a]}", "type": "slide", "axis": _vec(np.eye(3)[a])}
+                if alpha:
+                    attrs["damping"] = _f(alpha * m)
+                ET.SubElement(body, "joint", **attrs)
+        ET.SubElement(body, "site", name=f"node{i}", size=_f(0.05 * h))
+    if dim == 2:
+        world.append(ET.Comment(" 2D model: the nodes slide in the x-y plane only (no z joint) "))
+    if len(exp.pairs):
+        tendon = ET.SubElement(root, "tendon")
+        for s, ((i, j), k, L) in enumerate(zip(exp.pairs, exp.stiffness, exp.rest_length)):
+            sp = ET.SubElement(tendon, "spatial", name=f"spring{s}", stiffness=_f(k), springlength=_f(L),
+                               width=_f(0.01 * h))
+            ET.SubElement(sp, "site", site=f"node{int(i)}")
+            ET.SubElement(sp, "site", site=f"node{int(j)}")
+    forces = [("load", exp.loads)]
+    if exp.correction is not None:
+        forces.append(("baudet_correction", exp.correction.nodal))
+    actuators = []
+    for label, F in forces:
+        for i in range(n):
+            for a in range(dim):
+                if F[i, a] != 0.0 and not exp.fixed[i, a]:
+                    actuators.append(dict(name=f"{label}_node{i}_{AXES[a]}", joint=f"node{i}_{AXES[a]}", gainprm="0",
+                                          biastype="affine", biasprm=f"{_f(F[i, a])} 0 0"))
+    if actuators:
+        act = ET.SubElement(root, "actuator")
+        act.append(ET.Comment(" constant forces (N) at load factor 1: surface loads (load_*) and Baudet's "
+                              "correction (baudet_correction_*) "))
+        for attrs in actuators:
+            ET.SubElement(act, "general", **attrs)
+    ET.indent(root, space=" ")
+    return ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _xml_comment(text: str) -> str:
+    return " ".join(text.split()).replace("--", "- -")
+
+
+# --------------------------------------------------------------------------------------------
+# SOFA
+# --------------------------------------------------------------------------------------------
+
+
+def _sofa(parent, tag, **attrs):
+    spec = SOFA_COMPONENTS.get(tag)
+    if spec is None:
+        raise ValueError(f"SOFA component {tag!r} is not in SOFA_COMPONENTS")
+    bad = [a for a in attrs if a not in spec["attributes"]]
+    if bad:
+        raise ValueError(f"SOFA component {tag}: attributes {bad} are not in SOFA_COMPONENTS")
+    return ET.SubElement(parent, tag, **attrs) if parent is not None else ET.Element(tag, **attrs)
+
+
+def _ints(v) -> str:
+    return " ".join(str(int(x)) for x in v)
+
+
+def sofa_text(exp: MssExport) -> str:
+    """The SOFA scene (XML ``.scn``) of the MSS; every component and attribute is one of
+    :data:`SOFA_COMPONENTS`."""
+    dim, n = exp.dim, exp.n_nodes
+    scene = exp.scene
+    g = np.zeros(3)
+    if exp.gravity is not None:
+        g[:dim] = exp.gravity
+    root = _sofa(None, "Node", name="root", gravity=_vec(g), dt=_f(time_step(exp)))
+    for line in _header_lines(exp, "sofa"):
+        root.append(ET.Comment(f" {_xml_comment(line)} "))
+    _sofa(root, "DefaultAnimationLoop", name="animation")
+    node = _sofa(root, "Node", name="mss")
+    if scene.is_dynamic:
+        alpha, beta = exp.damping
+        node.append(ET.Comment(f" dynamic scene ({scene.solver.get('method')} in msslib): implicit Euler with "
+                               f"the scene's Rayleigh damping C = alpha M + beta K "))
+        _sofa(node, "EulerImplicitSolver", name="ode", rayleighMass=_f(alpha), rayleighStiffness=_f(beta))
+    else:
+        s = scene.solver
+        node.append(ET.Comment(" static scene: Newton (StaticSolver) at the full load in one step; msslib ramps the "
+                               "loads and prescribed displacements over load_steps to the same equilibrium "))
+        _sofa(node, "StaticSolver", name="ode", newton_iterations=str(int(s.get("max_iter", 50))),
+              relative_residual_tolerance_threshold=_f(s.get("tol", 1e-8)),
+              absolute_residual_tolerance_threshold="-1", relative_correction_tolerance_threshold="-1",
+              absolute_correction_tolerance_threshold="-1")
+    _sofa(node, "CGLinearSolver", name="linear", iterations=str(max(1000, 10 * dim * n)), tolerance="1e-20",
+          threshold="1e-30")
+    mesh = exp.setup.mesh
+    topo = {"name": "topology", "position": _vec(exp.points.ravel())}
+    if mesh.cell_type in _SOFA_CELLS:
+        topo[_SOFA_CELLS[mesh.cell_type]] = _ints(mesh.cells.ravel())
+    _sofa(node, "MeshTopology", **topo)
+    template = f"Vec{dim}d"
+    node.append(ET.Comment(" position: rest positions moved by the prescribed displacements (load factor 1) "))
+    _sofa(node, "MechanicalObject", name="dofs", template=template, position=_vec((exp.points + exp.prescribed).ravel()),
+          rest_position=_vec(exp.points.ravel()))
+    node.append(ET.Comment(f" node masses (kg), {exp.mass_source} "))
+    _sofa(node, "DiagonalMass", name="mass", vertexMass=_vec(exp.masses))
+    node.append(ET.Comment(" springs: i j ks kd L per spring (N/m, damping 0, rest length m) "))
+    spring = " ".join(f"{int(i)} {int(j)} {_f(k)} 0 {_f(L)}"
+                      for (i, j), k, L in zip(exp.pairs, exp.stiffness, exp.rest_length))
+    _sofa(node, "SpringForceField", name="springs", spring=spring)
+    full = np.flatnonzero(exp.fixed.all(axis=1))
+    if len(full):
+        _sofa(node, "FixedProjectiveConstraint", name="fixed", indices=_ints(full))
+    partial = exp.fixed.any(axis=1) & ~exp.fixed.all(axis=1)
+    for mask in sorted({tuple(r) for r in exp.fixed[partial].tolist()}):
+        idx = np.flatnonzero(partial & np.all(exp.fixed == np.array(mask), axis=1))
+        label = "".join(a for a, m in zip(AXES, mask) if m)
+        _sofa(node, "PartialFixedProjectiveConstraint", name=f"fixed_{label}", indices=_ints(idx),
+              fixedDirections=_ints(mask))
+    forces = [("loads", exp.loads, "surface loads (N) at load factor 1")]
+    if exp.correction is not None:
+        forces.append(("baudet_correction", exp.correction.nodal, "Baudet's correction forces (N) at load factor 1"))
+    for name, F, what in forces:
+        on = np.flatnonzero(np.any(F != 0, axis=1))
+        if len(on):
+            node.append(ET.Comment(f" {what} "))
+            _sofa(node, "ConstantForceField", name=name, indices=_ints(on), forces=_vec(F[on].ravel()))
+    # the plugins of the components used (DefaultAnimationLoop's is always loaded)
+    used = {e.tag for e in root.iter() if isinstance(e.tag, str)}
+    plugins = sorted({SOFA_COMPONENTS[t]["plugin"] for t in used} - {None, "Sofa.Simulation.Core"})
+    first = next(i for i, e in enumerate(root) if e.tag == "DefaultAnimationLoop")
+    for k, p in enumerate(plugins):
+        root.insert(first + k, _sofa(None, "RequiredPlugin", name=p))
+    ET.indent(root, space=" ")
+    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
