@@ -91,7 +91,10 @@ def _boundary_entry(item):
 
 
 def _source(name, materials, fixed, loads, thickness, solver, checks, options) -> dict:
-    if isinstance(materials, (_scene.Material, Mapping)):
+    if isinstance(materials, Mapping) and materials and not set(materials) <= {"E", "nu", "density"}:
+        # keyed by the mesh's groups: {"soft": Material(...), "stiff": {...}}
+        materials = {key: _material(m) for key, m in materials.items()}
+    elif isinstance(materials, (_scene.Material, Mapping)):
         materials = [materials]
     elif isinstance(materials, tuple):
         materials = list(materials)
@@ -164,7 +167,8 @@ def build_model(name: str, mesh, materials, *, fixed=None, loads=None, thickness
     ----------------------------------------------------------------
     mesh : a :class:`msslib.mesh.Mesh`, a mesh file path, or a scene ``geometry`` mapping.
     materials : a :class:`Material` (``msslib.Material(E, nu, density=None)``) or a mapping
-        ``{E, nu, density}``, or a list of them (material ``i`` for the cells of material index ``i``).
+        ``{E, nu, density}``, or a list of them (material ``i`` for the cells of material index ``i``),
+        or a mapping from the mesh's group names to them (``{"soft": Material(...), ...}``).
     fixed : the ``boundary``: a selection (``"all"``, ``{"plane": ["z", 0.0]}``, ``{"box": ...}``),
         whose nodes are fixed along every axis, or an entry ``{"select": ..., "fix": [...],
         "displacement": [...]}``, or a list of either.

@@ -1440,7 +1440,10 @@ def run_scene(scene, progress=True):
     t0 = time.perf_counter()
     bar = None
     if progress is True:
-        bar = TextProgress(label=scene.name)
+        total = None
+        if scene.is_dynamic:  # time steps per second and the time left
+            total = math.ceil(scene.solver["t_end"] / scene.solver["dt"] - 1e-9) if scene.solver["t_end"] > 0 else None
+        bar = TextProgress(label=scene.name, total=total, unit="steps")
         report: Callable = bar
     elif callable(progress):
         report = progress
