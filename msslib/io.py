@@ -597,9 +597,10 @@ def make_dataset(
 
 
 def _history(history: Mapping, n: int, dim: int):
-    unknown = set(history) - {"time", "step", "displacement", "velocity"}
+    unknown = set(history) - {"time", "step", "displacement", "velocity", "reaction"}
     if unknown:
-        raise ValueError(f"unknown history keys {sorted(unknown)}; expected time, step, displacement, velocity")
+        raise ValueError(f"unknown history keys {sorted(unknown)}; expected time, step, displacement, velocity, "
+                         f"reaction")
     if "time" not in history and "step" not in history:
         raise ValueError("history needs a 'time' or a 'step' array")
     if "displacement" not in history and "velocity" not in history:
@@ -623,6 +624,10 @@ def _history(history: Mapping, n: int, dim: int):
         variables["velocity_history"] = _var(
             (tdim, "node", "axis"), _array(history["velocity"], (n_t, n, dim), "history['velocity']"),
             "m s-1", "node velocity of every stored state")
+    if "reaction" in history:
+        variables["reaction_force_history"] = _var(
+            (tdim, "node", "axis"), _array(history["reaction"], (n_t, n, dim), "history['reaction']"),
+            "N", "support reaction at the nodes of every stored state (zero on free dofs)")
     return coords, variables
 
 

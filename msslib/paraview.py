@@ -17,8 +17,9 @@ decides by the suffix of the path:
       state, at ``t = 0`` for a static result and at the end time ``n_steps * dt`` for a dynamic one.
     * ``OUT_0000.vtu``, ``OUT_0001.vtu``, ... beside it (four digits, more when there are more
       states), the mesh at rest with the point data ``displacement`` (m) of the state,
-      ``velocity`` (m/s) when the result stores velocities, ``reaction_force_final`` (N: results
-      store the reaction of the final state only, so every file carries that one, and says so)
+      ``velocity`` (m/s) when the result stores velocities, ``reaction_force`` (N) of that state
+      when the result stores the reactions of every state (``reaction_force_history``, written by
+      dynamic scene runs), else ``reaction_force_final`` (the final state's, and the name says so),
       and ``fixed``; the cell data ``material``, and ``cell_state`` and ``relative_jacobian`` of
       that state (:func:`msslib.quality.check_state`, at the result's ``collapse_threshold``).
     * ``OUT_springs.vtu`` (results with springs): one line cell (VTK_LINE) per spring between
@@ -174,7 +175,7 @@ def _state_writer(mesh, u, v, reaction, fixed, threshold):
         if v is not None:
             point_data["velocity"] = v
         if reaction is not None:
-            point_data["reaction_force_final"] = reaction
+            point_data[reaction[0]] = reaction[1]
         if fixed is not None:
             point_data["fixed"] = fixed
         check = check_state(mesh, mesh.points + u, threshold=threshold)
@@ -211,7 +212,14 @@ def _stage_series(staged, path, ds) -> list[Path]:
     if not np.all(np.isfinite(times)):
         raise ValueError(f"ParaView series {str(path)!r}: the result's state times are not all finite")
     mesh = _mesh(ds)
-    reaction = _nodes_axes(ds, "reaction_force") if "reaction_force" in ds else None
+    # the reaction of every state when the result stores it, else the final one (and it says so)
+    if "reaction_force_history" in ds and len(times) == ds.sizes.get(ds["reaction_force_history"].dims[0]):
+        history = np.asarray(ds["reaction_force_history"].transpose(..., "node", "axis").values, dtype=float)
+        reactions = [("reaction_force", r) for r in history]
+    elif "reaction_force" in ds:
+        reactions = [("reaction_force_final", _nodes_axes(ds, "reaction_force"))] * len(times)
+    else:
+        reactions = [None] * len(times)
     fixed = _fixed(ds) if "fixed" in ds else None
     from msslib.quality import COLLAPSE_THRESHOLD
 
@@ -219,7 +227,7 @@ def _stage_series(staged, path, ds) -> list[Path]:
     files = series_files(path, len(times), "springs" in ds)
     pvd, state_files = files[0][1], files[1:1 + len(times)]
     for i, (what, dest) in enumerate(state_files):
-        staged.write(dest, _state_writer(mesh, u[i], None if v is None else v[i], reaction, fixed, threshold),
+        staged.write(dest, _state_writer(mesh, u[i], None if v is None else v[i], reactions[i], fixed, threshold),
                      what=what)
     if "springs" in ds:
         what, dest = files[-1]

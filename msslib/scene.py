@@ -1409,7 +1409,9 @@ def _solve_mss_dynamic(setup: Setup, report):
     if setup.scene.output["history"]:
         n_t = len(res.t)
         out["history"] = {"time": res.t, "displacement": (res.x - model.x0).reshape(n_t, n, dim),
-                          "velocity": res.v.reshape(n_t, n, dim)}
+                          "velocity": res.v.reshape(n_t, n, dim),
+                          "reaction": np.stack([model.reaction(x, 1.0) for x in res.x]) if n_t else
+                          np.zeros((0, n, dim))}
         extra = {"kinetic_energy": (("time",), res.kinetic_energy, {"units": "J", "long_name": "kinetic energy"})}
         if res.potential_energy is not None:
             extra["potential_energy"] = (("time",), res.potential_energy,

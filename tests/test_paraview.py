@@ -63,14 +63,15 @@ def assert_series(pvd, ds):
     assert files == [f"{pvd.stem}_{i:04d}.vtu" for i in range(ds.sizes["time"])]
     u_hist = ds["displacement_history"].transpose("time", "node", "axis").values
     v_hist = ds["velocity_history"].transpose("time", "node", "axis").values
-    reaction = ds["reaction_force"].transpose("node", "axis").values
+    r_hist = ds["reaction_force_history"].transpose("time", "node", "axis").values
+    np.testing.assert_array_equal(r_hist[-1], ds["reaction_force"].transpose("node", "axis").values)
     for i, name in enumerate(files):
         state = meshio.read(pvd.parent / name)
         np.testing.assert_array_equal(state.points, ds["rest_position"].values)
         np.testing.assert_array_equal(state.point_data["displacement"], u_hist[i])
         np.testing.assert_array_equal(state.point_data["velocity"], v_hist[i])
-        np.testing.assert_array_equal(state.point_data["reaction_force_final"], reaction)
-        assert "reaction_force" not in state.point_data  # only the final state's reaction exists, and says so
+        np.testing.assert_array_equal(state.point_data["reaction_force"], r_hist[i])  # the reaction of that state
+        assert "reaction_force_final" not in state.point_data
         assert state.cells[0].type == "hexahedron" and len(state.cells[0].data) == ds.sizes["cell"]
     last = meshio.read(pvd.parent / files[-1])
     np.testing.assert_array_equal(last.cell_data["cell_state"][0], ds["cell_state"].values)
@@ -202,3 +203,17 @@ def test_series_is_written_whole_or_not_at_all(tmp_path, capsys, monkeypatch, dy
     assert len(calls) == 3
     assert (tmp_path / "old.pvd").read_text() == "old collection\n"
     assert sorted(os.listdir(tmp_path)) == ["old.pvd", "old_0001.vtu", "swing.nc"]  # no temporary file left
+
+
+def test_first_saved_reaction_carries_the_weight_of_the_clamped_nodes(dynamic):
+    """At rest (t = 0) the springs are unstretched: a support carries exactly its node's weight."""
+    from msslib.scene import load_scene, prepare
+
+    setup = prepare(load_scene(DYNAMIC))
+    r0 = dynamic["reaction_force_history"].isel(time=0).transpose("node", "axis").values
+    clamped = setup.fixed.all(axis=1)
+    expected = -setup.masses[:, None] * setup.gravity[None, :]
+    np.testing.assert_allclose(r0[clamped], expected[clamped], rtol=1e-12, atol=1e-15)
+    assert np.all(r0[~setup.fixed] == 0.0)
+    # later states differ: the body moves and the supports feel it
+    assert np.abs(dynamic["reaction_force_history"].isel(time=-1).values - r0).max() > 1e-3 * np.abs(r0).max()
