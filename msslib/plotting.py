@@ -12,6 +12,10 @@ deformation; this module provides the pieces, for 2D meshes (triangles, quads) a
   reference (interpolated when the meshes differ), and a map of it;
 * :func:`comparison_figure` -- the usual layout: one column per load case, the variant's wireframe
   over the reference coloured by ``|u|`` on top, the error map below;
+* :func:`node_map` -- per-node values as coloured dots on the nodes (over a thin wireframe);
+* :func:`shared_limits`, :func:`pareto_front`, :func:`label_log_axis`, :func:`unique_legend` --
+  one colour scale for compared panels, the non-dominated points of a speed/error plot, log axes
+  whose ticks all carry a plain-number label, legends without duplicate entries;
 * :func:`save` -- write ``STEM.png`` (150 dpi) and ``STEM.pdf`` atomically.
 
 Lengths are drawn in ``length_unit`` (``"m"``, ``"cm"`` or ``"mm"``; default cm, the unit of the
@@ -41,7 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["LENGTH_UNITS", "figure", "deformed_mesh", "node_error", "error_map", "comparison_figure", "save"]
+__all__ = ["LENGTH_UNITS", "figure", "deformed_mesh", "node_error", "error_map", "node_map", "comparison_figure",
+           "shared_limits", "pareto_front", "label_log_axis", "unique_legend", "save"]
 
 #: Scale factors from metres to the supported drawing units.
 LENGTH_UNITS = {"m": 1.0, "cm": 1e2, "mm": 1e3}
@@ -104,6 +109,108 @@ def save(fig, stem, *, dpi: int = 150) -> tuple[Path, Path]:
                 tmp.unlink()
         out.append(path)
     return out[0], out[1]
+
+
+# ---------------------------------------------------------------------------------------------
+# scales, fronts, axes, legends
+# ---------------------------------------------------------------------------------------------
+
+def shared_limits(*arrays, symmetric: bool = False, zero: bool = False) -> tuple[float, float]:
+    """One ``(vmin, vmax)`` over the finite values of all ``arrays``, for panels that are compared
+    on one colour scale.  ``zero=True`` starts the scale at 0 (errors, magnitudes);
+    ``symmetric=True`` centres it on 0 (signed values).  A constant (or empty) set of values gives
+    a non-empty interval, so a colour bar can always be drawn."""
+    vals = [np.asarray(a, dtype=float).ravel() for a in arrays]
+    v = np.concatenate(vals) if vals else np.empty(0)
+    v = v[np.isfinite(v)]
+    lo, hi = (float(v.min()), float(v.max())) if v.size else (0.0, 0.0)
+    if symmetric:
+        m = max(abs(lo), abs(hi))
+        lo, hi = -m, m
+    elif zero:
+        lo, hi = min(lo, 0.0), max(hi, 0.0)
+    if hi <= lo:
+        pad = abs(hi) * 1e-3 or 1e-30
+        lo, hi = (lo - pad if not zero or lo < 0 else lo), hi + pad
+    return lo, hi
+
+
+def pareto_front(x, y) -> np.ndarray:
+    """Indices of the non-dominated points when both ``x`` (e.g. time) and ``y`` (e.g. error) are
+    to be small, in increasing ``x``: point i is kept unless another point is no worse in both
+    and better in one.  Non-finite points are ignored; exact duplicates are kept once."""
+    x, y = np.asarray(x, dtype=float).ravel(), np.asarray(y, dtype=float).ravel()
+    if x.shape != y.shape:
+        raise ValueError(f"x and y must have the same length, got {x.shape} and {y.shape}")
+    idx = np.flatnonzero(np.isfinite(x) & np.isfinite(y))
+    idx = idx[np.lexsort((y[idx], x[idx]))]  # by x, ties by y
+    front, best = [], np.inf
+    for i in idx:
+        if y[i] < best:
+            front.append(i)
+            best = y[i]
+    return np.asarray(front, dtype=np.int64)
+
+
+def _plain(v, _pos=None):
+    if v == 0 or not np.isfinite(v):
+        return "0"
+    e = int(np.floor(np.log10(abs(v)) + 1e-9))
+    if -3 <= e <= 4:
+        return f"{v:.0f}" if e >= 3 else f"{v:.3g}"
+    m = v / 10.0 ** e
+    return f"$10^{{{e}}}$" if np.isclose(m, 1) else f"${m:.3g}\\cdot10^{{{e}}}$"
+
+
+def label_log_axis(ax, which: str = "both"):
+    """Give the log-scaled axes ``which`` (``"x"``, ``"y"`` or ``"both"``) labelled ticks only:
+    the decades (unlabelled minor ticks between them) when the axis spans two decades or more,
+    1, 2 and 5 times the decades when it spans less, evenly spaced round numbers when it spans
+    less than 0.7 decades (so that at least two ticks are always labelled); labels are plain
+    numbers (0.01, 0.5, 10, 15.5) or powers of ten beyond 10^4.  Call after the data are drawn
+    and the limits are set."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter, NullLocator
+
+    for name in ("x", "y") if which == "both" else (which,):
+        axis = getattr(ax, f"{name}axis")
+        if axis.get_scale() != "log":
+            continue
+        lo, hi = sorted(getattr(ax, f"get_{name}lim")())
+        span = np.log10(hi / lo) if lo > 0 else np.inf
+        if span >= 2:
+            axis.set_major_locator(LogLocator(base=10, subs=(1.0,)))
+            axis.set_minor_locator(LogLocator(base=10, subs=np.arange(2, 10)))
+        elif span >= 0.7:
+            axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+            axis.set_minor_locator(NullLocator())
+        else:  # less than a decade: evenly spaced round numbers
+            axis.set_major_locator(MaxNLocator(nbins=5, steps=[1, 2, 2.5, 5, 10]))
+            axis.set_minor_locator(NullLocator())
+        axis.set_major_formatter(FuncFormatter(_plain))
+        axis.set_minor_formatter(NullFormatter())
+
+
+def unique_legend(target, handles=None, labels=None, **kwargs):
+    """A legend on ``target`` (axes or figure) with one entry per label: the first handle with
+    a given label is kept, labels starting with ``_`` (matplotlib's "no label") are dropped.
+    Without ``handles``, they are collected from ``target`` (all its axes for a figure)."""
+    if handles is None:
+        axes = target.axes if hasattr(target, "axes") and isinstance(target.axes, list) else [target]
+        handles, labels = [], []
+        for ax in axes:
+            h, lab = ax.get_legend_handles_labels()
+            handles += h
+            labels += lab
+    elif labels is None:
+        labels = [h.get_label() for h in handles]
+    seen, h_out, l_out = set(), [], []
+    for h, lab in zip(handles, labels):
+        if not lab or lab.startswith("_") or lab in seen:
+            continue
+        seen.add(lab)
+        h_out.append(h)
+        l_out.append(lab)
+    return target.legend(h_out, l_out, **kwargs)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -278,44 +385,98 @@ def error_map(ax, ds, ref_ds, *, plane: str = "yz", length_unit: str = "cm", val
                          vmax=max(vmax, 1e-30), linewidth=0.3)
 
 
+def node_map(ax, ds, values, *, plane: str = "yz", length_unit: str = "cm", value_scale: float = 1e3,
+             cmap="magma_r", vmin=None, vmax=None, deformed: bool = True, magnify: float = 1.0,
+             edgecolor="0.7", size: float = 18.0):
+    """Per-node ``values`` (one per node of ``ds``, times ``value_scale``) as dots coloured by
+    value, on the nodes of the (deformed, displacements times ``magnify``) mesh of ``ds`` over a
+    thin ``edgecolor`` wireframe; in 3D only the nodes of the boundary faces turned towards the
+    viewer are drawn, back to front.  Returns the scatter (for a colour bar)."""
+    X, u, cells, cell_type = _arrays(ds)
+    v = np.asarray(values, dtype=float).ravel()
+    if v.shape != (len(X),):
+        raise ValueError(f"values must have one value per node ({len(X)}), got shape {v.shape}")
+    x = X + magnify * u if deformed else X
+    shown = ds.copy()
+    shown["displacement"] = ds["displacement"] * (magnify if deformed else 0.0)
+    if edgecolor is not None:
+        deformed_mesh(ax, shown, color=edgecolor, plane=plane, length_unit=length_unit, linewidth=0.4, zorder=1)
+    a, b, toward = _plane_axes(plane, X.shape[1])
+    if toward is None:
+        nodes = np.arange(len(X))
+    else:
+        nodes = np.unique(_visible_faces(cells, cell_type, x, toward))
+        nodes = nodes[np.argsort(x[nodes] @ toward, kind="stable")]
+    s = _unit(length_unit)
+    sc = ax.scatter(x[nodes, a] * s, x[nodes, b] * s, c=v[nodes] * value_scale, cmap=cmap, vmin=vmin, vmax=vmax,
+                    s=size, edgecolors="0.3", linewidths=0.3, zorder=3)
+    ax.autoscale_view()
+    _label_axes(ax, a, b, length_unit)
+    return sc
+
+
 def comparison_figure(pairs: dict, *, plane: str = "yz", length_unit: str = "cm", variant_label: str = "MSS",
                       reference_label: str = "FEM", title: str | None = None, panel_width: float = 3.2,
-                      show_rest: bool = True):
+                      panel_height: float | None = None, show_rest: bool = True, magnify: float = 1.0,
+                      node_errors: bool = False):
     """One column per load case: top, the variant's wireframe (red) over the reference coloured
     by ``|u|`` (mm) and the rest shape (grey); bottom, the per-node error map (mm).
 
     ``pairs`` maps a column title (e.g. ``"a) stretch"``) to ``(variant_ds, reference_ds)``.  The
-    displacement colours share one scale (colour bar on the right); every error map has its own
-    colour bar below it, from 0 to its largest error.  Returns the figure.
+    panels of a row are compared, so each row has one colour scale and one colour bar: ``|u|``
+    from 0 to the largest reference displacement, the error from 0 to the largest error of all
+    columns.  ``magnify`` multiplies the drawn displacements (the colours stay true values);
+    ``node_errors=True`` draws the error as one coloured dot per node (:func:`node_map`, on the
+    variant's shape drawn as in the top row) instead of an interpolated filling.  Returns the
+    figure.
     """
     from matplotlib.lines import Line2D
 
     n = len(pairs)
     if n == 0:
         raise ValueError("pairs is empty")
-    fig = figure(figsize=(panel_width * n + 1.2, 2 * panel_width + 1.2))
+    ph = panel_width if panel_height is None else panel_height
+    fig = figure(figsize=(panel_width * n + 1.4, 2 * ph + 1.2))
     axes = fig.subplots(2, n, squeeze=False, sharex="col", sharey="col")
     umax = max(float(np.linalg.norm(r["displacement"].values, axis=-1).max()) for _, r in pairs.values()) * 1e3
-    im = None
+    errs = {name: node_error(var, ref) for name, (var, ref) in pairs.items()}
+    _, emax = shared_limits(*(e * 1e3 for e in errs.values()), zero=True)
+    im = em = None
+
+    def shown(ds):
+        if magnify == 1.0:
+            return ds
+        out = ds.copy()
+        out["displacement"] = ds["displacement"] * magnify
+        return out
+
     for j, (name, (var, ref)) in enumerate(pairs.items()):
         top, bottom = axes[0, j], axes[1, j]
         if show_rest:
             deformed_mesh(top, ref, color="0.7", deformed=False, plane=plane, length_unit=length_unit,
                           linewidth=0.5, zorder=0.5)
-        im = deformed_mesh(top, ref, color="k", colorby="displacement", plane=plane, length_unit=length_unit,
+        u_ref = np.linalg.norm(ref["displacement"].transpose("node", "axis").values, axis=1)
+        im = deformed_mesh(top, shown(ref), color="k", colorby=u_ref, plane=plane, length_unit=length_unit,
                            vmin=0.0, vmax=umax, linewidth=0.4)
-        deformed_mesh(top, var, color="tab:red", plane=plane, length_unit=length_unit, linewidth=1.0, zorder=3)
+        deformed_mesh(top, shown(var), color="tab:red", plane=plane, length_unit=length_unit, linewidth=1.0,
+                      zorder=3)
         top.set_title(name)
         top.set_xlabel("")
-        em = error_map(bottom, var, ref, plane=plane, length_unit=length_unit)
-        fig.colorbar(em, ax=bottom, location="bottom", shrink=0.8, aspect=25,
-                     label=f"|u$_{{{variant_label}}}$ - u$_{{{reference_label}}}$| (mm)")
+        if node_errors:
+            em = node_map(bottom, var, errs[name], plane=plane, length_unit=length_unit, vmin=0.0, vmax=emax,
+                          magnify=magnify)
+        else:
+            em = deformed_mesh(bottom, var, color="0.6", colorby=errs[name], plane=plane, length_unit=length_unit,
+                               cmap="magma_r", vmin=0.0, vmax=emax, linewidth=0.3)
         if j:
             top.set_ylabel("")
             bottom.set_ylabel("")
     fig.colorbar(im, ax=axes[0, :].tolist(), label=f"{reference_label} |u| (mm)", shrink=0.9)
-    handles = [Line2D([], [], color="tab:red", lw=1.0, label=variant_label),
-               Line2D([], [], color="k", lw=0.6, label=f"{reference_label} (colour: |u|)")]
+    fig.colorbar(em, ax=axes[1, :].tolist(), shrink=0.9,
+                 label=f"|u$_{{{variant_label}}}$ - u$_{{{reference_label}}}$| (mm)" + (" per node" if node_errors else ""))
+    mag = f", displacement x{magnify:g}" if magnify != 1.0 else ""
+    handles = [Line2D([], [], color="tab:red", lw=1.0, label=f"{variant_label}{mag}"),
+               Line2D([], [], color="k", lw=0.6, label=f"{reference_label}{mag} (fill colour: |u|)")]
     if show_rest:
         handles.append(Line2D([], [], color="0.7", lw=0.6, label="rest shape"))
     fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), frameon=False)

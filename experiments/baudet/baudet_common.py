@@ -244,53 +244,6 @@ def open_result(path):
         return ds.load()
 
 
-def magnified(ds, factor):
-    out = ds.copy()
-    out["displacement"] = ds["displacement"] * factor
-    return out
-
-
-def shapes_and_errors(pairs, ref, *, plane, magnify, length_unit="mm", title=None, panel=(3.0, 3.0)):
-    """One column per MSS result: top, its wireframe (red) over the FEM reference coloured by the
-    true |u| (mm), displacements magnified ``magnify`` times for the drawing; bottom, the per-node
-    error |u_MSS - u_FEM| (mm) on the MSS mesh (FEM interpolated at the MSS nodes)."""
-    from matplotlib.lines import Line2D
-
-    from msslib import plotting
-
-    n = len(pairs)
-    fig = plotting.figure(figsize=(panel[0] * n + 1.4, 2 * panel[1] + 0.8))
-    axes = fig.subplots(2, n, squeeze=False)
-    u_ref = np.linalg.norm(ref["displacement"].values, axis=-1)
-    umax = float(u_ref.max()) * 1e3
-    errs = {k: plotting.node_error(v, ref) for k, v in pairs.items()}
-    emax = max(float(e.max()) for e in errs.values()) * 1e3
-    ref_m = magnified(ref, magnify)
-    im = em = None
-    for j, (name, ds) in enumerate(pairs.items()):
-        top, bot = axes[0, j], axes[1, j]
-        plotting.deformed_mesh(top, ref, color="0.75", deformed=False, plane=plane, length_unit=length_unit, linewidth=0.4)
-        im = plotting.deformed_mesh(top, ref_m, color=None, colorby=u_ref, plane=plane, length_unit=length_unit,
-                                    vmin=0.0, vmax=umax)
-        plotting.deformed_mesh(top, magnified(ds, magnify), color="tab:red", plane=plane, length_unit=length_unit,
-                               linewidth=0.9)
-        top.set_title(name)
-        em = plotting.deformed_mesh(bot, ds, color="0.6", colorby=errs[name], plane=plane, length_unit=length_unit,
-                                    cmap="magma_r", vmin=0.0, vmax=emax, linewidth=0.3)
-        if j:
-            top.set_ylabel("")
-            bot.set_ylabel("")
-    fig.colorbar(im, ax=axes[0, :].tolist(), label="FEM |u| (mm)", shrink=0.9)
-    fig.colorbar(em, ax=axes[1, :].tolist(), label="|u$_{MSS}$ - u$_{FEM}$| (mm)", shrink=0.9)
-    handles = [Line2D([], [], color="tab:red", lw=1.0, label=f"MSS (displacement x{magnify:g})"),
-               Line2D([], [], color="tab:green", lw=6, alpha=0.5, label=f"FEM, coloured by |u| (x{magnify:g})"),
-               Line2D([], [], color="0.75", lw=0.6, label="rest shape")]
-    fig.legend(handles=handles, loc="outside upper center", ncol=3, frameon=False)
-    if title:
-        fig.suptitle(title)
-    return fig
-
-
 NU_COLORS = {"0.1": "tab:blue", "0.2": "tab:orange", "0.3": "tab:green", "0.4": "tab:red", "0.499": "tab:purple"}
 
 

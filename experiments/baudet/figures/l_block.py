@@ -1,4 +1,4 @@
-"""Baudet Fig. 13: L-shaped block, MSS wireframes over the FEM reference and error maps."""
+"""Baudet Fig. 13: L-shaped block, MSS wireframes over the FEM reference and per-node error maps."""
 
 import sys
 from pathlib import Path
@@ -15,7 +15,8 @@ def main():
     args = C.figure_args(__doc__)
     ref = C.open_result(INPUTS[-1])
     pairs = {f"n = {n} ({3 * n ** 3 // 4} cubes)": C.open_result(p) for n, p in zip(RES, INPUTS[:-1])}
-    fig = C.shapes_and_errors(pairs, ref, plane="xz", magnify=20.0, panel=(3.0, 3.0))
+    fig = plotting.comparison_figure({k: (ds, ref) for k, ds in pairs.items()}, plane="xz", length_unit="mm",
+                                     magnify=20.0, node_errors=True, panel_width=3.0, panel_height=3.0)
     plotting.save(fig, args.out)
 
 

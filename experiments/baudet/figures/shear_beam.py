@@ -15,7 +15,8 @@ def main():
     args = C.figure_args(__doc__)
     ref = C.open_result(INPUTS[-1])
     pairs = {f"{r} cubes": C.open_result(p) for r, p in zip(RES, INPUTS[:-1])}
-    fig = C.shapes_and_errors(pairs, ref, plane="xz", magnify=10.0, panel=(2.2, 4.2))
+    fig = plotting.comparison_figure({k: (ds, ref) for k, ds in pairs.items()}, plane="xz", length_unit="mm",
+                                     magnify=10.0, node_errors=True, panel_width=2.2, panel_height=4.2)
     plotting.save(fig, args.out)
 
 

@@ -2,6 +2,9 @@
 
 import argparse
 
+import matplotlib.ticker
+from matplotlib.lines import Line2D
+
 from msslib import plotting
 from msslib.io import read_result
 
@@ -25,7 +28,7 @@ def main():
         for c in ds.constants.values:
             r = ds.sel(material=m, constants=c)
             kw = dict(color=COLORS[str(c)], ls=STYLES[str(m)], marker="o", ms=3)
-            ax1.plot(A, r.nu_eff, label=f"{LABELS[str(c)]}, target nu = {nu_t:g}", **kw)
+            ax1.plot(A, r.nu_eff, **kw)
             ax2.plot(A, r.G_ratio, **kw)
             ax3.plot(A, r.G45_ratio, **kw)
         ax1.axhline(nu_t, color="0.5", lw=0.8, ls=STYLES[str(m)])
@@ -33,6 +36,8 @@ def main():
         ax.axhline(1.0, color="0.5", lw=0.8)
     for ax in (ax1, ax2, ax3):
         ax.set_xscale("log", base=2)
+        ax.set_xticks(A, [f"{a:g}" for a in A])  # the sampled values, as plain numbers
+        ax.xaxis.set_minor_locator(matplotlib.ticker.NullLocator())
         ax.set_xlabel("A = k_inner / k_face (-)")
     ax1.set_ylabel("effective Poisson's ratio (-)")
     ax2.set_ylabel("G = C44 / target G (-)")
@@ -40,7 +45,12 @@ def main():
     ax1.set_title("uniaxial stress")
     ax2.set_title("simple shear along the cube axes")
     ax3.set_title("pure shear along the face diagonals")
-    ax1.legend(fontsize=6.5, loc="best")
+    # one entry per colour (constants) and per line style (material) drawn, and the target lines
+    handles = [Line2D([], [], color=COLORS[str(c)], marker="o", ms=3, label=LABELS[str(c)]) for c in ds.constants.values]
+    handles += [Line2D([], [], color="k", ls=STYLES[str(m)],
+                       label=f"target nu = {float(ds.nu_target.sel(material=m)):g}") for m in ds.material.values]
+    handles.append(Line2D([], [], color="0.5", lw=0.8, label="target value (grey)"))
+    fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), frameon=False, fontsize=8)
     plotting.save(fig, args.out)
 
 
