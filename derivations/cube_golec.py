@@ -65,6 +65,86 @@ def moduli(C):
 
 
 # %% [markdown]
+# ## How to read the printed k_e, k_f, k_c
+#
+# The paper gives one constant per spring kind, "with l the springs' rest length", and does not say whether
+# a constant belongs to one cube (an edge is shared by up to 4 cubes, a face diagonal by 2, so an interior
+# spring is the sum of its cubes' shares) or is the assembled constant of an interior spring, nor whether l is
+# the cube's edge a or each spring's own rest length (a, sqrt(2) a, sqrt(3) a). The paper's claim to check:
+# the springs alone are "naturally based on nu = 1/4", for any A, and the model simulates isotropic materials.
+
+# %%
+SQ2, SQ3 = sp.sqrt(2), sp.sqrt(3)
+SPRING_READINGS = {  # reading -> per-element (k_e, k_f, k_c) of the lattice
+    "per element, l = a": (PUBLISHED[k_e], PUBLISHED[k_f], PUBLISHED[k_c]),
+    "interior totals, l = a": (PUBLISHED[k_e] / 4, PUBLISHED[k_f] / 2, PUBLISHED[k_c]),
+    "per element, l = own rest length": (PUBLISHED[k_e], SQ2 * PUBLISHED[k_f], SQ3 * PUBLISHED[k_c]),
+    "interior totals, l = own rest length": (PUBLISHED[k_e] / 4, SQ2 * PUBLISHED[k_f] / 2, SQ3 * PUBLISHED[k_c]),
+}
+
+
+@lru_cache(maxsize=None)
+def spring_readings():
+    """Isotropy defect and (E, nu) along an axis of the springs-only lattice under each reading, and the
+    shares (x, y) for which k_e = x k_e^printed, k_f = y k_f^printed, k_c = k_c^printed give an isotropic
+    lattice with the target E for every A (solved, not assumed)."""
+    C, _ = lattice_tensor()
+    out = {}
+    for name, (ke, kf, kc) in SPRING_READINGS.items():
+        Cr = C.subs({kappa: 0, k_e: ke, k_f: kf, k_c: kc}).applyfunc(sp.simplify)
+        E_, nu_, _, _ = el.isotropic_moduli_3d(Cr)
+        out[name] = {"defect": sp.factor(el.is_isotropic(Cr)), "E": sp.factor(E_), "nu": sp.factor(nu_)}
+    x, y = sp.symbols("x y", positive=True)
+    Cs = C.subs({kappa: 0, k_e: x * PUBLISHED[k_e], k_f: y * PUBLISHED[k_f], k_c: PUBLISHED[k_c]}).applyfunc(sp.simplify)
+    eqs = [sp.numer(sp.together(el.is_isotropic(Cs))), sp.numer(sp.together(el.isotropic_moduli_3d(Cs)[0] - E))]
+    coeffs = [c for e in eqs for c in sp.Poly(sp.expand(e), A).coeffs()]  # for every A
+    shares = sp.solve(coeffs, [x, y], dict=True)
+    return out, [(so[x], so[y]) for so in shares]
+
+
+# %% [markdown]
+# ## Units of the printed correction force
+#
+# dV/dP: V = x . (y x z) is homogeneous of degree 3 in the positions, so its gradient has the units of
+# length to the degree read off below; kappa is a modulus (it is lambda - mu, see the exact match).
+
+# %%
+@lru_cache(maxsize=None)
+def correction_force_units():
+    """Dimensions (sympy.physics.units) of kappa (V - V0) dV/dP as printed and of (kappa / V0)(V - V0) dV/dP."""
+    from sympy.physics import units as u
+    lam_ = sp.Symbol("lambda", positive=True)
+    P = [sp.Matrix(sp.symbols(f"p{i}_:3", real=True)) for i in range(8)]
+    V = mss.hex_averaged_volume(P)
+    grad = sp.Matrix([sp.diff(V, c) for c in P[0]])
+    scaled = grad.subs({c: lam_ * c for q in P for c in q}, simultaneous=True)
+    ratio = {sp.simplify(sv / g) for sv, g in zip(scaled, grad) if g != 0}
+    (r,) = ratio
+    deg_grad = sp.degree(r, lam_)  # dV/dP scales as length**deg_grad
+    deg_V = sp.degree(sp.simplify(V.subs({c: lam_ * c for q in P for c in q}, simultaneous=True) / V), lam_)
+    printed = u.pressure * u.length**deg_V * u.length**deg_grad
+    corrected = u.pressure / u.length**deg_V * u.length**deg_V * u.length**deg_grad
+    printed_unit = u.convert_to(u.pascal * u.meter**deg_V * u.meter**deg_grad, [u.newton, u.meter])
+    return {"deg_V": deg_V, "deg_grad": deg_grad, "printed": printed, "corrected": corrected,
+            "printed_unit": printed_unit}
+
+
+def unit_text(q) -> str:
+    """'N m^3' for newton*meter**3 (plain text for the erratum)."""
+    from sympy.physics import units as u
+    parts = []
+    for sym, name in ((u.newton, "N"), (u.meter, "m")):
+        e = sp.degree(q, sym) if q.has(sym) else 0
+        parts += [name if e == 1 else f"{name}^{e}"] if e else []
+    return " ".join(parts)
+
+
+def _txt(e) -> str:
+    """An expression as plain text for an erratum ('16 E (4 nu + 1)/(36 nu + 23)')."""
+    return str(e).replace("**", "^").replace("*", " ")
+
+
+# %% [markdown]
 # ## Exact match of the lattice with (lambda, mu), k_c = A k_f
 
 # %%
@@ -108,23 +188,36 @@ def derive() -> Derivation:
         ("derived kappa", f"\\kappa = {sp.latex(sp.factor(s[kappa]))}"),
         ("springs alone", f"{defect} = {sp.latex(springs_only['isotropy defect C11-C12-2C44'])},\\ "
                           f"\\nu_{{\\text{{lattice}}}} = {sp.latex(springs_only['E,nu,G,K'][1])}"),
-        ("printed constants read per element", f"{defect} = {sp.latex(pub_per_element['isotropy defect C11-C12-2C44'])},\\ "
-                                               f"\\nu_{{\\text{{lattice}}}} = {sp.latex(sp.factor(pub_per_element['E,nu,G,K'][1]))}"),
-        ("printed constants read as interior totals", f"{defect} = {sp.latex(pub_totals['isotropy defect C11-C12-2C44'])},\\ "
-                                                      f"E_{{\\text{{lattice}}}} = {sp.latex(pub_totals['E,nu,G,K'][0])},\\ \\nu_{{\\text{{lattice}}}} = {sp.latex(pub_totals['E,nu,G,K'][1])}"),
         ("shear modulus with printed constants", f"\\mu = {sp.latex(mu_pub)}\\ \\text{{vs}}\\ {sp.latex(mu)}"),
     ]
     d.data.update(solution=s, lattice=C, springs_only=springs_only, published_per_element=pub_per_element,
                   published_totals=pub_totals, mu_published=mu_pub, C_published=C_pub)
+    rd, shares = spring_readings()
+    units = correction_force_units()
+    d.findings += [(f"printed springs read '{n}' (kappa = 0)",
+                    f"{defect} = {sp.latex(v['defect'])},\\ E_{{\\text{{axis}}}} = {sp.latex(v['E'])},\\ "
+                    f"\\nu_{{\\text{{axis}}}} = {sp.latex(v['nu'])}") for n, v in rd.items()]
+    d.data.update(spring_readings=rd, spring_shares=shares, correction_units=units)
     d.errata += [
-        Erratum("Golec et al. (2017)", "spring constants k_e, k_f (Sec. 2)",
+        Erratum("Golec et al. (2017)", "spring constants k_e, k_f (Sec. 2; ambiguous: per cube or per interior spring)",
                 r"k_e = \left(\tfrac{8}{3}A + 1\right)\frac{E l}{\tfrac{10}{3}A + 2.5},\ k_f = \frac{E l}{\tfrac{10}{3}A + 2.5}",
-                f"k_e = {sp.latex(s[k_e])},\\ k_f = {sp.latex(s[k_f])}\\ \\text{{(per element)}}",
-                "The printed k_e and k_f are the assembled constants of an interior spring (an edge is shared by 4 cubes, "
-                "a face diagonal by 2), while k_c (inner diagonal, one cube) is per element. Used per element, as a "
-                "simulator summing over elements would, the lattice is anisotropic (C11 - C12 - 2 C44 != 0) and its nu "
-                "depends on A; read as interior totals they give an isotropic lattice with nu = 1/4 and the right E. "
-                "Boundary springs must get the per-element share only.",
+                f"k_e = {sp.latex(s[k_e])},\\ k_f = {sp.latex(s[k_f])}\\ \\text{{(per element; interior spring: }}"
+                f"4 k_e,\\ 2 k_f\\text{{)}}",
+                "The paper does not say whether its constants belong to one cube (a simulator sums them over the up to 4 "
+                "cubes sharing an edge and the 2 sharing a face diagonal) or are the assembled constants of an interior "
+                "spring, nor whether l is the cube edge a or each spring's own rest length. Springs only (kappa = 0): "
+                f"per cube with l = a, the lattice is anisotropic (C11 - C12 - 2 C44 = {_txt(rd['per element, l = a']['defect'])}) "
+                f"with nu = {_txt(rd['per element, l = a']['nu'])} along an axis (between 1/10 and 1/5, depending on A); "
+                f"per cube or as totals with l the own rest length, it is anisotropic for every A > 0 "
+                f"(defects {_txt(rd['per element, l = own rest length']['defect'])} and "
+                f"{_txt(rd['interior totals, l = own rest length']['defect'])}, which vanish only at negative A); as interior "
+                f"totals with l = a, it is isotropic with E_lattice = {_txt(rd['interior totals, l = a']['E'])} and "
+                f"nu = {_txt(rd['interior totals, l = a']['nu'])} for every A. "
+                f"The per-element shares that make the printed constants isotropic with the target E for every A are "
+                f"solved to be exactly {shares[0][0]} (edge) and {shares[0][1]} (face), i.e. the interior-total reading. "
+                "The paper's own claims (springs 'naturally based on nu = 1/4', A free, isotropic material) support "
+                "only that reading. A simulator must then give each cube k_e/4 and k_f/2, so that a boundary spring "
+                "gets only the shares of its cubes.",
                 "tests/test_derivations.py::test_golec_spring_reading"),
         Erratum("Golec et al. (2017)", "spring constants for nu != 1/4",
                 r"k \propto E", r"k \propto \tfrac{5}{2}\mu = \tfrac{5 E}{4 (1 + \nu)}",
@@ -136,7 +229,9 @@ def derive() -> Derivation:
         Erratum("Golec et al. (2017)", "correction force (Sec. 2)",
                 r"\vec F_{P_2} = \kappa (V - V_0) \frac{\partial V}{\partial P_2}",
                 r"\vec F_{P_2} = -\frac{\kappa}{V_0} (V - V_0) \frac{\partial V}{\partial P_2}",
-                "With kappa a modulus [Pa], kappa (V - V0) dV/dP has units Pa m^5 = N m^4, not N; the force of the energy "
+                f"With kappa a modulus [Pa], (V - V0) [m^{units['deg_V']}] and dV/dP [m^{units['deg_grad']}] "
+                f"(V is cubic in the positions), kappa (V - V0) dV/dP has units Pa m^{units['deg_V'] + units['deg_grad']} "
+                f"= {unit_text(units['printed_unit'])}, not N; the force of the energy "
                 "kappa/(2 V0)(V - V0)^2 (density kappa/2 (tr eps)^2, i.e. + kappa on lambda) is -(kappa/V0)(V - V0) dV/dP "
                 "(restoring: minus sign). The printed gradient dV/dB is also garbled; the kernel differentiates "
                 "V = x . (y x z) exactly.",

@@ -164,6 +164,38 @@ def test_baudet_correction_factor():
     assert -strain[0] / strain[2] == pytest.approx(vals[nu])
 
 
+def test_baudet_eq8_readings():
+    d = cube_baudet.derive()
+    rd = d.data["eq8_readings"]
+    face, node, pair = rd["face"], rd["node"], rd["node, pair"]
+    # what each reading of F_i / F_perp must be (the resultant per orthogonal face is -(4 nu - 1)/2 F)
+    assert is_zero(face["derived"] + (4 * nu - 1) / 2)
+    assert is_zero(node["derived"] + (4 * nu - 1) / 8)
+    assert is_zero(node["derived"] - cube_baudet.tension(False)[0][0][cube_baudet.alpha])  # per-node load, solved directly
+    assert is_zero(pair["derived"] - cube_baudet.PUBLISHED["alpha"])  # printed 1/16 exact only here
+    assert is_zero(face["derived"] / cube_baudet.PUBLISHED["alpha"] - 8)
+    assert is_zero(pair["E_eff"] - E) and is_zero(pair["nu_eff"] - nu)
+    # the formulas the erratum states for the printed 1/16 applied under the other readings
+    assert is_zero(face["E_eff"] - 16 * E * (4 * nu + 1) / (36 * nu + 23))
+    assert is_zero(face["nu_eff"] - (8 * nu**2 + 2 * nu + 7) / (36 * nu + 23))
+    assert is_zero(node["E_eff"] - 4 * E * (4 * nu + 1) / (12 * nu + 5))
+    assert is_zero(node["nu_eff"] - (8 * nu**2 + 2 * nu + 1) / (12 * nu + 5))
+    # the paper's numbers: small-strain errors must stay below its 10 %-strain E errors (falling with nu) and
+    # its 5 % nu bound; the first two readings exceed both at nu = 0.4, 0.5 and grow with nu
+    for r in (face, node):
+        errs_E, errs_nu = [], []
+        for n, published in cube_baudet.PUBLISHED_ERRORS.items():
+            eE = abs(r["E_eff"] / E - 1).subs(nu, n)
+            enu = abs(r["nu_eff"] / nu - 1).subs(nu, n)
+            errs_E.append(eE); errs_nu.append(enu)
+            if n > sp.Rational(3, 10):
+                assert eE > published and enu > sp.Rational(5, 100)
+        assert errs_E == sorted(errs_E) and errs_nu == sorted(errs_nu)  # growing with nu; the paper's fall
+    assert list(cube_baudet.PUBLISHED_ERRORS.values()) == sorted(cube_baudet.PUBLISHED_ERRORS.values(), reverse=True)
+    e = next(e for e in d.errata if "eq. 8" in e.where)
+    assert "6-17 %" in e.explanation and "21-51 %" in e.explanation
+
+
 def test_baudet_bulk_modulus_and_lattice():
     B_with, B_without = cube_baudet.inflation()
     assert is_zero(B_with - E / (3 * (1 - 2 * nu)))
@@ -188,6 +220,25 @@ def test_golec_spring_reading():
     assert not is_zero(per["isotropy defect C11-C12-2C44"])
     assert is_zero(tot["isotropy defect C11-C12-2C44"])
     assert is_zero(tot["E,nu,G,K"][0] - E) and tot["E,nu,G,K"][1] == QUARTER
+    A = cube_golec.A
+    rd, shares = d.data["spring_readings"], d.data["spring_shares"]
+    # per cube, l = a: anisotropic, nu along an axis between 1/10 and 1/5 depending on A
+    r = rd["per element, l = a"]
+    assert is_zero(r["nu"] - (2 * A + 3) / (5 * (4 * A + 3)))
+    assert is_zero(r["defect"] - 12 * E * (4 * A + 1) / (5 * (4 * A + 3)))
+    assert r["nu"].subs(A, 0) == sp.Rational(1, 5) and sp.limit(r["nu"], A, sp.oo) == sp.Rational(1, 10)
+    assert sp.diff(r["nu"], A).subs(A, 1) < 0 and sp.solve(sp.diff(r["nu"], A), A) == []  # monotone
+    Ar = sp.Symbol("A_r", real=True)  # A without its sign assumption: the roots must all be negative
+    assert sp.solve(sp.numer(sp.together(r["defect"].subs(A, Ar))), Ar) == [-QUARTER]
+    # l = each spring's own rest length: isotropic only at A < 0
+    for name in ("per element, l = own rest length", "interior totals, l = own rest length"):
+        roots = sp.solve(sp.numer(sp.together(rd[name]["defect"].subs(A, Ar))), Ar)
+        assert len(roots) == 1 and float(roots[0]) < 0
+        assert not is_zero(rd[name]["defect"].subs(A, 1))
+    # interior totals, l = a: isotropic, target E, nu = 1/4 for all A; these shares are the only ones
+    r = rd["interior totals, l = a"]
+    assert is_zero(r["defect"]) and is_zero(r["E"] - E) and r["nu"] == QUARTER
+    assert shares == [(QUARTER, sp.Rational(1, 2))]
 
 
 def test_golec_exact_lattice():
@@ -204,13 +255,21 @@ def test_golec_exact_lattice():
 
 
 def test_golec_correction_dimensions():
-    from sympy.physics.units import force, length, pressure
+    from sympy.physics import units as u
     from sympy.physics.units.systems.si import dimsys_SI as ds
     deps = ds.get_dimensional_dependencies
-    printed = pressure * length**3 * length**2  # kappa (V - V0) dV/dP
-    corrected = pressure / length**3 * length**3 * length**2  # kappa / V0 (V - V0) dV/dP
-    assert deps(printed) != deps(force)
-    assert deps(corrected) == deps(force)
+    d = cube_golec.derive()
+    units = d.data["correction_units"]
+    assert units["deg_V"] == 3 and units["deg_grad"] == 2  # read off the kernel's V = x . (y x z)
+    # printed kappa (V - V0) dV/dP: Pa m^3 m^2 = N m^3 (not N, not N m^4)
+    assert deps(units["printed"]) == deps(u.force * u.length**3)
+    assert deps(units["printed"]) != deps(u.force) and deps(units["printed"]) != deps(u.force * u.length**4)
+    assert sp.simplify(units["printed_unit"] - u.newton * u.meter**3) == 0
+    assert deps(units["corrected"]) == deps(u.force)
+    # the erratum's text states the unit that was computed
+    e = next(e for e in d.errata if e.where.startswith("correction force"))
+    assert "= N m^3, not N" in e.explanation and "N m^4" not in e.explanation
+    assert cube_golec.unit_text(u.newton * u.meter**4) == "N m^4"  # a wrong unit would be rendered (and fail)
     # the energy kappa/(2 V0)(V - V0)^2 has energy density kappa/2 (tr eps)^2: +kappa on lambda
     kap = sp.Symbol("kappa")
     C, _ = lattice.effective_tensor([mss.hex_volume_term(range(8), kap)], cube_golec.COORDS, cube_golec.a**3)

@@ -1,5 +1,5 @@
 # Generated from derivations/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: e32e688e0a0322b1f37a07e2f4fc48c24db819f47b5b4182d186346d65b99ff6
+# source-sha256: 5857373880752f48cfce384efb288f53c84ca00bf736c7b9cf360e1f69ac2576
 # body-sha256: 27a48c1508e2c336a6de6ee220c683003e0ac46e9e9f1ac653a3e8238d975b82
 """Cube with edge, face and inner springs and volume correction (Golec et al.).
 
