@@ -23,6 +23,8 @@ QUICK = bool(int(config.get("quick", 0)))
 QFLAG = "--quick" if QUICK else ""
 PAPERS = ["lloyd", "baudet", "golec", "performance", "summary"]
 DERIVATIONS = ["triangle", "square", "rectangle", "tetrahedron", "cube_baudet", "cube_golec", "kernels"]
+# the derivation modules as notebooks: one HTML page each, beside the paper (linked as derivations/<module>.html)
+NOTEBOOKS = [f"paper/build/derivations/{m}.html" for m in DERIVATIONS]
 ENGINE = ["__init__", "elasticity", "fem", "mss", "match", "lattice", "records", "codegen", "report"]
 SCENES = sorted(glob_wildcards("experiments/scenes/{name}.yaml").name)
 # every result depends on the library that computed it: a change in msslib reruns what it touches
@@ -80,6 +82,7 @@ rule all:
     input:
         "paper/build/paper.html",
         "paper/build/paper.pdf",
+        NOTEBOOKS,
         expand("results/scenes/{name}.nc", name=SCENES),
 
 
@@ -279,3 +282,20 @@ rule paper_pdf:
         "logs/paper_pdf.log",
     shell:
         "python -m msslib.paper pdf {input.markdown} --out {output.pdf} > {log} 2>&1"
+
+
+rule derivation_notebook:
+    """One derivation module as a notebook page: its cells run in order, prose as text, code with
+    what it showed (matrices, equations, solution, checks) as MathML; one self-contained HTML file."""
+    input:
+        module="derivations/{module}.py",
+        engine=expand("derivations/{m}.py", m=ENGINE + ["show", "notebook"]),
+        code="msslib/paper.py",
+    output:
+        "paper/build/derivations/{module}.html",
+    wildcard_constraints:
+        module="|".join(DERIVATIONS),
+    log:
+        "logs/derivations/{module}.log",
+    shell:
+        "python -m derivations.notebook {wildcards.module} --out {output} > {log} 2>&1"

@@ -22,7 +22,7 @@ from functools import lru_cache
 import sympy as sp
 
 from derivations import elasticity as el
-from derivations import lattice, mss
+from derivations import fem, lattice, mss, show
 from derivations.elasticity import E, nu
 from derivations.fem import _REF
 from derivations.records import Derivation, Erratum, Formula
@@ -73,6 +73,21 @@ def shear():
 
 
 # %% [markdown]
+# Baudet et al. match no element matrices: the model is fitted through experiments on one element,
+# i.e. through the element's Voigt tensor C (below, for the cube) against the isotropic D.
+
+# %%
+if __name__ == "__main__":
+    show.math(r"D", el.elasticity_matrix("3d"))
+    show.math(r"C_{\text{MSS}}", element_tensor())
+    show.math(r"C_{44} = G", sp.Eq(element_tensor()[3, 3], el.lame()[1]))
+    per_plane_kd, kd_cube = shear()
+    show.solution(r"k_d\ \text{per shear plane (parallelepiped)}", {sp.Symbol(f"k_d^{{{n}}}"): v for n, v in per_plane_kd.items()})
+    show.math(r"k_d\ \text{(cube)}", kd_cube)
+    show.check(r"k_d = \frac{3 E a}{8 (1 + \nu)}\ \text{(eq. 7)}", sp.simplify(kd_cube - 3 * E * a / (8 * (1 + nu))) == 0)
+
+
+# %% [markdown]
 # ## Tension with the correction force: k_x and the correction amplitude
 #
 # A tensile force F on the faces normal to z, and correction forces F_perp = alpha F on each face
@@ -114,6 +129,20 @@ def inflation():
     return B_with, B_without
 
 
+# %%
+if __name__ == "__main__":
+    (sol_t,), (E_eff_t, nu_eff_t) = tension()
+    show.math(r"E_{\text{eff}}", E_eff_t)
+    show.math(r"\nu_{\text{eff}}", nu_eff_t)
+    show.equations(r"E_{\text{eff}} = E,\ \nu_{\text{eff}} = \nu", [sp.numer(sp.together(E_eff_t - E)), sp.numer(sp.together(nu_eff_t - nu))])
+    show.solution(r"\text{solution}", sol_t)
+    show.check(r"k_x = \frac{E a (4 \nu + 1)}{8 (1 + \nu)}\ \text{(eq. 8)}", sp.simplify(sol_t[k_x] - E * a * (4 * nu + 1) / (8 * (1 + nu))) == 0)
+    B_w, B_wo = inflation()
+    show.math(r"B_{\text{with correction}}", sp.factor(B_w))
+    show.math(r"B_{\text{without correction}}", sp.factor(B_wo))
+    show.check(r"B_{\text{with correction}} = \frac{E}{3 (1 - 2 \nu)}", sp.simplify(B_w - E / (3 * (1 - 2 * nu))) == 0)
+
+
 # %% [markdown]
 # ## What an assembled lattice of such cubes does
 #
@@ -128,6 +157,30 @@ def assembled_lattice():
     E_l, nu_l, G_l, K_l = el.isotropic_moduli_3d(C)
     return C, {"isotropy defect": el.is_isotropic(C), "nu_lattice": sp.factor(nu_l), "C44": sp.simplify(C[3, 3]),
                "uniaxial E along an axis": sp.factor(sp.simplify((C[0, 0] - C[0, 1]) * (C[0, 0] + 2 * C[0, 1]) / (C[0, 0] + C[0, 1])))}
+
+
+# %%
+if __name__ == "__main__":
+    C_lat, lat_moduli = assembled_lattice()
+    show.math(r"C_{\text{lattice}}", C_lat)
+    show.solution(r"\text{the lattice's moduli}", {sp.Symbol(r"C_{11} - C_{12} - 2 C_{44}"): sp.factor(lat_moduli["isotropy defect"]),
+                                                   sp.Symbol(r"\nu_{\text{lattice}}"): lat_moduli["nu_lattice"],
+                                                   sp.Symbol(r"E_{\text{axis}}"): lat_moduli["uniaxial E along an axis"]})
+
+
+# %% [markdown]
+# For orientation, the element matrices themselves (24 x 24, dofs x0, y0, z0, x1, ... in VTK order):
+# the trilinear hexahedron and the springs with the derived constants (the correction force is a load,
+# not a stiffness). Shown: the rows of node 0 against nodes 0 and 1.
+
+# %%
+if __name__ == "__main__":
+    (sol_t,), _ = tension()
+    cube = coords((a, a, a))
+    K_hex = fem.element_stiffness("hexahedron", cube, "3d")
+    K_springs = mss.stiffness_at_rest(terms((sol_t[k_x],) * 3, shear()[1]), cube).applyfunc(sp.factor)
+    show.matrix(r"K_{\text{FEM}}", K_hex, rows=slice(0, 3), cols=slice(0, 6))
+    show.matrix(r"K_{\text{MSS}}", K_springs, rows=slice(0, 3), cols=slice(0, 6))
 
 
 PUBLISHED = {"k_d": 3 * E * a / (8 * (1 + nu)), "k_x": E * a * (4 * nu + 1) / (8 * (1 + nu)),

@@ -22,7 +22,7 @@ from functools import lru_cache
 import sympy as sp
 
 from derivations import elasticity as el
-from derivations import lattice, match, mss
+from derivations import fem, lattice, match, mss, show
 from derivations.elasticity import E, nu
 from derivations.fem import _REF
 from derivations.records import Derivation, Erratum, Formula
@@ -155,6 +155,21 @@ def exact():
     return match.match_exact(D, C.subs(k_c, A * k_f), (k_e, k_f, kappa))
 
 
+# %%
+if __name__ == "__main__":
+    C_abstract, sigma0_abstract = lattice_tensor()
+    show.math(r"D", el.elasticity_matrix("3d"))
+    show.math(r"C_{\text{MSS}}", C_abstract)
+    show.math(r"\sigma_0^T", sigma0_abstract.T)
+    show.equations(r"D = C_{\text{MSS}}\ (k_c = A k_f)", exact().equations)
+    (s_exact,) = exact().solutions
+    show.solution(r"\text{solution}", {x: sp.factor(v) for x, v in s_exact.items()})
+    C_at = C_abstract.subs({k_c: A * k_f}).subs(s_exact).applyfunc(sp.simplify)
+    show.check(r"C_{\text{MSS}} - D = 0\ \text{at the solution, for every}\ A",
+               (C_at - el.elasticity_matrix("3d")).applyfunc(sp.simplify) == sp.zeros(6, 6))
+    show.check(r"\kappa = \lambda - \mu", sp.simplify(s_exact[kappa] - (el.lame()[0] - el.lame()[1])) == 0)
+
+
 @lru_cache(maxsize=None)
 def derive() -> Derivation:
     C, sigma0 = lattice_tensor()
@@ -238,6 +253,24 @@ def derive() -> Derivation:
                 "tests/test_derivations.py::test_golec_correction_dimensions"),
     ]
     return d
+
+
+# %% [markdown]
+# For orientation, the element matrices themselves (24 x 24, dofs x0, y0, z0, x1, ... in VTK order):
+# the trilinear hexahedron, and the springs with the derived constants (kappa = 0; the volume energy adds
+# a rank-one term). Shown: the rows of node 0 against nodes 0 and 1. The match above is done on the
+# lattice tensor, not on these matrices.
+
+# %%
+if __name__ == "__main__":
+    d = derive()
+    sol = d.data["solution"]
+    show.matrix(r"K_{\text{FEM}}", fem.element_stiffness("hexahedron", COORDS, "3d"), rows=slice(0, 3), cols=slice(0, 6))
+    K_springs = mss.stiffness_at_rest(terms(sol[k_e], sol[k_f], sol[k_c]), COORDS).applyfunc(sp.factor)
+    show.matrix(r"K_{\text{MSS}}", K_springs, rows=slice(0, 3), cols=slice(0, 6), what="springs only")
+    show.math(r"\mu_{\text{printed constants}}", d.data["mu_published"])
+    show.check(r"\mu_{\text{printed constants}} \ne \mu = \frac{E}{2 (1 + \nu)}",
+               sp.simplify(d.data["mu_published"] - el.lame()[1]) != 0)
 
 
 # %%

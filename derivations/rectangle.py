@@ -26,7 +26,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from derivations import fem, lattice, match, mss
+from derivations import fem, lattice, match, mss, show
 from derivations.elasticity import E, elasticity_matrix, nu, t
 from derivations.records import Derivation, Formula
 
@@ -119,6 +119,20 @@ def zero_entry_conditions():
             if cond not in out and -cond not in out:
                 out.append(cond)
     return out
+
+
+# %%
+if __name__ == "__main__":
+    show.matrix(r"K_{\text{FEM}}", stiffness_fem())
+    show.matrix(r"K_{\text{MSS}}", stiffness_mss(), what="six prestrained springs")
+    show.equations(r"K_{\text{FEM}} = K_{\text{MSS}}", exact().equations)
+    (s_exact,) = exact().solutions
+    show.solution(r"\text{solution}", s_exact)
+    show.equations(r"\text{Gröbner basis, last two elements}", groebner_certificate(True).exprs[-2:])
+    show.check(r"K_{\text{FEM}} - K_{\text{MSS}} = 0\ \text{at the solution}",
+               (stiffness_fem() - stiffness_mss()).subs(s_exact).applyfunc(sp.simplify) == sp.zeros(8, 8))
+    show.math(r"\text{Gröbner basis without prestrain}", r"\{" + ",\ ".join(sp.latex(g) for g in groebner_certificate(False).exprs) + r"\}")
+    show.equations(r"\text{without prestrain, structural zeros of}\ K_{\text{MSS}}\ \text{demand}", zero_entry_conditions())
 
 
 # %% [markdown]
@@ -250,6 +264,20 @@ def positivity_interval(fit):
     return lo, hi
 
 
+# %%
+if __name__ == "__main__":
+    show.matrix(r"S^T K_{\text{FEM}} S", to_symmetry_frame(stiffness_fem()), what="the FEM matrix in the symmetry-adapted frame")
+    show.matrix(r"S^T K_{\text{MSS}} S", to_symmetry_frame(stiffness_mss_linear()), what="the springs in (p, q)")
+    show.solution(r"\text{equilibrium at rest}", equilibrium_condition())
+    for label, eq in ((r"\text{least squares}\ (\nu = 1/3)", False), (r"\text{least squares in equilibrium}\ (\nu = 1/3)", True)):
+        fit_ = least_squares_fit(NU_LLOYD, eq)
+        show.solution(label, {**dict(zip(K_SYM, fit_["k"])), **dict(zip(C_SYM, fit_["c"]))})
+        show.math(r"\epsilon_{\text{rel}}(r)", fit_["relative_residual"])
+        show.check(r"\nabla \lVert K_{\text{FEM}} - K_{\text{MSS}} \rVert_F^2 = 0\ \text{at the optimum}",
+                   all(sp.simplify(g) == 0 for g in fit_["ls"].gradient))
+    show.math(r"f_{\text{rest}}^T\ \text{(free fit)}", forces(least_squares_fit(NU_LLOYD)).T)
+
+
 # %% [markdown]
 # ## Lattice check
 #
@@ -286,6 +314,16 @@ def lattice_agreement(C):
             else:
                 differ[(i, j)] = d
     return agree, differ
+
+
+# %%
+if __name__ == "__main__":
+    for name, eq in (("least squares", False), ("least squares in equilibrium", True)):
+        C_, sigma0_ = lattice_check(eq)
+        show.note(f"Lattice of the {name} springs:")
+        show.math(r"C_{\text{lattice}}", C_)
+        show.math(r"\sigma_0^T", sigma0_.T)
+    show.math(r"D_{\text{plane stress}}(\nu = 1/3)", elasticity_matrix("plane_stress", E, NU_LLOYD))
 
 
 # %% [markdown]

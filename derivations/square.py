@@ -18,7 +18,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from derivations import fem, lattice, match, mss
+from derivations import fem, lattice, match, mss, show
 from derivations.elasticity import E, elasticity_matrix, nu, t
 from derivations.records import Derivation, Formula
 
@@ -49,6 +49,14 @@ def without_prestrain():
     return match.match_exact(K_fem(), mss.stiffness_at_rest(springs(k_e, k_d), COORDS), (k_e, k_d), (nu_c,))
 
 
+# %%
+if __name__ == "__main__":
+    show.matrix(r"K_{\text{FEM}}", K_fem())
+    show.matrix(r"K_{\text{MSS}}", mss.stiffness_at_rest(springs(k_e, k_d), COORDS), what="springs without prestrain")
+    show.equations(r"K_{\text{FEM}} = K_{\text{MSS}}", without_prestrain().equations)
+    show.check(r"\text{no solution}\ (k_e, k_d, \nu)", not without_prestrain().exists)
+
+
 # %% [markdown]
 # ## With prestrain: the exact match and its conditions
 
@@ -57,6 +65,18 @@ def without_prestrain():
 def with_prestrain():
     return match.match_exact(K_fem(), mss.stiffness_at_rest(springs(k_e, k_d, c_e, c_d), COORDS),
                              (k_e, k_d, c_e, c_d), (nu_c,))
+
+
+# %%
+if __name__ == "__main__":
+    K_pre = mss.stiffness_at_rest(springs(k_e, k_d, c_e, c_d), COORDS)
+    show.matrix(r"K_{\text{MSS}}", K_pre, what="prestrained springs, rest length c times the rest distance")
+    show.equations(r"K_{\text{FEM}} = K_{\text{MSS}}", with_prestrain().equations)
+    (s,) = with_prestrain().solutions
+    show.solution(r"\text{solution}", s)
+    show.matrix(r"K_{\text{FEM}} = K_{\text{MSS}}", K_fem().subs(s).applyfunc(sp.simplify), what="at the solution")
+    show.check(r"K_{\text{FEM}} - K_{\text{MSS}} = 0\ \text{at the solution}",
+               (K_fem() - K_pre).subs(s).applyfunc(sp.simplify) == sp.zeros(8, 8))
 
 
 # %% [markdown]
@@ -100,6 +120,17 @@ def derive() -> Derivation:
     d.data.update(solution=s, forces_at_rest=f_rest, tensions=tensions, lattice=C, sigma0=sigma0,
                   no_prestrain=without_prestrain())
     return d
+
+
+# %%
+if __name__ == "__main__":
+    d = derive()
+    show.math(r"f_{\text{rest}}^T", d.data["forces_at_rest"].T)
+    show.solution(r"\text{spring tensions at rest}", {sp.Symbol(_tension_tex(n)): v for n, v in d.data["tensions"].items()})
+    show.math(r"C_{\text{lattice}}", d.data["lattice"])
+    show.math(r"\sigma_0^T", d.data["sigma0"].T)
+    show.check(r"C_{\text{lattice}} = D_{\text{plane stress}}(\nu = 1/3)",
+               (d.data["lattice"] - elasticity_matrix("plane_stress", E, sp.Rational(1, 3))).applyfunc(sp.simplify) == sp.zeros(3, 3))
 
 
 # %%

@@ -18,7 +18,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from derivations import fem, match, mss
+from derivations import fem, match, mss, show
 from derivations.elasticity import E, nu
 from derivations.records import Derivation, Erratum, Formula
 
@@ -56,6 +56,14 @@ def symmetric_blocks_condition():
     return sp.solve(list(eqs), nu, dict=True)
 
 
+# %%
+if __name__ == "__main__":
+    show.matrix(r"K_{\text{FEM}}", K_fem(), what="the linear tetrahedron, dofs (x0, y0, z0, x1, ...)")
+    K01 = K_fem()[0:3, 3:6]
+    show.math(r"K_{01} - K_{01}^T", (K01 - K01.T).applyfunc(sp.factor))
+    show.solution(r"K_{ij} = K_{ij}^T\ \text{for all blocks}", symmetric_blocks_condition()[0])
+
+
 # %% [markdown]
 # ## Least squares, six independent springs (eq. 12)
 
@@ -73,6 +81,20 @@ def exact_springs_only():
     return match.match_exact(K_fem().subs(nu, sp.Symbol("nu_c", real=True)), K_mss, (k,), (sp.Symbol("nu_c", real=True),))
 
 
+# %%
+if __name__ == "__main__":
+    show.matrix(r"K_{\text{MSS}}", mss.stiffness_at_rest([mss.spring(i, j, kk) for (i, j), kk in zip(PAIRS, ks)], COORDS),
+                what="six independent springs")
+    show.equations(r"K_{\text{FEM}} = K_{\text{MSS}}\ (\text{one}\ k)", exact_springs_only().equations)
+    show.check(r"\text{no exact solution}\ (k, \nu)", not exact_springs_only().exists)
+    ls = springs_only()
+    show.solution(r"\text{least squares}", {x: sp.factor(v) for x, v in ls.solution.items()})
+    show.math(r"\epsilon_{\text{rel}}", sp.factor(ls.relative_residual))
+    show.check(r"\nabla \lVert K_{\text{FEM}} - K_{\text{MSS}} \rVert_F^2 = 0\ \text{at the optimum}",
+               all(sp.simplify(g) == 0 for g in ls.gradient))
+    show.check(r"\text{Hessian positive definite}", match.is_positive_definite(ls.hessian))
+
+
 # %% [markdown]
 # ## With Lloyd's volume energy k_V/(2 V0^2) (V - V0)^2 (eq. 14)
 
@@ -85,6 +107,18 @@ def with_volume():
 
 # equivalent edge length from the volume (eq. 13)
 L_HAT = (12 * V / sp.sqrt(2)) ** sp.Rational(1, 3)
+
+
+# %%
+if __name__ == "__main__":
+    terms_v = [mss.spring(i, j, k) for i, j in PAIRS] + [mss.tet_volume_term(range(4), k_V)]
+    show.matrix(r"K_{\text{MSS}}", mss.stiffness_at_rest(terms_v, COORDS), rows=slice(0, 6), cols=slice(0, 6),
+                what="one spring constant k and the volume energy, nodes 0 and 1")
+    lv = with_volume()
+    show.solution(r"\text{least squares}", {x: sp.factor(v) for x, v in lv.solution.items()})
+    show.math(r"\epsilon_{\text{rel}}", sp.factor(lv.relative_residual))
+    show.check(r"\nabla \lVert K_{\text{FEM}} - K_{\text{MSS}} \rVert_F^2 = 0\ \text{at the optimum}",
+               all(sp.simplify(g) == 0 for g in lv.gradient))
 
 
 # %%
@@ -134,6 +168,17 @@ def derive() -> Derivation:
         "used, and k_V < 0 (an energy that rewards volume change) for nu < 3/13.",
         "tests/test_derivations.py::test_tetrahedron_volume_eq14_reading"))
     return d
+
+
+# %%
+if __name__ == "__main__":
+    d = derive()
+    show.check(r"k(\nu = 1/4) = \frac{2\sqrt{2}}{25} l E\ \text{(eq. 12)}",
+               sp.simplify(d.formulas[0].outputs["k"] - 2 * sp.sqrt(2) / 25 * l * E) == 0)
+    f14 = d.formulas[2].outputs
+    show.check(r"(k, k_V)(\nu = 1/4) = \left(\frac{2\sqrt{2}}{21} l E \frac{4}{5},\ \frac{\sqrt{2}}{84} l^3 E \frac{2}{5}\right)\ \text{(eq. 14 read as products)}",
+               sp.simplify(f14["k"].subs(nu, QUARTER) - d.data["eq14"][0]) == 0
+               and sp.simplify(f14["k_volume"].subs(nu, QUARTER) - d.data["eq14"][1]) == 0)
 
 
 # %%

@@ -20,7 +20,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from derivations import fem, lattice, match, mss
+from derivations import fem, lattice, match, mss, show
 from derivations.elasticity import E, elasticity_matrix, nu, t
 from derivations.records import Derivation, Erratum, Formula
 
@@ -40,12 +40,41 @@ def springs(ks):
 # ## Exact match
 
 # %%
+COORDS = [(0, 0), (a, 0), (x2, y2)]
+
+
+@lru_cache(maxsize=None)
+def K_fem():
+    """6x6 plane-stress CST stiffness, nu free (``nu_c``); dofs (x0, y0, x1, y1, x2, y2)."""
+    return fem.element_stiffness("triangle", COORDS, "plane_stress").subs(nu, nu_c)
+
+
+@lru_cache(maxsize=None)
+def K_mss():
+    """Linearised stiffness of the three springs at rest."""
+    return mss.stiffness_at_rest(springs(k), COORDS)
+
+
 @lru_cache(maxsize=None)
 def exact():
-    coords = [(0, 0), (a, 0), (x2, y2)]
-    K_fem = fem.element_stiffness("triangle", coords, "plane_stress").subs(nu, nu_c)
-    K_mss = mss.stiffness_at_rest(springs(k), coords)
-    return match.match_exact(K_fem, K_mss, k, (nu_c, x2, y2))
+    return match.match_exact(K_fem(), K_mss(), k, (nu_c, x2, y2))
+
+
+# %% [markdown]
+# The two matrices, the equations K_FEM = K_MSS (numerators of the entries' differences), their only
+# solution, and both matrices at that solution.
+
+# %%
+if __name__ == "__main__":
+    show.matrix(r"K_{\text{FEM}}", K_fem())
+    show.matrix(r"K_{\text{MSS}}", K_mss())
+    show.equations(r"K_{\text{FEM}} = K_{\text{MSS}}", exact().equations)
+    (s,) = exact().solutions
+    show.solution(r"\text{solution}", s)
+    K_at = K_fem().subs(s).applyfunc(sp.simplify)
+    show.matrix(r"K_{\text{FEM}} = K_{\text{MSS}}", K_at)
+    show.check(r"K_{\text{FEM}} - K_{\text{MSS}} = 0\ \text{at the solution}",
+               (K_at - K_mss().subs(s)).applyfunc(sp.simplify) == sp.zeros(6, 6))
 
 
 # %% [markdown]
@@ -67,6 +96,16 @@ def lattice_check():
     coords = [(0, 0), (a, 0), (a / 2, sp.sqrt(3) * a / 2)]
     C, s0 = lattice.effective_tensor(springs([kk] * 3), coords, sp.sqrt(3) / 4 * a**2 * t)
     return C, s0
+
+
+# %%
+if __name__ == "__main__":
+    show.check(r"k_{\text{van Gelder}} = \frac{\sqrt{3}}{4} E t \frac{A_e}{A_0}\ \text{(Lloyd eq. 9)}",
+               sp.simplify(VAN_GELDER - LLOYD_EQ9) == 0)
+    C_lat, s0_lat = lattice_check()
+    show.math(r"C_{\text{lattice}}", C_lat)
+    show.check(r"C_{\text{lattice}} = D_{\text{plane stress}}(\nu = 1/3)",
+               (C_lat - elasticity_matrix("plane_stress", E, sp.Rational(1, 3))).applyfunc(sp.simplify) == sp.zeros(3, 3))
 
 
 # %%

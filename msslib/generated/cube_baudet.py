@@ -1,5 +1,5 @@
 # Generated from derivations/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 1668d655148cc762f1eeb7c6924f80f8f49ae34d9a00282493088282ac89e1f3
+# source-sha256: abc85281fd1c91c1236f7beaf81846e175b65840ee4b41f02fe4c658642c8c5a
 # body-sha256: a35ff5265d287f0040075799752d846c04cfcc02c51cc80aa3045cf95055a64d
 """Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.).
 

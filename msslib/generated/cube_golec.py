@@ -1,5 +1,5 @@
 # Generated from derivations/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 5857373880752f48cfce384efb288f53c84ca00bf736c7b9cf360e1f69ac2576
+# source-sha256: 48e6382c03ac0e98548b6daa821b9fc84ed8bb63fc581530b74273be85d73357
 # body-sha256: 27a48c1508e2c336a6de6ee220c683003e0ac46e9e9f1ac653a3e8238d975b82
 """Cube with edge, face and inner springs and volume correction (Golec et al.).
 

@@ -1,5 +1,5 @@
 // Generated from derivations/ by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 3665d615006a745e3e631ac218c017824c23d406d52359eb8cd22093cad798f8
+// source-sha256: a3482487f48e97bcf813af674b8e238b6a6ed2b563d838dbd97c8c52b2117f24
 // body-sha256: 5ceba7b2a30e6d690d2d5155aca5c1712604068917890b031bb7363351837576
 /* Spring constants, rest-length factors, volume coefficients and the energy, gradient and
  * Hessian kernels of msslib's mass-spring models, in C99.

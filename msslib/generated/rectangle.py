@@ -1,5 +1,5 @@
 # Generated from derivations/rectangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 0e5543ff856c9bc12ef418b03183b731ffd7be002ec0af387fd5631c732de067
+# source-sha256: fd7421382c91cdefac01a432604392f1ab0c7b8e510b546a95b3208d5f63f72f
 # body-sha256: a12cb5a0f8c951f64d4017cf31409c8628780887755be05ccb4859e5988cfd00
 """Rectangle of aspect ratio r, plane stress, six prestrained springs (generalising Lloyd et al. Sec. 4.1).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 6994b30138988a7e17af29b5a52acd3ac38e4b7ee413b025f72c724bbe7a2060
+# source-sha256: c0069f9f6eb5a78a05fa70496f1202aaaf0f27c52251913c1f32c13bc7b6e248
 # body-sha256: 7ecb914d1852416401807e86d947e0367f8126e72b51da001538baf27e8712cf
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 

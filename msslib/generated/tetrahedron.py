@@ -1,5 +1,5 @@
 # Generated from derivations/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: bebf7704e13541908d40b2db3c68dd63c2f4094080c960f1b4a30d5df78382b2
+# source-sha256: 11640693c13ed3ffe5c4ee54f681aece245e04121c2ff8e0f9b437708fdf1364
 # body-sha256: 5716b40384f04f492eacbd021bad8b372a273de563323bb760142807fd1ce70c
 """Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/triangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: f7c1a1ffdd525bb3a27067b692257bc118992f05ca5859211c60896f34255eef
+# source-sha256: 3f66ca96955156fe7cbad8f6629de3b00e6197115b582e69663d5e890b262d9b
 # body-sha256: c6ba7510b590fab05b555a4882f6db07bb64bbe5ac2fa7a67658d8e149997bb2
 """Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9).
 

@@ -1,0 +1,141 @@
+"""Render a derivation module (a jupytext percent-format notebook) as one self-contained HTML page.
+
+    python -m derivations.notebook triangle --out paper/build/derivations/triangle.html
+
+The module's cells run in order in one namespace, as ``__main__`` (as in Jupyter). A markdown cell
+(``# %% [markdown]``) becomes Markdown text; a code cell becomes a code block followed by what it
+showed: the math of :mod:`derivations.show` as ``$$...$$`` and its printed output as a text block.
+The Markdown goes through :func:`msslib.paper.render_html` (pandoc, math as MathML, no script), the
+same path as the paper's HTML. The pages are written beside the paper (``paper/build/derivations/``),
+so the paper links them as ``derivations/<module>.html``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import re
+import sys
+from contextlib import redirect_stdout
+from pathlib import Path
+
+from derivations import show
+
+HERE = Path(__file__).resolve().parent
+CELL = re.compile(r"^# %%(.*)$")
+
+
+def cells(source: str):
+    """``(kind, text, first_line)`` of each cell (``kind`` is ``"markdown"`` or ``"code"``; lines
+    count from 1). Text before the first cell (the jupytext header) is left out."""
+    out, kind, lines, start = [], None, [], 0
+    for n, line in enumerate(source.splitlines(), 1):
+        m = CELL.match(line)
+        if m:
+            if kind is not None:
+                out.append((kind, lines, start))
+            kind = "markdown" if "[markdown]" in m.group(1) else "code"
+            lines, start = [], n + 1
+        elif kind is not None:
+            lines.append(line)
+    if kind is not None:
+        out.append((kind, lines, start))
+    result = []
+    for kind, lines, start in out:
+        if kind == "markdown":
+            text = "\n".join(re.sub(r"^# ?", "", ln) if ln.startswith("#") else ln for ln in lines)
+        else:
+            text = "\n".join(lines)
+        if text.strip():
+            result.append((kind, text.strip("\n"), start))
+    return result
+
+
+class _Capture(io.TextIOBase):
+    """Stdout that appends ``("text", ...)`` to the list the show helpers collect into, so that
+    printed and shown output keep their order."""
+
+    def __init__(self, items):
+        self.items = items
+
+    def writable(self):
+        return True
+
+    def write(self, s):
+        self.items.append(("text", s))
+        return len(s)
+
+
+def _fence(text: str, info: str = "") -> str:
+    ticks = "```"
+    while ticks in text:
+        ticks += "`"
+    return f"{ticks}{info}\n{text}\n{ticks}"
+
+
+def _outputs(items) -> list[str]:
+    """Markdown blocks from the collected items: runs of printed text become one text block."""
+    blocks, text = [], []
+    for kind, s in items + [("end", "")]:
+        if kind == "text":
+            text.append(s)
+            continue
+        joined = "".join(text).strip("\n")
+        if joined.strip():
+            blocks.append(_fence(joined, "text"))
+        text = []
+        if kind == "md":
+            blocks.append(s)
+    return blocks
+
+
+def to_markdown(module: str) -> str:
+    """Run ``derivations/<module>.py`` cell by cell and return the notebook as Markdown."""
+    path = HERE / f"{module}.py"
+    source = path.read_text(encoding="utf-8")
+    namespace = {"__name__": "__main__", "__file__": str(path), "__builtins__": __builtins__}
+    parts = []
+    for kind, text, start in cells(source):
+        if kind == "markdown":
+            parts.append(text)
+            continue
+        parts.append(_fence(text, "python"))
+        code = compile("\n" * (start - 1) + text + "\n", str(path), "exec")  # tracebacks name the module's lines
+        items: list = []
+        with show.collecting(items), redirect_stdout(_Capture(items)):
+            exec(code, namespace)
+        parts += _outputs(items)
+    return "\n\n".join(parts) + "\n"
+
+
+def render(module: str) -> str:
+    """The notebook of ``derivations/<module>.py`` as a standalone HTML page."""
+    from msslib.paper import render_html
+
+    return render_html(to_markdown(module))
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m derivations.notebook", description=__doc__.splitlines()[0])
+    p.add_argument("module", help="derivation module, e.g. triangle")
+    p.add_argument("--out", "-o", required=True, help="HTML file")
+    p.add_argument("--markdown", help="also write the Markdown here")
+    args = p.parse_args(argv)
+    if not (HERE / f"{args.module}.py").is_file():
+        print(f"no derivation module derivations/{args.module}.py", file=sys.stderr)
+        return 2
+    markdown = to_markdown(args.module)
+    if args.markdown:
+        Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.markdown).write_text(markdown, encoding="utf-8")
+    from msslib.paper import render_html
+
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(render_html(markdown), encoding="utf-8")
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
