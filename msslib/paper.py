@@ -9,10 +9,20 @@ Placeholders (in ``paper/*.md.in`` and the files they include):
     the figure ``figures/NAME.png`` (made by the workflow) with its caption;
 ``{{value FILE VAR [DIM=LABEL ...] [scale=S] [fmt=F]}}``
     a number read from the NetCDF result ``FILE`` (relative to the project root): variable or
-    attribute ``VAR``, selected by labels, multiplied by ``S``, formatted with ``F`` (default .3g).
+    attribute ``VAR``, selected by labels, multiplied by ``S``, formatted with ``F`` (default .3g);
+``{{claim CONDITION | TEXT}}``
+    ``TEXT`` (which may hold ``{{value ...}}`` placeholders), after checking that ``CONDITION``
+    holds; ``{{claim CONDITION}}`` checks and prints nothing. ``CONDITION`` compares numbers:
+    ``[FILE VAR DIM=LABEL ... scale=S]`` is a result value as in ``{{value}}`` (unformatted),
+    with number literals, ``+ - * /``, ``abs``, ``min``, ``max``, the comparisons (chained:
+    ``a > b > c``), ``and``, ``or`` and ``not``; e.g. ``abs([f.nc E]/[f.nc E_ref] - 1) < 0.05``.
 
 Numbers in the text therefore come from results: a missing file, variable or label is an error,
-never a blank. The filled Markdown (``paper/build/paper.md``, figures linked as
+never a blank. A sentence that interprets numbers ("the error halves with every refinement") is
+written as a claim, so a change of the results that makes it false fails the build. The one
+exception is a quick build (``--config quick=1``), whose reduced runs make some claims vacuous (one
+resolution for three): a false claim whose result files, or the run files beside them, carry the
+attribute ``quick = 1`` is printed with the mark "[not met by the reduced quick-build results]" instead. The filled Markdown (``paper/build/paper.md``, figures linked as
 ``../figures/NAME.png``) is then rendered twice::
 
     python -m msslib.paper fill paper/paper.md.in --out paper/build/paper.md
@@ -51,6 +61,12 @@ from pathlib import Path
 from msslib.io import write_text
 
 PLACEHOLDER = re.compile(r"\{\{\s*(include|figure|value)\s+(.*?)\s*\}\}", re.S)
+#: a claim, matched after the other placeholders (including those in its text) are filled
+CLAIM = re.compile(r"\{\{\s*claim\s+(.*?)\s*\}\}", re.S)
+#: a result value in a claim's condition: ``[FILE VAR DIM=LABEL ...]``
+CLAIM_VALUE = re.compile(r"\[([^\[\]]+)\]")
+#: mark of a false claim on quick results
+QUICK_MARK = " [not met by the reduced quick-build results]"
 
 #: pandoc's Markdown reader: CommonMark (what the sources are written in) with dollar math, pipe
 #: tables, attributes and figures (an image alone in a paragraph, its alt text the caption); list
@@ -116,6 +132,93 @@ def _value(root: Path, spec: str) -> str:
     return format(val * scale, fmt)
 
 
+def _is_quick(path: Path) -> bool:
+    """Whether ``path`` holds quick-build results: its attribute ``quick``, or that of the run
+    files beside it (a comparison file is made from the runs in its directory)."""
+    import xarray as xr
+
+    for f in [path, *sorted(path.parent.glob("*.nc"))]:
+        with xr.open_dataset(f) as ds:
+            if "quick" in ds.attrs:
+                return bool(int(ds.attrs["quick"]))
+    return False
+
+
+def _evaluate(node, values):
+    """Evaluate the condition's syntax tree: numbers, value names, arithmetic, abs/min/max,
+    comparisons and boolean operators; anything else is an error."""
+    import ast
+    import operator as op
+
+    binary = {ast.Add: op.add, ast.Sub: op.sub, ast.Mult: op.mul, ast.Div: op.truediv}
+    compare = {ast.Lt: op.lt, ast.LtE: op.le, ast.Gt: op.gt, ast.GtE: op.ge, ast.Eq: op.eq, ast.NotEq: op.ne}
+    if isinstance(node, ast.Expression):
+        return _evaluate(node.body, values)
+    if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
+        return float(node.value)
+    if isinstance(node, ast.Name) and node.id in values:
+        return values[node.id]
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
+        return -_evaluate(node.operand, values)
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.Not):
+        return not _evaluate(node.operand, values)
+    if isinstance(node, ast.BinOp) and type(node.op) in binary:
+        return binary[type(node.op)](_evaluate(node.left, values), _evaluate(node.right, values))
+    if isinstance(node, ast.BoolOp):
+        results = [_evaluate(v, values) for v in node.values]
+        return all(results) if isinstance(node.op, ast.And) else any(results)
+    if isinstance(node, ast.Compare) and all(type(o) in compare for o in node.ops):
+        left = _evaluate(node.left, values)
+        for o, c in zip(node.ops, node.comparators):
+            right = _evaluate(c, values)
+            if not compare[type(o)](left, right):
+                return False
+            left = right
+        return True
+    if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in ("abs", "min", "max")
+            and node.args and not node.keywords):
+        args = [_evaluate(a, values) for a in node.args]
+        return {"abs": abs, "min": min, "max": max}[node.func.id](*args)
+    raise ValueError(f"not allowed in a claim: {ast.dump(node)[:80]}")
+
+
+def _claim(root: Path, arg: str) -> str:
+    """Check a claim's condition (see the module's docstring) and return its text."""
+    import ast
+
+    condition, _, text = (s.strip() for s in arg.partition("|"))
+    values, files = {}, []
+
+    def name(m):
+        spec = m.group(1).strip()
+        parts = spec.split()
+        if len(parts) < 2:
+            raise ValueError(f"{{{{claim {condition}}}}}: [{spec}]: expected [FILE VAR DIM=LABEL ...]")
+        files.append(root / parts[0])
+        key = f"_v{len(values)}"
+        values[key] = float(_value(root, spec + " fmt=.17g"))
+        return key
+
+    expression = CLAIM_VALUE.sub(name, condition)
+    try:
+        tree = ast.parse(expression, mode="eval")
+    except SyntaxError as exc:
+        raise ValueError(f"{{{{claim {condition}}}}}: not a condition ({exc.msg})") from None
+    try:
+        holds = _evaluate(tree, values)
+    except ValueError as exc:
+        raise ValueError(f"{{{{claim {condition}}}}}: {exc}") from None
+    if holds is True or (holds is not False and bool(holds)):
+        return text
+    shown = ", ".join(f"[{m.group(1).strip()}] = {values[f'_v{i}']:.6g}"
+                      for i, m in enumerate(CLAIM_VALUE.finditer(condition)))
+    if any(_is_quick(f) for f in files):
+        print(f"claim not met by quick results: {condition} ({shown})", file=sys.stderr)
+        return text + QUICK_MARK if text else ""
+    raise ValueError(f"false claim: {{{{claim {condition}}}}} with {shown or 'no result values'}"
+                     + (f"; text: {text!r}" if text else ""))
+
+
 def _figure(paper_dir: Path, arg: str) -> str:
     name, _, caption = (s.strip() for s in arg.partition("|"))
     if not (paper_dir / "figures" / f"{name}.png").is_file():
@@ -142,7 +245,8 @@ def expand(text: str, paper_dir: Path, root: Path, depth: int = 0) -> str:
             return _figure(paper_dir, arg)
         return _value(root, arg)
 
-    return PLACEHOLDER.sub(repl, text)
+    text = PLACEHOLDER.sub(repl, text)
+    return CLAIM.sub(lambda m: _claim(root, m.group(1)), text)
 
 
 def title_of(markdown_text: str, default: str = "msslib") -> str:

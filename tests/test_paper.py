@@ -217,3 +217,56 @@ def test_html_screenshot_offline(tmp_path):
         # text and the embedded red figure are drawn: dark pixels and red pixels
         assert gray.getextrema()[0] < 80
         assert (200, 30, 30) in {c for _, c in img.convert("RGB").getcolors(maxcolors=1 << 20)}
+
+
+CLAIMS = """## Claims
+
+{{claim [results/demo.nc E_error level=eps10] > [results/demo.nc E_error level=eps05] | The error at 10 % strain,
+{{value results/demo.nc E_error level=eps10 scale=100 fmt=.2f}} %, exceeds that at 5 %.}}
+{{claim abs([results/demo.nc E_error level=eps05 scale=100] - 1.23) < 0.01 and 0 < 1 < 2}}
+"""
+
+
+def test_claim_that_holds_prints_its_text(tmp_path):
+    source = make_paper(tmp_path, CLAIMS)
+    text = paper.fill(source, tmp_path / "paper" / "build" / "paper.md").read_text(encoding="utf-8")
+    assert "The error at 10 % strain,\n4.56 %, exceeds that at 5 %." in text
+    assert "claim" not in text and "[results" not in text and "{{" not in text
+
+
+@pytest.mark.parametrize("condition", [
+    "[results/demo.nc E_error level=eps10] < [results/demo.nc E_error level=eps05]",
+    "abs([results/demo.nc E_error level=eps05] / 0.0456 - 1) < 0.05",
+    "0.01 < [results/demo.nc E_error level=eps05] < 0.012",
+])
+def test_false_claim_fails_the_build(tmp_path, condition):
+    source = make_paper(tmp_path, f"{{{{claim {condition} | A sentence.}}}}\n")
+    with pytest.raises(ValueError, match="false claim"):
+        paper.fill(source, tmp_path / "paper" / "build" / "paper.md")
+    assert paper.main(["fill", str(source), "--out", str(tmp_path / "out.md")]) == 1
+
+
+@pytest.mark.parametrize("condition", [
+    "__import__('os').getcwd() == 0",
+    "[results/demo.nc E_error level=eps05].real > 0",
+    "[results/demo.nc E_error level=eps05] ** 2 > 0",
+    "[results/demo.nc] > 0",
+    "[results/demo.nc E_error level=eps05] >",
+])
+def test_claim_condition_is_restricted(tmp_path, condition):
+    source = make_paper(tmp_path, f"{{{{claim {condition}}}}}\n")
+    with pytest.raises(ValueError):
+        paper.fill(source, tmp_path / "paper" / "build" / "paper.md")
+
+
+def test_false_claim_on_quick_results_is_marked(tmp_path):
+    import xarray as xr
+
+    source = make_paper(tmp_path, "{{claim [results/demo.nc E_error level=eps10] < 0 | Negative.}}\n")
+    path = tmp_path / "results" / "demo.nc"
+    with xr.open_dataset(path) as ds:
+        ds = ds.load()
+    ds.attrs["quick"] = 1
+    ds.to_netcdf(path)
+    text = paper.fill(source, tmp_path / "paper" / "build" / "paper.md").read_text(encoding="utf-8")
+    assert "Negative." + paper.QUICK_MARK in text
