@@ -12,6 +12,8 @@ import pytest
 import xarray as xr
 import yaml
 
+from cli_helpers import assert_refused
+from cli_helpers import run_cli as _cli
 from msslib import cli, planning
 from msslib import parameters as P
 from msslib.io import write_result
@@ -159,20 +161,6 @@ def test_scene_loader_accepts_numbers_written_as_strings():
 
 def _files(directory):
     return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in directory.iterdir() if p.is_file()}
-
-
-def _cli(capsys, *argv):
-    code = cli.main([str(a) for a in argv])
-    return code, capsys.readouterr().err
-
-
-def assert_refused(code, err, *names):
-    lines = err.splitlines()
-    assert code == 1, err
-    assert len(lines) == 1, err
-    assert lines[0].startswith("msslib: error:"), err
-    for name in names:
-        assert str(name) in lines[0], (name, err)
 
 
 @pytest.fixture

@@ -18,6 +18,8 @@ import textwrap
 import pytest
 import yaml
 
+from cli_helpers import assert_refused
+from cli_helpers import run_cli as _cli
 from msslib import cli
 from msslib import experiment as EXP
 from msslib import mesh as M
@@ -56,21 +58,6 @@ def _snapshot(directory):
 def _temporaries(directory):
     return sorted(name for root, _, files in os.walk(directory) for name in files
                   if "msslib-tmp" in name or "msslib-bak" in name or name.endswith(".tmp"))
-
-
-def _cli(capsys, *argv):
-    code = cli.main([str(a) for a in argv])
-    return code, capsys.readouterr().err
-
-
-def assert_refused(code, err, *names):
-    lines = err.splitlines()
-    assert code == 1, err
-    assert len(lines) == 1, err
-    assert lines[0].startswith("msslib: error:"), err
-    for name in names:
-        assert str(name) in lines[0], (name, err)
-    assert "msslib-tmp" not in err
 
 
 @pytest.fixture(scope="module")
