@@ -178,7 +178,7 @@ def _col(name, unit, values, description="", dtype=float):
 class MssExport:
     """Everything that defines a scene's mass-spring system (SI units, rest configuration).
 
-    ``points`` (n, dim) rest positions; ``masses`` (n,); ``fixed`` (n, dim) bool and
+    ``points`` (n, dim) rest positions (the mesh's); ``masses`` (n,); ``fixed`` (n, dim) bool and
     ``prescribed`` (n, dim) displacements at load factor 1; ``pairs`` (s, 2), ``stiffness`` (s,),
     ``rest_length`` (s,); ``tet_volume`` / ``hex_volume`` / ``correction`` the model's
     :class:`msslib.terms.TetVolume`, :class:`~msslib.terms.HexVolume`,
@@ -189,7 +189,6 @@ class MssExport:
     scene: object
     setup: object
     model: object
-    points: np.ndarray
     masses: np.ndarray
     mass_source: str
     fixed: np.ndarray
@@ -207,12 +206,17 @@ class MssExport:
     _time_step: float | None = field(default=None, repr=False)
 
     @property
+    def points(self) -> np.ndarray:
+        """Rest positions (n, dim), the mesh's."""
+        return self.setup.mesh.points
+
+    @property
     def dim(self) -> int:
-        return self.points.shape[1]
+        return self.setup.mesh.dim
 
     @property
     def n_nodes(self) -> int:
-        return len(self.points)
+        return self.setup.mesh.n_nodes
 
     @property
     def volume_terms(self) -> list[str]:
@@ -284,7 +288,7 @@ def from_setup(setup) -> MssExport:
         d = scene.solver.get("damping", 0.0)
         damping = (float(d), 0.0) if np.ndim(d) == 0 else (float(d[0]), float(d[1]))
     gravity = None if setup.gravity is None else np.asarray(setup.gravity, dtype=float)
-    return MssExport(scene=scene, setup=setup, model=model, points=np.asarray(setup.mesh.points, dtype=float),
+    return MssExport(scene=scene, setup=setup, model=model,
                      masses=masses, mass_source=source, fixed=np.asarray(setup.fixed, dtype=bool).reshape(-1, dim),
                      prescribed=np.asarray(setup.prescribed, dtype=float).reshape(-1, dim), pairs=pairs,
                      stiffness=k, rest_length=rest, tet_volume=tet, hex_volume=hexv, correction=corr,
