@@ -198,7 +198,7 @@ def build_model(name: str, mesh, materials, *, fixed=None, loads=None, thickness
 
 
 def _var(dims, data, units, long_name):
-    """``units``: UDUNITS strings as in :mod:`msslib.io`; None for indices (not quantities)."""
+    """``units``: UDUNITS strings as in :mod:`msslib.schema`; None for indices (not quantities)."""
     return (dims, data, {"long_name": long_name} if units is None else {"units": units, "long_name": long_name})
 
 
@@ -286,7 +286,7 @@ def _run(model, kind: str, given: dict, output: dict | None, progress):
 def solve_static(model, *, load_steps=None, tol=None, max_iter=None, progress=True):
     """Solve ``model`` (from :func:`build_model`) statically, as ``run`` solves a scene with
     ``solver: {type: static, ...}`` (the arguments given override the model's ``solver``), and
-    return the result dataset (:mod:`msslib.io` schema).  ``progress``: see
+    return the result dataset (:mod:`msslib.schema`).  ``progress``: see
     :func:`msslib.scene.run_scene`."""
     return _run(model, "static", {"load_steps": load_steps, "tol": tol, "max_iter": max_iter}, None, progress)
 

@@ -30,7 +30,7 @@ Inputs and outputs: an output that is one of the command's inputs (the scene, it
 experiment, the result or front read) or another of its outputs is refused before anything runs
 (same resolved path, or :func:`os.path.samefile`: hard and symbolic links too); a ParaView series
 is refused before the run when a file it writes beside the ``.pvd`` would be an input.  A command that
-writes several files writes them together (:class:`msslib.io.StagedOutputs`): all are replaced,
+writes several files writes them together (:class:`msslib.staging.StagedOutputs`): all are replaced,
 or none is; temporary files are removed on any error, on SIGINT and on SIGTERM.
 
 ``--version`` prints ``msslib X.Y.Z``.

@@ -2,186 +2,20 @@
 
 Results are :class:`xarray.Dataset` objects built by :func:`make_dataset`, written atomically by
 :func:`write_result` (engine ``netcdf4``) and read back fully into memory by :func:`read_result`.
-:func:`mesh_from_result` rebuilds the :class:`~msslib.mesh.Mesh`. :class:`StagedOutputs` writes
-several files as one (all are replaced, or none is); every write goes through it, so temporary
-files are removed on any error, on SIGINT and on SIGTERM.
-
-Schema ``msslib-result-2.0``: CF-1.11 and UGRID-1.0
-===================================================
-
-A result follows the CF metadata conventions 1.11 and the UGRID conventions 1.0 for unstructured
-meshes (global attribute ``Conventions = "CF-1.11 UGRID-1.0"``, :data:`CONVENTIONS`); the global
-attribute ``msslib_schema`` (:data:`SCHEMA_VERSION`) tells this schema from the older
-``msslib-result-1.0`` (which had ``Conventions = "msslib-result-1.0"``, the material constants as
-global attributes and the per-cell material index in a variable ``material``; such files are still
-read by :func:`mesh_from_result`). ``tests/test_cf.py`` runs the IOOS compliance checker (CF-1.11)
-and checks the UGRID rules listed here.
-
-Units are UDUNITS strings (``m``, ``N``, ``N m-1``, ``Pa``, ``kg m-3``, ``J``, ``s``, ``m s-1``;
-``1`` for dimensionless quantities). Every variable has a ``long_name``; every physical or
-dimensionless quantity has ``units``; connectivity, index, flag and label variables have none (they
-are not quantities). CF standard names are used where one exists and fits: none fits Cartesian
-coordinates of a body (``projection_x_coordinate`` means map projections), displacements, forces,
-spring or material constants, so these have ``long_name`` and ``units`` only. ``time`` has no
-``standard_name`` either: CF's ``time`` needs units ``"<unit> since <date>"``, and a simulation's
-time is elapsed time with no date.
-
-Mesh topology (UGRID)
----------------------
-
-``mesh`` (a dummy integer, ``cf_role = "mesh_topology"``) describes the mesh of the run:
-``topology_dimension`` 2 (triangles, quads: faces) or 3 (tetrahedra, hexahedra: volumes),
-``node_coordinates = "node_x node_y"`` (2D) or ``"node_x node_y node_z"`` (3D), and
-
-* 2D: ``face_node_connectivity = "cells"``, ``face_dimension = "cell"``;
-* 3D: ``volume_node_connectivity = "cells"``, ``volume_dimension = "cell"``,
-  ``volume_shape_type = "cell_shape"`` (UGRID's 3D section: a flag variable with the shape of every
-  volume; node order per shape is VTK's, which is :mod:`msslib.mesh`'s).
-
-The springs of a mass-spring system are a second topology, ``spring_network``
-(``topology_dimension = 1``, the same ``node_coordinates``, ``edge_node_connectivity = "springs"``,
-``edge_dimension = "spring"``): a 1D network on the same nodes. They are not the edges of ``mesh``
-because many models have springs along face and cell diagonals. Connectivities are 0-based
-(``start_index = 0``); all cells of a mesh have the same number of nodes, so no ``_FillValue`` is
-needed. Variables defined on the mesh carry ``mesh`` and ``location``: ``"node"`` (dimension
-``node``; with ``coordinates = "node_x node_y (node_z)"``, written by xarray), ``"face"`` (2D) or
-``"volume"`` (3D) for dimension ``cell``, and ``mesh = "spring_network"``, ``location = "edge"``
-for dimension ``spring``. :func:`make_dataset` adds these to every variable with one of these
-dimensions (``extra_vars`` included) that does not set them itself.
-
-Dimensions
-----------
-
-============== ===============================================================================
-dimension      meaning
-============== ===============================================================================
-``node``       mesh nodes, in the order of ``Mesh.points``
-``axis``       spatial axes x, y (2D) and z (3D); the label variable ``axis_name`` names them
-               (CF coordinate variables are numeric, so there is no coordinate variable ``axis``)
-``cell``       mesh cells, in the order of ``Mesh.cells``
-``cell_node``  nodes of one cell (3 triangle, 4 quad, 4 tetra, 8 hexahedron)
-``material``   materials; coordinate variable ``material`` holds ``0, 1, ...``
-``spring``     springs of a mass-spring system (optional)
-``spring_end`` the two end nodes of a spring (length 2; optional, with ``spring``)
-``time``       stored states of a dynamic run; coordinate variable ``time`` [s] (optional)
-``step``       stored states of a quasi-static / iterative run when there is no physical time;
-               coordinate variable ``step`` [1] (optional; used only if ``time`` is not)
-============== ===============================================================================
-
-Variables
----------
-
-====================================================== ======== ========================================
-variable                                               units    content
-====================================================== ======== ========================================
-``mesh``                                               -        UGRID mesh topology (see above)
-``node_x(node)``, ``node_y(node)``, ``node_z(node)``   m        node coordinates of the undeformed mesh
-                                                                (auxiliary coordinates; ``node_z`` in
-                                                                3D only)
-``axis_name(axis)``                                    -        ``"x"``, ``"y"`` (, ``"z"``): string
-                                                                label (auxiliary coordinate, CF 6.1)
-``rest_position(node, axis)``                          m        the same node positions as one array,
-                                                                for arithmetic with ``displacement``
-``displacement(node, axis)``                           m        displacement of the final state
-``cells(cell, cell_node)``                             -        int64 connectivity, 0-based node
-                                                                indices, node order of
-                                                                :mod:`msslib.mesh`; ``cf_role``
-                                                                ``face_node_connectivity`` (2D) or
-                                                                ``volume_node_connectivity`` (3D),
-                                                                ``start_index = 0``; attribute
-                                                                ``cell_type`` (``triangle``,
-                                                                ``quad``, ``tetra``, ``hexahedron``)
-``cell_shape(cell)``                                   -        3D only: int8 UGRID volume shape flag
-                                                                (``flag_values 0 1 2 3``,
-                                                                ``flag_meanings "tetrahedron pyramid
-                                                                wedge hexahedron"``)
-``material(material)``                                 -        int64 material index (coordinate)
-``cell_material(cell)``                                -        int64 material index of the cell
-``material_E(material)``                               Pa       Young's modulus
-``material_nu(material)``                              1        Poisson's ratio
-``material_density(material)``                         kg m-3   density (optional: only when some
-                                                                material has one; ``_FillValue``
-                                                                9.969209968386869e36, read back as NaN,
-                                                                where a material has none)
-``material_name(material)``                            -        material names (optional)
-``thickness``                                          m        membrane thickness of a 2D (plane
-                                                                stress) mesh (optional, scalar)
-``spring_network``                                     -        UGRID 1D topology of the springs
-                                                                (optional, with ``springs``)
-``springs(spring, spring_end)``                        -        int64 end nodes of every spring,
-                                                                ``cf_role = "edge_node_connectivity"``,
-                                                                ``start_index = 0`` (optional)
-``spring_constant(spring)``                            N m-1    spring stiffness (optional)
-``rest_length(spring)``                                m        spring rest length (optional)
-``reaction_force(node, axis)``                         N        reaction force at the nodes (optional)
-``fixed(node, axis)``                                  -        Dirichlet mask: ``bool`` in memory,
-                                                                stored as ``int8`` 0/1 with attribute
-                                                                ``dtype = "bool"`` (xarray decodes it
-                                                                back to ``bool``), ``flag_values 0 1``,
-                                                                ``flag_meanings "free prescribed"``
-                                                                (optional)
-``time(time)``                                         s        simulated time of the stored states,
-                                                                from the start of the run (optional)
-``step(step)`` or ``step(time)``                       1        iteration / load-step number (optional)
-``displacement_history(time|step, node, axis)``        m        displacement of every stored state
-                                                                (optional)
-``velocity_history(time|step, node, axis)``            m s-1    velocity of every stored state
-                                                                (optional)
-====================================================== ======== ========================================
-
-Further variables may be added with ``extra_vars``; they need a ``long_name``, and ``units`` unless
-they are flags (``flag_values`` and ``flag_meanings``) or text. :func:`msslib.scene.run_scene`
-adds ``cell_state(cell)`` (flags, :mod:`msslib.quality`), ``relative_jacobian(cell)`` [1], the
-energies of dynamic runs (``kinetic_energy(time)``, ``potential_energy(time)`` [J]) and the
-potential energy of the final state of static mass-spring runs (scalar ``potential_energy`` [J]).
-
-Global attributes
------------------
-
-==================== ==========================================================================
-attribute            content
-==================== ==========================================================================
-``Conventions``      ``"CF-1.11 UGRID-1.0"`` (:data:`CONVENTIONS`)
-``msslib_schema``    ``"msslib-result-2.0"`` (:data:`SCHEMA_VERSION`)
-``title``            ``"msslib result: <model>"``
-``source``           ``"msslib <version>"``
-``history``          ``"<created> created by msslib <version>"``
-``model``            model name, e.g. ``"fem_linear"``, ``"lloyd_tetrahedron"``
-``scene``            the scene text or name (``""`` if none; a mapping is stored as JSON)
-``msslib_version``   :data:`msslib.__version__`
-``git_commit``       ``git rev-parse HEAD`` run in the package's directory, with suffix
-                     ``"+dirty"`` when tracked files have uncommitted changes (untracked files are
-                     ignored, as by ``git describe --dirty``); ``"unknown"`` when unavailable
-``created``          creation time, UTC, ISO 8601 (``YYYY-MM-DDTHH:MM:SS+00:00``)
-``python_version``   :func:`platform.python_version`
-``numpy_version``    :data:`numpy.__version__`
-``wall_time_s``      wall time of the run [s]; NaN when not given
-``solver_*``         solver statistics, flattened: ``{"newton": {"iterations": 3}}`` becomes
-                     ``solver_newton_iterations = 3``
-==================== ==========================================================================
-
-Attribute values are restricted to what netCDF stores: strings, numbers and 1-D numeric arrays.
-Booleans become the integers 0/1; ``None`` (and the string ``"None"``, which older callers passed for
-"no value") drops the attribute; anything else (lists of strings, nested or ragged lists, mappings)
-is stored as its JSON text. A length-1 array attribute reads back as a scalar (a netCDF property).
-Further global attributes may be added with ``extra_attrs`` (they must not collide with the
-attributes above); physical quantities belong in variables, where they carry units.
+:func:`mesh_from_result` rebuilds the :class:`~msslib.mesh.Mesh`. Every write goes through
+:class:`msslib.staging.StagedOutputs` (several files as one; temporaries removed on any error, on
+SIGINT and on SIGTERM). The schema (CF-1.11 and UGRID-1.0, ``msslib-result-2.0``: dimensions,
+variables, attributes) is described in :mod:`msslib.schema`.
 """
 
 from __future__ import annotations
 
-import errno
 import json
 import math
 import os
 import platform
-import re
-import secrets
-import signal
 import subprocess
-import threading
 from collections.abc import Mapping
-from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -190,6 +24,22 @@ import xarray as xr
 
 from . import __version__
 from .mesh import CELL_TYPES, Mesh
+from .schema import (  # noqa: F401
+    CONVENTIONS,
+    SCHEMA_VERSION,
+    LEGACY_SCHEMA_VERSION,
+    AXIS_NAMES,
+    ENGINE,
+    FINITE_VARIABLES,
+    SCHEMA_ATTRS,
+    MESH,
+    SPRING_NETWORK,
+    VOLUME_SHAPES,
+    _VOLUME_SHAPE_OF,
+    DOUBLE_FILL,
+    FILLED_VARIABLES,
+)
+from .staging import TEMP_TAG, StagedOutputs, Terminated, remove_stale_temporaries, terminate_raises  # noqa: F401
 
 __all__ = [
     "CONVENTIONS",
@@ -205,32 +55,6 @@ __all__ = [
     "read_result",
     "mesh_from_result",
 ]
-
-#: value of the global attribute ``Conventions``
-CONVENTIONS = "CF-1.11 UGRID-1.0"
-#: value of the global attribute ``msslib_schema``
-SCHEMA_VERSION = "msslib-result-2.0"
-#: the schema before CF/UGRID (its ``Conventions`` attribute); :func:`mesh_from_result` reads it
-LEGACY_SCHEMA_VERSION = "msslib-result-1.0"
-AXIS_NAMES = ("x", "y", "z")
-ENGINE = "netcdf4"
-#: Variables that must be finite for :func:`write_result` to accept a dataset.
-FINITE_VARIABLES = ("rest_position", "displacement", "displacement_history", "velocity_history")
-#: Global attributes set by :func:`make_dataset` (``solver_*`` apart).
-SCHEMA_ATTRS = (
-    "Conventions", "msslib_schema", "title", "source", "history", "model", "scene", "msslib_version",
-    "git_commit", "created", "python_version", "numpy_version", "wall_time_s",
-)
-#: the UGRID mesh topology variables
-MESH, SPRING_NETWORK = "mesh", "spring_network"
-#: UGRID volume shapes (flag values of ``cell_shape``) and the msslib cell types they stand for
-VOLUME_SHAPES = ("tetrahedron", "pyramid", "wedge", "hexahedron")
-_VOLUME_SHAPE_OF = {"tetra": "tetrahedron", "hexahedron": "hexahedron"}
-#: the netCDF default fill value of doubles, used where a material has no density
-DOUBLE_FILL = 9.969209968386869e36
-#: variables stored with a ``_FillValue`` (:data:`DOUBLE_FILL`; NaN in memory)
-FILLED_VARIABLES = ("material_density",)
-
 
 # --------------------------------------------------------------------------------------------------
 # provenance and attribute sanitising
@@ -660,13 +484,6 @@ def _to_netcdf(ds: xr.Dataset):
     return lambda tmp: ds.to_netcdf(tmp, mode="w", format="NETCDF4", engine=ENGINE, encoding=_encoding(ds))
 
 
-def _to_text(text: str):
-    def write(tmp: Path) -> None:
-        with open(tmp, "w", encoding="utf-8") as f:
-            f.write(text)
-    return write
-
-
 def write_result(path: str | os.PathLike, ds: xr.Dataset) -> Path:
     """Write ``ds`` to ``path`` (NetCDF-4, engine netcdf4) atomically and return the path.
 
@@ -698,297 +515,6 @@ def write_text(path: str | os.PathLike, text: str) -> Path:
     with StagedOutputs() as out:
         out.write_text(path, text)
     return path
-
-
-# --------------------------------------------------------------------------------------------------
-# staged outputs: temporary files committed together
-
-
-#: marks the temporary files of msslib: ``.NAME.msslib-tmp-PID-RANDOM`` beside the target ``NAME``
-#: (``msslib-bak`` for the copy of a replaced file kept while several files are committed)
-TEMP_TAG = "msslib-tmp"
-_BACKUP_TAG = "msslib-bak"
-
-
-class Terminated(KeyboardInterrupt):
-    """Raised by the SIGTERM handler of :func:`terminate_raises` (and of :class:`StagedOutputs`).
-
-    A :class:`KeyboardInterrupt`, so that code which lets an interrupt pass (solvers catching
-    ``Exception``) lets a termination pass too, and ``finally`` blocks remove temporary files."""
-
-
-def _raise_terminated(signum, frame):
-    raise Terminated(f"terminated by signal {signum}")
-
-
-def _in_main_thread() -> bool:
-    return threading.current_thread() is threading.main_thread()
-
-
-@contextmanager
-def terminate_raises():
-    """Within the block, SIGTERM raises :class:`Terminated` in the main thread (as SIGINT raises
-    :class:`KeyboardInterrupt`), so that ``finally`` blocks run and temporary files are removed;
-    the previous handler is restored afterwards. Outside the main thread it does nothing."""
-    if not _in_main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGTERM, _raise_terminated)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
-
-
-def _temp_path(dest: Path, tag: str = TEMP_TAG) -> Path:
-    return dest.parent / f".{dest.name}.{tag}-{os.getpid()}-{secrets.token_hex(4)}"
-
-
-def _temp_pattern(name: str) -> re.Pattern:
-    # ``..NAME.msslib-tmp-PID-RANDOM.<hex>.tmp`` too: the temporary of a writer (write_vtu) that
-    # itself writes beside the path it is given
-    return re.compile(r"^\.{1,2}" + re.escape(name) + rf"\.(?:{TEMP_TAG}|{_BACKUP_TAG})-(\d+)-[0-9a-f]+(?:\..+)?$")
-
-
-def _pid_alive(pid: int) -> bool:
-    if pid <= 0:
-        return True  # not one of ours: never remove
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (OSError, OverflowError):  # PermissionError: a process of another user is alive
-        return True
-    return True
-
-
-def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
-    """Remove the temporary files that runs killed while writing ``path`` left beside it (those
-    whose process id is no longer alive); returns the paths removed. Errors are ignored."""
-    path = Path(path)
-    pattern = _temp_pattern(path.name)
-    removed = []
-    try:
-        names = os.listdir(path.parent if str(path.parent) else ".")
-    except OSError:
-        return removed
-    for name in names:
-        match = pattern.match(name)
-        if match is None or _pid_alive(int(match.group(1))):
-            continue
-        stale = path.parent / name
-        try:
-            if stale.is_file() and not stale.is_symlink():
-                stale.unlink()
-                removed.append(stale)
-        except OSError:
-            pass
-    return removed
-
-
-def _unlink(path: Path) -> None:
-    try:
-        os.unlink(path)
-    except FileNotFoundError:
-        pass
-
-
-def _fsync(path: Path, flags: int = os.O_RDONLY) -> None:
-    try:
-        fd = os.open(path, flags)
-    except OSError:
-        return  # directories cannot be opened on every platform
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
-
-
-def _rename_error(exc: BaseException, tmp: Path, dest: Path, what: str) -> BaseException:
-    """``exc`` raised while writing ``tmp``, re-made to name ``dest`` (not the temporary file)."""
-    pattern = re.compile(r"\.?" + re.escape(tmp.name) + r"(?:\.[0-9a-f]+\.tmp)?")
-    if isinstance(exc, OSError) and exc.errno is not None:  # shown as "[Errno N] message: 'dest'"
-        message = f"cannot write {what}: {pattern.sub(dest.name, str(exc.strerror or exc))}"
-        try:
-            new = type(exc)(exc.errno, message, str(dest))
-        except Exception:  # an OSError subclass with another signature
-            new = OSError(exc.errno, message, str(dest))
-    elif isinstance(exc, OSError):
-        new = type(exc)(f"cannot write {what} {str(dest)!r}: {pattern.sub(dest.name, str(exc))}")
-    else:
-        message = f"cannot write {what} {str(dest)!r}: {pattern.sub(dest.name, ' '.join(str(exc).split()))}"
-        try:
-            new = type(exc)(message)
-        except Exception:
-            new = OSError(errno.EIO, message, str(dest))
-    new.msslib_output = str(dest)  # the command line reports such errors as one line
-    return new
-
-
-class StagedOutputs:
-    """Several output files written as one: every file is replaced, or none is.
-
-    .. code-block:: python
-
-        with StagedOutputs() as out:
-            out.write_result("run.nc", ds)
-            out.write("run.vtu", lambda tmp: write_vtu(tmp, mesh), what="VTU file")
-        # here both files are in place; had anything in the block failed, neither would be touched
-
-    Each output is first written to a temporary file in its destination directory, named
-    ``.NAME.msslib-tmp-PID-RANDOM``; when the block ends without an error, every temporary file is
-    flushed to disk and renamed over its destination (:func:`os.replace`). Should a rename fail
-    half-way, the files already replaced get their old content back (a hard link to each replaced
-    file is kept until the end). On any error, ``KeyboardInterrupt`` included, every temporary file
-    is removed and the error re-raised, naming the destination rather than the temporary file.
-
-    SIGTERM: when the process has the default SIGTERM disposition, the block installs a handler
-    that raises :class:`Terminated`; after the clean-up the default is restored and the signal
-    re-sent, so that the process still ends as killed by SIGTERM (another handler, such as the
-    command line's :func:`terminate_raises`, is left alone). Temporary files of runs killed
-    outright (SIGKILL, power loss) are removed the next time the same destination is written, once
-    their process id is no longer alive (:func:`remove_stale_temporaries`).
-
-    Without ``with``, call :meth:`commit` or :meth:`discard` yourself.
-    """
-
-    def __init__(self):
-        self._staged: list[tuple[Path, Path]] = []  # (destination, temporary file)
-        self._installed = False
-        self._previous = None
-
-    # -- staging
-
-    def stage(self, dest: str | os.PathLike, what: str = "output file") -> Path:
-        """Reserve (create, empty) a temporary file for ``dest`` and return its path; it becomes
-        ``dest`` at :meth:`commit`."""
-        dest = Path(dest)
-        for other, _ in self._staged:
-            if os.path.abspath(other) == os.path.abspath(dest):
-                raise ValueError(f"{what} {str(dest)!r} is staged twice")
-        directory = dest.parent
-        if not directory.is_dir():
-            code = errno.ENOTDIR if directory.exists() else errno.ENOENT
-            raise (NotADirectoryError if code == errno.ENOTDIR else FileNotFoundError)(
-                code, f"cannot write {what}, directory {str(directory)!r} does not exist", str(dest))
-        if dest.is_dir():
-            raise IsADirectoryError(errno.EISDIR, f"cannot write {what}, it is a directory", str(dest))
-        if dest.exists() and not dest.is_file():  # a device or a pipe: os.replace would replace it
-            raise OSError(errno.EINVAL, f"cannot write {what}, it exists and is not a regular file", str(dest))
-        remove_stale_temporaries(dest)
-        tmp = _temp_path(dest)
-        try:
-            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # mode honours the umask
-        except OSError as exc:
-            raise type(exc)(exc.errno, f"cannot write {what}, no temporary file in {str(directory)!r}: "
-                                       f"{exc.strerror}", str(dest)) from exc
-        os.close(fd)
-        self._staged.append((dest, tmp))
-        return tmp
-
-    def write(self, dest: str | os.PathLike, writer, what: str = "output file") -> Path:
-        """Stage ``dest`` and call ``writer(temporary_path)`` to fill it; an error of the writer
-        is re-raised naming ``dest``."""
-        dest = Path(dest)
-        tmp = self.stage(dest, what)
-        try:
-            writer(tmp)
-        except BaseException as exc:
-            self._staged.remove((dest, tmp))
-            _unlink(tmp)
-            if isinstance(exc, Exception):
-                raise _rename_error(exc, tmp, dest, what) from exc
-            raise
-        return dest
-
-    def write_result(self, dest: str | os.PathLike, ds: xr.Dataset, what: str = "result") -> Path:
-        """Stage a NetCDF result (refused, ValueError, if :data:`FINITE_VARIABLES` are not finite)."""
-        _check_finite(Path(dest), ds)
-        return self.write(dest, _to_netcdf(ds), what)
-
-    def write_text(self, dest: str | os.PathLike, text: str, what: str = "text file") -> Path:
-        """Stage a UTF-8 text file."""
-        return self.write(dest, _to_text(text), what)
-
-    @property
-    def destinations(self) -> list[Path]:
-        return [dest for dest, _ in self._staged]
-
-    # -- ending
-
-    def discard(self) -> None:
-        """Remove every temporary file; no destination is touched."""
-        staged, self._staged = self._staged, []
-        for _, tmp in staged:
-            _unlink(tmp)
-
-    def commit(self) -> list[Path]:
-        """Rename every temporary file over its destination (all, or none); returns the
-        destinations."""
-        staged = self._staged
-        backups: dict[Path, Path | None] = {}
-        replaced: list[Path] = []
-        existed = {dest: os.path.lexists(dest) for dest, _ in staged}
-        try:
-            for _, tmp in staged:
-                _fsync(tmp)
-            for dest, _ in staged:  # keep the files about to be replaced, to put them back on failure
-                backups[dest] = None
-                if existed[dest]:
-                    backup = _temp_path(dest, _BACKUP_TAG)
-                    try:
-                        os.link(dest, backup, follow_symlinks=False)
-                        backups[dest] = backup
-                    except OSError:  # no hard links here: that file cannot be put back
-                        pass
-            for dest, tmp in staged:
-                try:
-                    os.replace(tmp, dest)
-                except Exception as exc:
-                    raise _rename_error(exc, tmp, dest, "output file") from exc
-                replaced.append(dest)
-        except BaseException:
-            for dest in reversed(replaced):  # put the old files back
-                try:
-                    if backups.get(dest) is not None:
-                        os.replace(backups.pop(dest), dest)
-                    elif not existed[dest]:
-                        os.unlink(dest)
-                except OSError:
-                    pass
-            raise
-        finally:
-            for backup in backups.values():
-                if backup is not None:
-                    _unlink(backup)
-            self.discard()
-        for directory in {dest.parent for dest in replaced}:  # make the renames durable
-            _fsync(directory)
-        return replaced
-
-    def __enter__(self):
-        if _in_main_thread() and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL:
-            self._previous = signal.signal(signal.SIGTERM, _raise_terminated)
-            self._installed = True
-        return self
-
-    def __exit__(self, exc_type, exc, tb):
-        try:
-            if exc_type is None:
-                self.commit()
-            else:
-                self.discard()
-        finally:
-            if self._installed:
-                self._installed = False
-                signal.signal(signal.SIGTERM, self._previous)
-                if exc_type is not None and issubclass(exc_type, Terminated):
-                    os.kill(os.getpid(), signal.SIGTERM)  # end as the default disposition would
-        return False
 
 
 def read_result(path: str | os.PathLike) -> xr.Dataset:
