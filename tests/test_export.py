@@ -28,7 +28,7 @@ import pytest
 import yaml
 
 from derivations import codegen
-from msslib import cli, export
+from msslib import cli, export, export_simulators
 from msslib.solvers import static_solve
 from msslib.terms import BaudetCorrection, HexVolume, Springs, TetVolume
 
@@ -315,15 +315,15 @@ def test_sofa_scene_uses_documented_names_and_carries_the_model(scene, tmp_path,
     root = ET.parse(tmp_path / "s.scn").getroot()
     elements = [e for e in root.iter() if isinstance(e.tag, str)]
     for e in elements:
-        assert e.tag in export.SOFA_COMPONENTS, e.tag
+        assert e.tag in export_simulators.SOFA_COMPONENTS, e.tag
         for attr in e.attrib:
-            assert attr in export.SOFA_COMPONENTS[e.tag]["attributes"], (e.tag, attr)
+            assert attr in export_simulators.SOFA_COMPONENTS[e.tag]["attributes"], (e.tag, attr)
     by_tag = {}
     for e in elements:
         by_tag.setdefault(e.tag, []).append(e)
     used = {e.tag for e in elements}
     plugins = {e.get("name") for e in by_tag["RequiredPlugin"]}
-    assert plugins == {export.SOFA_COMPONENTS[t]["plugin"] for t in used} - {None, "Sofa.Simulation.Core"}
+    assert plugins == {export_simulators.SOFA_COMPONENTS[t]["plugin"] for t in used} - {None, "Sofa.Simulation.Core"}
     springs = _springs(exp.model)
     (ff,) = by_tag["SpringForceField"]
     q = np.array(ff.get("spring").split(), dtype=float).reshape(-1, 5)  # i j ks kd L
@@ -487,7 +487,7 @@ def test_all_outputs_or_none(tmp_path, capsys, monkeypatch):
     def fail(_exp):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(export, "sofa_text", fail)
+    monkeypatch.setattr(export_simulators, "sofa_text", fail)
     monkeypatch.setattr(export, "json_text", lambda e: '{"changed": true}\n')
     code, err = _cli(capsys, "export", scene, "--out", f"{out}/", "--format", "csv,json,sofa")
     _assert_one_error_line(code, err, "baudet_bar.scn")
