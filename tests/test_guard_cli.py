@@ -20,7 +20,7 @@ import yaml
 
 from cli_helpers import assert_refused
 from cli_helpers import run_cli as _cli
-from msslib import cli
+from msslib import cli, cli_inputs
 from msslib import experiment as EXP
 from msslib import mesh as M
 from msslib.io import StagedOutputs, read_result, remove_stale_temporaries, write_result, write_text
@@ -161,7 +161,7 @@ def test_run_failing_vtu_keeps_old_result(work, capsys, monkeypatch, failure):
             raise OSError(failure.errno, failure.strerror, str(tmp))
         raise RuntimeError(f"{failure}: {tmp}")
 
-    monkeypatch.setattr(cli, "_write_vtu", failing_vtu)
+    monkeypatch.setattr(cli_inputs, "_write_vtu", failing_vtu)
     before = _snapshot(work)
     code, err = _cli(capsys, "run", work / "scene.yaml", "--out", out, "--vtu", vtu, "--quiet")
     assert_refused(code, err, vtu, str(failure.strerror if isinstance(failure, OSError) else failure))
@@ -315,13 +315,13 @@ def test_sigterm_during_cli_run_keeps_old_outputs(work):
     before = _snapshot(work)
     proc = _python("""
         import os, signal, sys, time
-        from msslib import cli
+        from msslib import cli, cli_inputs
 
         def killed(tmp, ds):  # SIGTERM arrives while both outputs are staged
             os.kill(os.getpid(), signal.SIGTERM)
             time.sleep(30)
 
-        cli._write_vtu = killed
+        cli_inputs._write_vtu = killed
         sys.exit(cli.main(sys.argv[1:]))
     """, "run", work / "scene.yaml", "--out", out, "--vtu", vtu, "--quiet")
     assert proc.returncode == 143, proc.stderr

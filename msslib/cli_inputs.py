@@ -1,0 +1,220 @@
+"""Inputs and outputs of the command line, checked before anything runs.
+
+Every check ends in a :class:`CommandError`, which :func:`msslib.cli.main` prints as one line with
+exit code 1: inputs that are missing, unreadable or not UTF-8, outputs that equal an input or each
+other, outputs in a directory that cannot be written, result files without what a command needs.
+ParaView outputs (one ``.vtu`` or a ``.pvd`` series) are staged here with the other outputs.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+class CommandError(Exception):
+    """A user-facing error reported as one line with exit code 1."""
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__
+
+
+# --------------------------------------------------------------------------------------------
+# inputs and outputs: checked before anything runs
+# --------------------------------------------------------------------------------------------
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """``a`` and ``b`` name one file: the same resolved path, or (existing files) the same inode
+    (hard links, symbolic links, other spellings)."""
+    try:
+        if a.resolve() == b.resolve():
+            return True
+    except (OSError, RuntimeError):  # a symlink loop
+        pass
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):
+        return False
+
+
+def _check_distinct(outputs, inputs=()) -> None:
+    """Refuse an output that is one of the inputs or another output (pairs ``(what, path)``)."""
+    outputs = [(what, Path(p)) for what, p in outputs if p is not None]
+    inputs = [(what, Path(p)) for what, p in inputs if p is not None]
+    for i, (what, out) in enumerate(outputs):
+        for what_in, src in inputs:
+            if _same_file(out, src):
+                raise CommandError(f"{what} {str(out)!r} is the {what_in} {str(src)!r}: refusing to overwrite "
+                                   f"an input; give another {what}")
+        for what_other, other in outputs[:i]:
+            if _same_file(out, other):
+                raise CommandError(f"{what} {str(out)!r} and {what_other} {str(other)!r} are the same file; "
+                                   f"give two different files")
+
+
+def _check_writable(path: Path, what: str) -> None:
+    """Fail early (before a long run) when ``path`` cannot be written."""
+    if path.is_dir():
+        raise CommandError(f"{what} {str(path)!r} is a directory")
+    if path.exists() and not path.is_file():
+        raise CommandError(f"{what} {str(path)!r} exists and is not a regular file; give a file name")
+    directory = path.parent
+    if not directory.exists():
+        raise CommandError(f"cannot write {what} {str(path)!r}: directory {str(directory)!r} does not exist")
+    if not directory.is_dir():
+        raise CommandError(f"cannot write {what} {str(path)!r}: {str(directory)!r} is not a directory")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise CommandError(f"cannot write {what} {str(path)!r}: directory {str(directory)!r} is not writable")
+
+
+def _input_file(path: Path, what: str) -> Path:
+    path = Path(path)
+    if not path.exists():
+        raise CommandError(f"{what} not found: {str(path)!r}")
+    if not path.is_file():
+        raise CommandError(f"{what} {str(path)!r} is not a file")
+    if not os.access(path, os.R_OK):
+        raise CommandError(f"{what} {str(path)!r} is not readable")
+    return path
+
+
+def _not_utf8(path, what, exc: UnicodeDecodeError) -> CommandError:
+    return CommandError(f"{what} {str(path)!r} is not UTF-8 text (byte {exc.start}: {exc.reason})")
+
+
+def _load_scene(path):
+    from msslib.scene import load_scene
+
+    _input_file(Path(path), "scene file")
+    try:
+        return load_scene(path)
+    except UnicodeDecodeError as exc:
+        raise _not_utf8(path, "scene file", exc) from None
+
+
+def _mesh_input(scene):
+    """``[("mesh file", path)]`` when the scene reads its mesh from a file."""
+    return [("mesh file", scene.geometry["file"])] if "file" in scene.geometry else []
+
+
+def _load_experiment(path):
+    import yaml
+
+    from msslib import experiment
+
+    _input_file(Path(path), "experiment file")
+    try:
+        return experiment.load_experiment(path)
+    except UnicodeDecodeError as exc:
+        raise _not_utf8(path, "experiment file", exc) from None
+    except yaml.YAMLError as exc:
+        raise CommandError(f"experiment file {str(path)!r}: invalid YAML: {_one_line(exc)}") from None
+    except FileNotFoundError:
+        raise
+    except ValueError as exc:
+        raise CommandError(f"experiment file {str(path)!r}: {_one_line(exc)}") from None
+    except (TypeError, AttributeError, KeyError) as exc:  # a value of the wrong kind somewhere in the file
+        raise CommandError(f"experiment file {str(path)!r} is not a valid experiment ({type(exc).__name__}: "
+                           f"{_one_line(exc)})") from None
+
+
+def _choice(option: str, value: str, allowed, what: str) -> str:
+    if value not in allowed:
+        raise CommandError(f"{option} {value!r} is not a {what}; expected one of {', '.join(map(str, allowed))}")
+    return value
+
+
+#: the variables a result needs for ``vtu`` and ``experiment compare``
+RESULT_VARIABLES = ("rest_position", "displacement", "cells")
+
+
+def _read_result(path: Path, what: str = "result file", required=RESULT_VARIABLES):
+    """Read an msslib result; CommandError naming ``path`` when it is not one."""
+    from msslib.io import SCHEMA_VERSION, read_result
+
+    _input_file(path, what)
+    try:
+        ds = read_result(path)
+    except (OSError, ValueError, RuntimeError) as exc:
+        detail = _one_line(exc).replace(str(Path(path).resolve()), "").replace(str(path), "").strip(" :'")
+        raise CommandError(f"{what} {str(path)!r} is not a NetCDF file msslib can read ({detail})") from None
+    missing = [v for v in required if v not in ds.variables]
+    if missing:
+        ours = ds.attrs.get("msslib_schema") == SCHEMA_VERSION
+        kind = "an msslib result" if ours else f"a {SCHEMA_VERSION} result"
+        raise CommandError(f"{what} {str(path)!r} is not {kind} with a mesh: no variable "
+                           f"{', '.join(map(repr, missing))}")
+    for name in ("rest_position", "displacement"):
+        if name in required and set(ds[name].dims) != {"node", "axis"}:
+            raise CommandError(f"{what} {str(path)!r}: variable {name!r} has dimensions {ds[name].dims}, "
+                               f"expected (node, axis)")
+    if "cells" in required:
+        from msslib.io import mesh_from_result
+
+        try:
+            mesh_from_result(ds)
+        except (ValueError, TypeError, KeyError) as exc:
+            raise CommandError(f"{what} {str(path)!r}: not a valid mesh ({_one_line(exc)})") from None
+    return ds
+
+
+def _vtu_path(scene, out: Path, cli_vtu: str | None) -> Path | None:
+    if cli_vtu:
+        return Path(cli_vtu)
+    vtu = scene.output.get("vtu", False)
+    if vtu is True:
+        return out.with_suffix(".vtu")
+    if isinstance(vtu, str):
+        return out.parent / vtu
+    return None
+
+
+def _write_vtu(path: Path, ds) -> None:
+    """The final state as one VTU file (:func:`msslib.paraview.write_state`)."""
+    from msslib.paraview import write_state
+
+    write_state(path, ds)
+
+
+def _paraview_what(path: Path) -> str:
+    from msslib.paraview import is_series
+
+    return "ParaView series" if is_series(path) else "VTU file"
+
+
+def _check_paraview(path: Path, others) -> None:
+    """Refuse, before anything runs, a ParaView output whose suffix is neither .vtu nor .pvd, or a
+    series whose files beside the .pvd (STEM_NNNN.vtu, STEM_springs.vtu) would be one of
+    ``others`` (pairs ``(what, path)``: the inputs and the other outputs)."""
+    from msslib.paraview import check_suffix, in_series, is_series
+
+    try:
+        check_suffix(path, _paraview_what(path))
+    except ValueError as exc:
+        raise CommandError(_one_line(exc)) from None
+    if is_series(path):
+        for what, other in others:
+            if other is not None and in_series(path, other):
+                raise CommandError(f"{what} {str(other)!r} would be overwritten by the ParaView series {str(path)!r} "
+                                   f"(it writes {path.stem}_NNNN.vtu and {path.stem}_springs.vtu beside it); "
+                                   f"give another .pvd name")
+
+
+def _paraview_files(path: Path, ds) -> list:
+    """Every file of the ParaView export of ``ds`` at ``path``, pairs ``(what, path)``."""
+    from msslib.paraview import is_series, series_files, states
+
+    if not is_series(path):
+        return [("VTU file", path)]
+    return series_files(path, len(states(ds)[0]), "springs" in ds)
+
+
+def _stage_paraview(staged, path: Path, ds) -> None:
+    from msslib.paraview import is_series, stage
+
+    if is_series(path):
+        stage(staged, path, ds)
+    else:
+        staged.write(path, lambda tmp: _write_vtu(tmp, ds), what="VTU file")
