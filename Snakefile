@@ -205,7 +205,7 @@ rule table:
 rule stability:
     """Hard cases: where each model breaks, and how."""
     input:
-        script="experiments/stability.py",
+        script=["experiments/stability.py", "experiments/stability_cases.py", "experiments/stability_common.py"],
         derived="paper/derivations.json",
         code=MSSLIB,
     output:
@@ -215,7 +215,7 @@ rule stability:
     log:
         "logs/stability.log",
     shell:
-        "python {input.script} --out {output} {params.quick} > {log} 2>&1"
+        "python -m experiments.stability --out {output} {params.quick} > {log} 2>&1"
 
 
 rule benchmarks:

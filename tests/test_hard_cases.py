@@ -1,4 +1,4 @@
-"""Hard cases of the mass-spring models: the behaviour measured by ``experiments/stability.py``.
+"""Hard cases of the mass-spring models: the behaviour measured by ``experiments.stability``.
 
 The cases are built by the helpers of that script (loaded from its file), so the test suite and
 the recorded experiment cannot drift apart.  Meshes are kept small (the whole module runs in
@@ -8,14 +8,13 @@ comment says why the behaviour is what it is.
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import yaml
 
+from experiments import stability_cases, stability_common
 from msslib import cli
 from msslib import mesh as M
 from msslib import model as MD
@@ -23,18 +22,9 @@ from msslib import solvers as S
 from msslib.errors import StabilityError
 from msslib.scene import load_scene, prepare
 
-_SCRIPT = Path(__file__).resolve().parents[1] / "experiments" / "stability.py"
-
-
-def _load_script():
-    spec = importlib.util.spec_from_file_location("msslib_stability_experiment", _SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-st = _load_script()
+# the hard-case study's cases and their shared pieces, as one namespace
+st = SimpleNamespace(**{k: v for m in (stability_common, stability_cases) for k, v in vars(m).items()
+                        if not k.startswith("__")})
 
 
 # --------------------------------------------------------------------------------------------
