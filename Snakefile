@@ -298,4 +298,4 @@ rule derivation_notebook:
     log:
         "logs/derivations/{module}.log",
     shell:
-        "python -m derivations.notebook {wildcards.module} --out {output} > {log} 2>&1"
+        "python -m msslib.paper notebook {wildcards.module} --out {output} > {log} 2>&1"

@@ -1,13 +1,15 @@
-"""Render a derivation module (a jupytext percent-format notebook) as one self-contained HTML page.
+"""Run a derivation module (a jupytext percent-format notebook) cell by cell into Markdown.
 
-    python -m derivations.notebook triangle --out paper/build/derivations/triangle.html
+    python -m derivations.notebook triangle --out triangle.md
+    python -m msslib.paper notebook triangle --out paper/build/derivations/triangle.html
 
 The module's cells run in order in one namespace, as ``__main__`` (as in Jupyter). A markdown cell
 (``# %% [markdown]``) becomes Markdown text; a code cell becomes a code block followed by what it
 showed: the math of :mod:`derivations.show` as ``$$...$$`` and its printed output as a text block.
-The Markdown goes through :func:`msslib.paper.render_html` (pandoc, math as MathML, no script), the
-same path as the paper's HTML. The pages are written beside the paper (``paper/build/derivations/``),
-so the paper links them as ``derivations/<module>.html``.
+The paper stage (``python -m msslib.paper notebook``) turns the Markdown into one self-contained HTML
+page by the same path as the paper's HTML (pandoc, math as MathML, no script), beside the paper
+(``paper/build/derivations/``), so that the paper links them as ``derivations/<module>.html``. This
+module imports nothing of msslib: the derivations come first in the workflow.
 """
 
 from __future__ import annotations
@@ -108,31 +110,17 @@ def to_markdown(module: str) -> str:
     return "\n\n".join(parts) + "\n"
 
 
-def render(module: str) -> str:
-    """The notebook of ``derivations/<module>.py`` as a standalone HTML page."""
-    from msslib.paper import render_html
-
-    return render_html(to_markdown(module))
-
-
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m derivations.notebook", description=__doc__.splitlines()[0])
     p.add_argument("module", help="derivation module, e.g. triangle")
-    p.add_argument("--out", "-o", required=True, help="HTML file")
-    p.add_argument("--markdown", help="also write the Markdown here")
+    p.add_argument("--out", "-o", required=True, help="Markdown file")
     args = p.parse_args(argv)
     if not (HERE / f"{args.module}.py").is_file():
         print(f"no derivation module derivations/{args.module}.py", file=sys.stderr)
         return 2
-    markdown = to_markdown(args.module)
-    if args.markdown:
-        Path(args.markdown).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.markdown).write_text(markdown, encoding="utf-8")
-    from msslib.paper import render_html
-
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(render_html(markdown), encoding="utf-8")
+    out.write_text(to_markdown(args.module), encoding="utf-8")
     print(f"wrote {out}")
     return 0
 

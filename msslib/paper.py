@@ -415,6 +415,18 @@ def html_from_markdown(markdown, out) -> Path:
     return write_text(out, render_html(markdown.read_text(encoding="utf-8"), resource_dir=markdown.parent))
 
 
+def notebook_html(module, out) -> Path:
+    """The derivation module ``derivations/<module>.py`` as a notebook page: its cells run in order
+    (:func:`derivations.notebook.to_markdown`), rendered like the paper's HTML."""
+    from derivations.notebook import HERE, to_markdown
+
+    if not (HERE / f"{module}.py").is_file():
+        raise ValueError(f"no derivation module derivations/{module}.py")
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    return write_text(out, render_html(to_markdown(module)))
+
+
 def pdf_from_markdown(markdown, out) -> Path:
     """The PDF, through a Typst file written beside the Markdown (``paper.typ``)."""
     markdown, out = Path(markdown), Path(out)
@@ -438,12 +450,13 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m msslib.paper", description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="step", required=True)
     for step, src, dst in [("fill", "main source, e.g. paper/paper.md.in", "filled Markdown"),
-                           ("html", "filled Markdown", "HTML file"), ("pdf", "filled Markdown", "PDF file")]:
+                           ("html", "filled Markdown", "HTML file"), ("pdf", "filled Markdown", "PDF file"),
+                           ("notebook", "derivation module, e.g. triangle", "HTML file")]:
         s = sub.add_parser(step, help=f"{src} -> {dst}")
         s.add_argument("source", help=src)
         s.add_argument("--out", "-o", required=True, help=dst)
     args = p.parse_args(argv)
-    step = {"fill": fill, "html": html_from_markdown, "pdf": pdf_from_markdown}[args.step]
+    step = {"fill": fill, "html": html_from_markdown, "pdf": pdf_from_markdown, "notebook": notebook_html}[args.step]
     try:
         step(args.source, args.out)
     except (OSError, ValueError, KeyError, RuntimeError) as exc:

@@ -94,12 +94,29 @@ def test_triangle_notebook_html_has_mathml(triangle_html):
     assert "<title>Triangle: plane-stress CST against three springs</title>" in html
 
 
-def test_notebook_cli_writes_html(tmp_path, monkeypatch):
+def test_notebook_commands_write_markdown_and_html(tmp_path, monkeypatch):
+    from msslib import paper
+
     monkeypatch.setattr(notebook, "to_markdown", lambda m: "# T\n\n$$x = \\frac{1}{2}$$\n")
+    md = tmp_path / "t.md"
+    assert notebook.main(["triangle", "--out", str(md)]) == 0
+    assert md.read_text() == "# T\n\n$$x = \\frac{1}{2}$$\n"
+    assert notebook.main(["no_such_module", "--out", str(md)]) == 2
     out = tmp_path / "derivations" / "t.html"
-    assert notebook.main(["triangle", "--out", str(out)]) == 0
+    assert paper.main(["notebook", "triangle", "--out", str(out)]) == 0
     assert "<math" in out.read_text()
-    assert notebook.main(["no_such_module", "--out", str(out)]) == 2
+    assert paper.main(["notebook", "no_such_module", "--out", str(out)]) == 1
+
+
+def test_derivations_import_nothing_downstream():
+    """The workflow's one direction: the derivations import neither msslib nor the experiments."""
+    import ast
+
+    for path in sorted((ROOT / "derivations").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import)
+                     else [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+            assert not any(n.split(".")[0] in ("msslib", "experiments") for n in names), (path.name, names)
 
 
 def test_triangle_imports_silently_and_runs_as_script():
