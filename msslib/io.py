@@ -39,7 +39,8 @@ from .schema import (  # noqa: F401
     DOUBLE_FILL,
     FILLED_VARIABLES,
 )
-from .staging import TEMP_TAG, StagedOutputs, Terminated, remove_stale_temporaries, terminate_raises  # noqa: F401
+from . import staging
+from .staging import TEMP_TAG, Terminated, remove_stale_temporaries, terminate_raises  # noqa: F401
 
 __all__ = [
     "CONVENTIONS",
@@ -482,6 +483,15 @@ def _check_finite(path: Path, ds: xr.Dataset) -> None:
 
 def _to_netcdf(ds: xr.Dataset):
     return lambda tmp: ds.to_netcdf(tmp, mode="w", format="NETCDF4", engine=ENGINE, encoding=_encoding(ds))
+
+
+class StagedOutputs(staging.StagedOutputs):
+    """:class:`msslib.staging.StagedOutputs` that also stages NetCDF results."""
+
+    def write_result(self, dest: str | os.PathLike, ds: xr.Dataset, what: str = "result") -> Path:
+        """Stage a NetCDF result (refused, ValueError, if :data:`FINITE_VARIABLES` are not finite)."""
+        _check_finite(Path(dest), ds)
+        return self.write(dest, _to_netcdf(ds), what)
 
 
 def write_result(path: str | os.PathLike, ds: xr.Dataset) -> Path:

@@ -3,7 +3,8 @@
 :class:`StagedOutputs` writes several files as one (all are replaced, or none is): each is written
 to a hidden temporary file beside its target, flushed to disk and renamed over it only when every
 file was written; on any error, on SIGINT and on SIGTERM the temporaries are removed and the targets
-are left as they were. :func:`msslib.io.write_result` and :func:`msslib.io.write_text` go through it.
+are left as they were. :class:`msslib.io.StagedOutputs` adds NetCDF results to it; every write of
+msslib goes through that class.
 """
 
 from __future__ import annotations
@@ -16,10 +17,6 @@ import signal
 import threading
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:  # pragma: no cover
-    import xarray as xr
 
 __all__ = ["TEMP_TAG", "StagedOutputs", "Terminated", "terminate_raises", "remove_stale_temporaries"]
 
@@ -164,8 +161,8 @@ class StagedOutputs:
 
     .. code-block:: python
 
-        with StagedOutputs() as out:
-            out.write_result("run.nc", ds)
+        with StagedOutputs() as out:  # msslib.io.StagedOutputs adds out.write_result(path, dataset)
+            out.write_text("run.md", table)
             out.write("run.vtu", lambda tmp: write_vtu(tmp, mesh), what="VTU file")
         # here both files are in place; had anything in the block failed, neither would be touched
 
@@ -234,14 +231,6 @@ class StagedOutputs:
                 raise _rename_error(exc, tmp, dest, what) from exc
             raise
         return dest
-
-    def write_result(self, dest: str | os.PathLike, ds: xr.Dataset, what: str = "result") -> Path:
-        """Stage a NetCDF result (refused, ValueError, if :data:`msslib.io.FINITE_VARIABLES` are not
-        finite)."""
-        from .io import _check_finite, _to_netcdf  # the result schema lives in msslib.io
-
-        _check_finite(Path(dest), ds)
-        return self.write(dest, _to_netcdf(ds), what)
 
     def write_text(self, dest: str | os.PathLike, text: str, what: str = "text file") -> Path:
         """Stage a UTF-8 text file."""
