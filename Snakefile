@@ -161,6 +161,8 @@ rule study:
     input:
         script="experiments/{paper}/studies/{name}.py",
         shared=shared,
+        # a study may run the paper's experiment files (e.g. over a load range): edits rerun it
+        experiments=lambda wc: sorted(str(p) for p in Path("experiments", wc.paper).glob("*.yaml")),
         code=MSSLIB,
         derived="paper/derivations.json",
     output:
