@@ -102,7 +102,10 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     internal force terms to build — only those listed are built, e.g.
     ``{type: golec_cube, terms: [springs]}`` is a classical MSS without Golec's volume term.
     Baudet's ``correction`` is computed from the traction and nodal-force loads (not gravity); it
-    is non-conservative, so the static solver's line search works on the residual norm.
+    is non-conservative, so the static solver's line search works on the residual norm.  Option
+    ``correction: boundary | element`` (``baudet_cube`` only) picks its reading: ``boundary`` (the
+    default, as just said) or ``element``, each cube's correction from the forces acting on it from
+    outside (neighbours, loads, gravity, supports), see :mod:`msslib.baudet_correction`.
 ``boundary``
     List of ``{select: SELECTION, fix: [x, y(, z)] | all, displacement: [...]}``, e.g.
     ``{select: {group: base}, fix: all}`` for a gmsh physical surface ``base``.  ``fix``
@@ -618,9 +621,16 @@ def _model(path, value):
         value, type_path = {"type": value}, path
     if not isinstance(value, Mapping):
         _fail(path, f"expected a model name or a mapping with 'type', got {value!r}")
-    _mapping(path, value, ("type", "published", "A", "terms", "plane"), required=("type",))
+    _mapping(path, value, ("type", "published", "A", "terms", "plane", "correction"), required=("type",))
     name = _choice(type_path, value["type"], MODELS, "model")
     opts = {"published": False, "A": None, "terms": None, "plane": "stress"}
+    if name == "baudet_cube":
+        from msslib.baudet_correction import READINGS
+
+        opts["correction"] = _choice(f"{path}.correction", value.get("correction", "boundary"), READINGS,
+                                     "Baudet correction reading")
+    elif "correction" in value:
+        _fail(f"{path}.correction", f"only baudet_cube takes correction, not {name}")
     if "published" in value:
         opts["published"] = _boolean(f"{path}.published", value["published"])
     if "A" in value:
@@ -1198,7 +1208,7 @@ def _internal_terms(name, mesh, materials, opts, thickness):
 
 
 def _build_model(setup: Setup):
-    from msslib.model import Model, baudet_correction
+    from msslib.model import Model
     from msslib.terms import Gravity, HexVolume, NodalForces, Springs, TetVolume
 
     scene, mesh = setup.scene, setup.mesh
@@ -1218,7 +1228,10 @@ def _build_model(setup: Setup):
                     if kind in wanted:
                         internal.append(t)
             if "correction" in wanted:
-                internal.append(baudet_correction(mesh, materials, setup.surface_forces, published=opts["published"]))
+                from msslib.baudet_correction import correction_term
+
+                internal.append(correction_term(opts["correction"], mesh, materials, setup.surface_forces,
+                                                published=opts["published"]))
     except ValueError as exc:
         _fail("scene.model", f"{name}: {exc}")
     terms = list(internal)
@@ -1487,6 +1500,8 @@ def run_scene(scene, progress=True):
              **extra_attrs, **guard_attrs}
     if scene.model_options.get("A") is not None:
         attrs["model_A"] = scene.model_options["A"]
+    if scene.model_options.get("correction") is not None:
+        attrs["model_correction"] = scene.model_options["correction"]
     extra_vars = {**(out.get("extra_vars") or {}), **guard_vars}
     if energy is not None and not isinstance(energy, str):
         extra_vars["potential_energy"] = ((), float(energy), {

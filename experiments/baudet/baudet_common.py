@@ -1,8 +1,10 @@
 """Shared pieces of the Baudet et al. (2007) studies (not a study itself: studies/*.py import it).
 
 * :func:`block` -- a box of Baudet cubes with symmetry planes x = 0, y = 0, z = 0 (an octant of a
-  body twice as large in every direction), a unit load on chosen faces and the correction built
-  from that load (derived factor, or the printed one with ``published=True``);
+  body twice as large in every direction), a unit load on chosen faces and the correction in one
+  of two readings (:data:`READINGS`): built from that load on the loaded boundary faces
+  (``boundary``) or for every cube from the forces acting on it from outside (``element``, see
+  :mod:`msslib.baudet_correction`); derived factor, or the printed one with ``published=True``;
 * :class:`Path` -- the model with its load multiplied by a factor, moved from one factor to the
   next (continuation: each equilibrium starts from the previous one);
 * :func:`follow` -- load continuation until a measured quantity reaches a target;
@@ -30,6 +32,7 @@ A0 = 0.1  # m, cube edge
 NUS = (0.1, 0.2, 0.3, 0.4, 0.499)  # nu = 0.5 of the paper as 0.499 (nu < 1/2 for the FEM-style parameters)
 NU_LABELS = tuple(f"{v:g}" for v in NUS)
 FACTORS = ("derived", "printed")
+READINGS = ("boundary", "element")  # readings of the correction force (msslib.baudet_correction)
 STEPS = 40  # load levels per curve (set to 10 by --quick)
 
 
@@ -51,14 +54,15 @@ def face_facets(mesh, axis, value):
 
 
 def block(n, nu, *, published=False, tractions=(), fixed_planes="xyz", fix_all_planes=(), E=E0, a=A0,
-          correction=True):
+          correction=True, reading="boundary"):
     """Box of ``n = (nx, ny, nz)`` cubes of edge ``a``.
 
     ``tractions``: list of ``(axis, value, traction_vector)``: a dead traction (Pa, at unit load)
     on the boundary face ``x_axis = value``. ``fixed_planes``: axes whose ``= 0`` plane is a
     symmetry plane (normal displacement fixed). ``fix_all_planes``: axes whose ``= 0`` face is
     clamped (all displacements fixed). Returns ``(mesh, model)``; the model has the springs, the
-    loads and Baudet's correction computed from those loads (left out with ``correction=False``).
+    loads and Baudet's correction computed from those loads (left out with ``correction=False``),
+    or with ``reading="element"`` from the forces acting on every cube from outside it.
     """
     mesh = M.hex_grid(a * n[0], a * n[1], a * n[2], *n)
     terms = list(MD.baudet_cube_springs(mesh, [(E, nu)], published=published))
@@ -68,7 +72,11 @@ def block(n, nu, *, published=False, tractions=(), fixed_planes="xyz", fix_all_p
     # shares the load of a node among the boundary faces it pushes on, which halves the elongation
     # force at an edge where two loaded faces meet (pressure on a box); built face by face, each
     # face gets exactly its own normal resultant.
-    if correction:
+    if correction and reading == "element":
+        from msslib.baudet_correction import element_correction
+
+        terms.append(element_correction(mesh, [(E, nu)], published=published))
+    elif correction:
         terms += [MD.baudet_correction(mesh, [(E, nu)], [ld], published=published) for ld in loads]
     fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
     for ax in fixed_planes:
@@ -137,6 +145,16 @@ def follow(model, measure, target, first_step, *, max_levels=400, tol=1e-10, gro
     else:
         raise RuntimeError(f"target {target} not reached after {max_levels} load levels")
     return np.array(loads), states
+
+
+def split_readings(ds, default="boundary"):
+    """Rename every variable with a ``reading`` dimension to ``NAME_by_reading`` and add ``NAME``,
+    its ``default`` slice (the names the paper's placeholders used before the readings existed)."""
+    for name in [v for v in ds.data_vars if "reading" in ds[v].dims]:
+        ds = ds.rename({name: f"{name}_by_reading"})
+        ds[name] = ds[f"{name}_by_reading"].sel(reading=default, drop=True)
+        ds[name].attrs = {**ds[f"{name}_by_reading"].attrs, "reading": default}
+    return ds
 
 
 def write(ds, out, t0):

@@ -1,4 +1,5 @@
-"""Baudet Fig. 8: error of the bulk modulus against the volume change (deflation < 0 < inflation)."""
+"""Baudet Fig. 8: error of the bulk modulus against the volume change (deflation < 0 < inflation), under
+the boundary and the element reading of the correction force."""
 
 import sys
 from pathlib import Path
@@ -13,9 +14,10 @@ INPUTS = ["results/baudet/studies/bulk.nc"]
 def main():
     args = C.figure_args(__doc__)
     ds = C.open_result(INPUTS[0])
-    panels = {"derived factor -(4nu-1)/2": {"geometry": "cube", "factor": "derived"},
-              "printed factor -(4nu-1)/16": {"geometry": "cube", "factor": "printed"}}
-    fig = C.curves(ds["B_error"], ds["volume_change"].values, xlabel="volume change dV/V0 (%)", ylabel="B error (%)",
+    panels = {"boundary reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "boundary"},
+              "boundary reading, printed factor": {"geometry": "cube", "factor": "printed", "reading": "boundary"},
+              "element reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "element"}}
+    fig = C.curves(ds["B_error_by_reading"], ds["volume_change"].values, xlabel="volume change dV/V0 (%)", ylabel="B error (%)",
                    panels=panels, dashed={"block of 4x4x4 cubes": {"geometry": "block"}})
     plotting.save(fig, args.out)
 

@@ -1,4 +1,5 @@
-"""Baudet Fig. 5: signed error of Poisson's ratio against the axial strain, with the +-5 % band."""
+"""Baudet Fig. 5: signed error of Poisson's ratio against the axial strain, with the +-5 % band, under
+the boundary and the element reading of the correction force."""
 
 import sys
 from pathlib import Path
@@ -16,9 +17,10 @@ BAND = 5.0  # %, the tolerance drawn
 def main():
     args = C.figure_args(__doc__)
     ds = C.open_result(INPUTS[0])
-    panels = {"derived factor -(4nu-1)/2": {"geometry": "cube", "factor": "derived"},
-              "printed factor -(4nu-1)/16": {"geometry": "cube", "factor": "printed"}}
-    fig = C.curves(ds["nu_error"], ds["strain"].values, xlabel="axial strain (%)",
+    panels = {"boundary reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "boundary"},
+              "boundary reading, printed factor": {"geometry": "cube", "factor": "printed", "reading": "boundary"},
+              "element reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "element"}}
+    fig = C.curves(ds["nu_error_by_reading"], ds["strain"].values, xlabel="axial strain (%)",
                    ylabel="nu error, (nu_MSS - nu)/nu (%)", panels=panels,
                    dashed={"beam of 4x4x12 cubes": {"geometry": "beam"}})
     fig.set_size_inches(fig.get_size_inches()[0], 4.4)
@@ -28,7 +30,7 @@ def main():
     for ax in fig.axes:
         # signed log scale: linear within +-5 % (the band is readable), logarithmic beyond
         ax.set_yscale("symlog", linthresh=5.0, linscale=0.6)
-        ax.set_ylim(lo, hi)  # one scale for both panels
+        ax.set_ylim(lo, hi)  # one scale for all panels
         ax.set_yticks(ticks, [f"{t:g}" for t in ticks])
         ax.yaxis.set_minor_locator(matplotlib.ticker.NullLocator())
         ax.axhspan(-BAND, BAND, color="0.9", zorder=0)

@@ -1,4 +1,5 @@
-"""Baudet Fig. 6: error of the shear modulus of a cube against the shear angle."""
+"""Baudet Fig. 6: error of the shear modulus of a cube against the shear angle, without correction and
+with it under the boundary reading (derived, printed factor) and the element reading (derived)."""
 
 import sys
 from pathlib import Path
@@ -13,10 +14,11 @@ INPUTS = ["results/baudet/studies/shear.nc"]
 def main():
     args = C.figure_args(__doc__)
     ds = C.open_result(INPUTS[0])
-    panels = {"no correction (paper's definition)": {"factor": "none"},
-              "derived factor (msslib load sharing)": {"factor": "derived"},
-              "printed factor (msslib load sharing)": {"factor": "printed"}}
-    fig = C.curves(ds["G_error"], ds["angle"].values, xlabel="shear angle (degree)", ylabel="G error (%)",
+    panels = {"no correction (paper's definition)": {"factor": "none", "reading": "boundary"},
+              "boundary reading, derived factor": {"factor": "derived", "reading": "boundary"},
+              "boundary reading, printed factor": {"factor": "printed", "reading": "boundary"},
+              "element reading, derived factor": {"factor": "derived", "reading": "element"}}
+    fig = C.curves(ds["G_error_by_reading"], ds["angle"].values, xlabel="shear angle (degree)", ylabel="G error (%)",
                    panels=panels, xscale=1.0)
     plotting.save(fig, args.out)
 
