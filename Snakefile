@@ -122,6 +122,8 @@ for (_paper, _exp), _path in experiments().items():
             f"experiment_{_paper}_{_exp}"
         input:
             exp=str(_path),
+            # mesh files the experiments of this paper read (experiments/<paper>/meshes/)
+            meshes=sorted(str(p) for p in Path("experiments", _paper, "meshes").glob("*") if p.suffix != ".py"),
             derived="paper/derivations.json",
             code=MSSLIB,
         output:
