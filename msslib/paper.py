@@ -10,6 +10,9 @@ Placeholders (in ``paper/*.md.in`` and the files they include):
 ``{{value FILE VAR [DIM=LABEL ...] [scale=S] [fmt=F]}}``
     a number read from the NetCDF result ``FILE`` (relative to the project root): variable or
     attribute ``VAR``, selected by labels, multiplied by ``S``, formatted with ``F`` (default .3g);
+``{{expr EXPRESSION [| FMT]}}``
+    a number computed from result values, e.g. a difference or a ratio: ``EXPRESSION`` is
+    arithmetic as in a claim's condition (below), formatted with ``FMT`` (default .3g);
 ``{{claim CONDITION | TEXT}}``
     ``TEXT`` (which may hold ``{{value ...}}`` placeholders), after checking that ``CONDITION``
     holds; ``{{claim CONDITION}}`` checks and prints nothing. ``CONDITION`` compares numbers:
@@ -63,6 +66,8 @@ from msslib.io import write_text
 PLACEHOLDER = re.compile(r"\{\{\s*(include|figure|value)\s+(.*?)\s*\}\}", re.S)
 #: a claim, matched after the other placeholders (including those in its text) are filled
 CLAIM = re.compile(r"\{\{\s*claim\s+(.*?)\s*\}\}", re.S)
+#: {{expr EXPRESSION | FMT}}: a number computed from result values (expanded before the claims)
+EXPR = re.compile(r"\{\{\s*expr\s+(.*?)\s*\}\}", re.S)
 #: a result value in a claim's condition: ``[FILE VAR DIM=LABEL ...]``
 CLAIM_VALUE = re.compile(r"\[([^\[\]]+)\]")
 #: mark of a false claim on quick results
@@ -182,32 +187,47 @@ def _evaluate(node, values):
     raise ValueError(f"not allowed in a claim: {ast.dump(node)[:80]}")
 
 
-def _claim(root: Path, arg: str) -> str:
-    """Check a claim's condition (see the module's docstring) and return its text."""
+def _compute(root: Path, expression: str, kind: str):
+    """Evaluate ``expression`` (result values in brackets, see the module's docstring): its value,
+    the values read and the files they came from."""
     import ast
 
-    condition, _, text = (s.strip() for s in arg.partition("|"))
     values, files = {}, []
 
     def name(m):
         spec = m.group(1).strip()
         parts = spec.split()
         if len(parts) < 2:
-            raise ValueError(f"{{{{claim {condition}}}}}: [{spec}]: expected [FILE VAR DIM=LABEL ...]")
+            raise ValueError(f"{{{{{kind} {expression}}}}}: [{spec}]: expected [FILE VAR DIM=LABEL ...]")
         files.append(root / parts[0])
         key = f"_v{len(values)}"
         values[key] = float(_value(root, spec + " fmt=.17g"))
         return key
 
-    expression = CLAIM_VALUE.sub(name, condition)
     try:
-        tree = ast.parse(expression, mode="eval")
+        tree = ast.parse(CLAIM_VALUE.sub(name, expression), mode="eval")
     except SyntaxError as exc:
-        raise ValueError(f"{{{{claim {condition}}}}}: not a condition ({exc.msg})") from None
+        raise ValueError(f"{{{{{kind} {expression}}}}}: not an expression ({exc.msg})") from None
     try:
-        holds = _evaluate(tree, values)
-    except ValueError as exc:
-        raise ValueError(f"{{{{claim {condition}}}}}: {exc}") from None
+        return _evaluate(tree, values), values, files
+    except (ValueError, ZeroDivisionError) as exc:
+        raise ValueError(f"{{{{{kind} {expression}}}}}: {exc}") from None
+
+
+def _expr(root: Path, arg: str) -> str:
+    """The value of an arithmetic expression of result values, formatted (default ``.3g``)."""
+    expression, _, fmt = (s.strip() for s in arg.partition("|"))
+    value, _, _ = _compute(root, expression, "expr")
+    if isinstance(value, bool):
+        raise ValueError(f"{{{{expr {expression}}}}}: a comparison, not a number (write it as a claim)")
+    return format(value, fmt or ".3g")
+
+
+def _claim(root: Path, arg: str) -> str:
+    """Check a claim's condition (see the module's docstring) and return its text."""
+
+    condition, _, text = (s.strip() for s in arg.partition("|"))
+    holds, values, files = _compute(root, condition, "claim")
     if holds is True or (holds is not False and bool(holds)):
         return text
     shown = ", ".join(f"[{m.group(1).strip()}] = {values[f'_v{i}']:.6g}"
@@ -246,6 +266,7 @@ def expand(text: str, paper_dir: Path, root: Path, depth: int = 0) -> str:
         return _value(root, arg)
 
     text = PLACEHOLDER.sub(repl, text)
+    text = EXPR.sub(lambda m: _expr(root, m.group(1)), text)
     return CLAIM.sub(lambda m: _claim(root, m.group(1)), text)
 
 

@@ -259,6 +259,25 @@ def test_claim_condition_is_restricted(tmp_path, condition):
         paper.fill(source, tmp_path / "paper" / "build" / "paper.md")
 
 
+def test_expr_computes_differences_and_ratios(tmp_path):
+    # demo values: E_error 0.0123 at 5 %, 0.0456 at 10 % strain
+    source = make_paper(tmp_path, "d = {{expr ([results/demo.nc E_error level=eps10] - [results/demo.nc E_error "
+                                  "level=eps05]) * 100 | +.2f}}, r = {{expr [results/demo.nc E_error level=eps10] / "
+                                  "[results/demo.nc E_error level=eps05]}}\n"
+                                  "{{claim 1 < 2 | in a claim: {{expr 2 * [results/demo.nc E_error level=eps05] | .4f}}}}\n")
+    text = paper.fill(source, tmp_path / "paper" / "build" / "paper.md").read_text(encoding="utf-8")
+    assert "d = +3.33, r = 3.71" in text
+    assert "in a claim: 0.0246" in text
+
+
+@pytest.mark.parametrize("expression", ["[results/demo.nc E_error level=eps05] > 0",
+                                        "[results/demo.nc E_error level=eps05] / 0", "open('x')"])
+def test_expr_is_a_number_or_an_error(tmp_path, expression):
+    source = make_paper(tmp_path, f"{{{{expr {expression}}}}}\n")
+    with pytest.raises(ValueError):
+        paper.fill(source, tmp_path / "paper" / "build" / "paper.md")
+
+
 def test_false_claim_on_quick_results_is_marked(tmp_path):
     import xarray as xr
 
