@@ -1,4 +1,4 @@
-"""Baudet Figs. 9-10: deflection of the cantilever's neutral axis, MSS and FEM against eq. 10."""
+"""Baudet Figs. 9-10: deflection of the cantilever's neutral axis, MSS (and 32x8x8 beyond the paper) and FEM against eq. 10."""
 
 import sys
 from pathlib import Path
@@ -7,7 +7,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import baudet_common as C  # noqa: E402
 from msslib import plotting  # noqa: E402
 
-RES = ("4x1x1", "8x2x2", "16x4x4")
+RES = ("4x1x1", "8x2x2", "16x4x4", "32x8x8")
 INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]
           + ["results/baudet/cantilever/gravity__fem.nc", "results/baudet/studies/cantilever_eq10.nc"])
 
@@ -21,7 +21,7 @@ def main():
     ax.plot(eq["x"] * 1e3, eq["deflection_timoshenko"] * 1e3, "k:", lw=1.5, label="eq. 10 + shear (Timoshenko)")
     x, w = C.section_deflection(C.open_result(INPUTS[-2]))
     ax.plot(x * 1e3, w * 1e3, color="0.5", lw=3, alpha=0.6, label="FEM (linear, 48x12x12)")
-    for r, p, c in zip(RES, INPUTS[:3], ("tab:red", "tab:orange", "tab:blue")):
+    for r, p, c in zip(RES, INPUTS[:len(RES)], ("tab:red", "tab:orange", "tab:blue", "tab:purple")):
         x, w = C.section_deflection(C.open_result(p))
         ax.plot(x * 1e3, w * 1e3, "o-", color=c, ms=4, label=f"MSS {r}")
     ax.set_xlabel("x (mm)")

@@ -9,7 +9,7 @@ import baudet_common as C  # noqa: E402
 
 from msslib.io import write_text  # noqa: E402
 
-RES = ("4x1x1", "8x2x2", "16x4x4")
+RES = ("4x1x1", "8x2x2", "16x4x4", "32x8x8")
 INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]
           + ["results/baudet/cantilever/gravity__fem.nc", "results/baudet/studies/cantilever_eq10.nc"])
 
@@ -24,7 +24,8 @@ def main():
              "| model | tip deflection (mm) | vs eq. 10 (%) | vs eq. 10 + shear (%) |", "|---|---|---|---|",
              f"| eq. 10 (Euler-Bernoulli, nu = 0) | {tip * 1e3:.4g} | 0 | {100 * (tip / tip_s - 1):+.3g} |",
              f"| eq. 10 + Timoshenko shear | {tip_s * 1e3:.4g} | {100 * (tip_s / tip - 1):+.3g} | 0 |"]
-    for name, path in [("FEM linear 48x12x12", INPUTS[3])] + [(f"MSS {r}", q) for r, q in zip(RES, INPUTS[:3])]:
+    n = len(RES)
+    for name, path in [("FEM linear 48x12x12", INPUTS[n])] + [(f"MSS {r}", q) for r, q in zip(RES, INPUTS[:n])]:
         _, w = C.section_deflection(C.open_result(path))
         lines.append(f"| {name} | {w[-1] * 1e3:.4g} | {100 * (w[-1] / tip - 1):+.3g} | {100 * (w[-1] / tip_s - 1):+.3g} |")
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)

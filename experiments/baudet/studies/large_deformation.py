@@ -1,0 +1,134 @@
+"""Baudet Fig. 11 (and the mass readings of Fig. 10): the cantilever under growing weight.
+
+The paper gives no load for Fig. 11 ("results ... totally wrong for small deformation conditions with
+finite element", linear FEM out of its domain; the MSS "within an acceptable range"), so the weight
+is swept: densities from the printed 0.0125 kg/m^3 up to past the two other readings of the printed
+"mass of 0.0125" (a linear density of 0.0125 kg/m, a total mass of 0.0125 kg), which are levels of
+the sweep. At each level: the Baudet MSS at 4x1x1, 8x2x2 and 16x4x4 cubes (springs are geometrically exact;
+static Newton, 4x1x1 by damped implicit-Euler relaxation, its section modes being zero-energy), linear
+FEM (Q1, scales with the load) and the non-linear reference, neo-Hookean FEM (Q1, total Lagrangian,
+dead load), both on 24x6x6 hexahedra. Errors per node (error_stats: relative to the largest reference
+displacement, and to each node's own) of every model against the non-linear and against the linear
+FEM, and the tip deflection (mean -u_z of the end section).
+"""
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import baudet_common as C  # noqa: E402
+import cantilever_common as K  # noqa: E402
+
+FEM_N = (24, 6, 6)
+MSS = ((4, 1, 1), (8, 2, 2), (16, 4, 4))
+SHAPE_MSS = (16, 4, 4)  # the MSS drawn in the figure
+
+
+def label(n):
+    return "x".join(str(v) for v in n)
+
+
+def at_points(ds, u, X):
+    from msslib.experiment import interpolate
+    from msslib.io import mesh_from_result
+
+    Xr = ds["rest_position"].transpose("node", "axis").values
+    if X.shape == Xr.shape and np.allclose(X, Xr):
+        return u
+    return interpolate(mesh_from_result(ds), u, X)
+
+
+def main():
+    args = C.parse(__doc__)
+    t0 = time.perf_counter()
+    L, T, H, E, _nu, rho0, g = K.base()
+    readings = {k: float(f"{v:.12g}") for k, v in K.mass_readings().items()}  # 3.125, not 3.1249999999999996
+    fem_n, mss = FEM_N, MSS
+    # --quick keeps the model labels and runs every mesh at a reduced size, at the three readings only
+    size = (lambda n: (8, 2, 2)) if args.quick else (lambda n: n)
+    if args.quick:
+        levels = [readings["density"], readings["linear_density"], readings["total_mass"]]
+    else:
+        levels = sorted({readings["density"], 0.5, readings["linear_density"], readings["total_mass"], 8.0})
+    shape_n = SHAPE_MSS
+    # eq. 10 (linear Euler-Bernoulli) tip / L per unit density: the load steps follow it
+    tip_per_rho = T * H * g * L**4 / (8 * E * T * H**3 / 12) / L
+    lin = K.run("fem_linear", size(fem_n))
+    X_f, u_lin1 = K.fields(lin)
+    models = [f"mss_{label(n)}" for n in mss] + ["fem_linear"]
+    stat_names = sorted(K.error_stats(u_lin1, u_lin1 + 1e-9))
+    refs = ("nonlinear", "linear")
+    err = np.full((len(levels), len(models), len(refs), len(stat_names)), np.nan)
+    tip = np.full((len(levels), len(models) + 1), np.nan)
+    tip_x = np.full_like(tip, np.nan)
+    shapes = {}
+    for i, rho in enumerate(levels):
+        t1 = time.perf_counter()
+        s = rho / rho0
+        steps = int(max(1, np.ceil(rho * tip_per_rho / 0.08)))
+        nl = K.run("fem_neohookean", size(fem_n), density=rho,
+                   solver={"type": "static", "load_steps": steps, "tol": 1e-8, "max_iter": 50})
+        _, u_nl = K.fields(nl)
+        u_l = u_lin1 * s
+        fields = {}
+        for n in mss:
+            if size(n)[1] == 1:  # zero-energy section modes: relax dynamically; the relaxation time grows with the mass
+                solver = {"type": "dynamic", "method": "implicit_euler", "dt": 0.005 * s, "t_end": 2.0 * s,
+                          "damping": 100.0, "save_every": 400}
+            else:
+                solver = {"type": "static", "load_steps": steps, "tol": 1e-9}
+            fields[f"mss_{label(n)}"] = K.fields(K.run("baudet_cube", size(n), density=rho, solver=solver))
+        fields["fem_linear"] = (X_f, u_l)
+        for j, m in enumerate(models):
+            X, u = fields[m]
+            for r, (ref_u) in enumerate((u_nl, u_l)):
+                st = K.error_stats(u, at_points(nl, ref_u, X))
+                err[i, j, r] = [st[k] for k in stat_names]
+            tip[i, j] = K.tip(X, u)
+            end = np.isclose(X[:, 0], L)
+            tip_x[i, j] = float(u[end, 0].mean())
+        tip[i, -1] = K.tip(X_f, u_nl)
+        tip_x[i, -1] = float(u_nl[np.isclose(X_f[:, 0], L), 0].mean())
+        if i == len(levels) - 1:
+            shapes = {"mss": fields[f"mss_{label(shape_n)}"], "fem_linear": (X_f, u_l), "fem_nonlinear": (X_f, u_nl)}
+        k_mean = stat_names.index("max_mean")
+        print(f"density {rho:.4g} kg/m^3 ({steps} steps): tip/L nonlinear FEM {tip[i, -1] / L:.4f}, linear {tip[i, -2] / L:.4f}; "
+              "mean error vs non-linear FEM " + ", ".join(f"{m} {err[i, j, 0, k_mean]:.4f}" for j, m in enumerate(models))
+              + f" ({time.perf_counter() - t1:.1f} s)", flush=True)
+
+    ds = xr.Dataset(coords={"density": np.array(levels), "model": models, "reference": list(refs), "stat": stat_names,
+                            "tip_model": models + ["fem_nonlinear"]})
+    ds["density"].attrs = {"units": "kg/m^3", "long_name": "density of the beam"}
+    ds["error"] = (("density", "model", "reference", "stat"), err,
+                   {"units": "1", "long_name": "per-node displacement error statistics (cantilever_common.error_stats)"})
+    ds["tip_deflection"] = (("density", "tip_model"), tip, {"units": "m", "long_name": "tip deflection, downwards"})
+    ds["tip_axial"] = (("density", "tip_model"), tip_x, {"units": "m", "long_name": "axial displacement of the free end"})
+    ds["tip_ratio"] = ds["tip_deflection"] / L
+    ds["tip_ratio"].attrs = {"units": "1", "long_name": "tip deflection / length"}
+    ds["largest_density"] = ((), levels[-1], {"units": "kg/m^3", "long_name": "largest density of the sweep"})
+    ds["largest_error"] = ds["error"].isel(density=-1).drop_vars("density").assign_attrs(
+        long_name="error statistics at the largest density")
+    ds["largest_tip_ratio"] = ds["tip_ratio"].isel(density=-1).drop_vars("density").assign_attrs(
+        units="1", long_name="tip deflection / length at the largest density")
+    ds["tip_ratio_eq10"] = ("density", np.array(levels) * tip_per_rho, {"units": "1", "long_name": "eq. 10 tip deflection / length"})
+    for k, v in readings.items():
+        ds[f"reading_{k}"] = ((), v, {"units": "kg/m^3", "long_name": f"density implied by reading 0.0125 as {k.replace('_', ' ')}"})
+    at = ds.sel(density=list(readings.values())).rename(density="reading").assign_coords(reading=list(readings))
+    ds["reading_error"] = at["error"].assign_attrs(long_name="error statistics at the three readings of the printed mass")
+    ds["reading_tip_ratio"] = (at["tip_deflection"] / L).assign_attrs(units="1", long_name="tip deflection / length at the three readings")
+    for name, (X, u) in shapes.items():
+        ds[f"rest_{name}"] = ((f"node_{name}", "axis"), X, {"units": "m", "long_name": f"rest positions, {name}"})
+        ds[f"displacement_{name}"] = ((f"node_{name}", "axis"), u, {"units": "m",
+                                       "long_name": f"displacement at the largest density, {name}"})
+    ds.attrs.update(title="Baudet cantilever under growing weight (Fig. 11)", quick=int(args.quick),
+                    fem_mesh=label(fem_n), shape_mss=label(shape_n), length=L)
+    C.write(ds, args.out, t0)
+    print(f"done in {time.perf_counter() - t0:.1f} s")
+
+
+if __name__ == "__main__":
+    main()
