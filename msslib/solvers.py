@@ -111,6 +111,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
 
+from msslib.blas_threads import BLOCKED_BANDWIDTH, one_blas_thread
+
 __all__ = [
     "ConvergenceError",
     "DivergenceError",
@@ -1187,6 +1189,23 @@ class _VCycle:
         L["A"] = A
         return True
 
+    def refresh_diagonal(self):
+        """Invert the finest level's diagonal blocks anew, from the matrix of the last
+        :meth:`update`.  The sweeps assume that they solve the diagonal blocks exactly: with the
+        inverses of an older matrix the cycle is not symmetric, and CG with it stalled (the
+        cylinder scene, 2 568 dofs: no convergence in 1 013 iterations at the first solve of the
+        next load step; 4 iterations with the inverses refreshed).
+        False (nothing changed) when a diagonal block is singular."""
+        A = self.levels[0]["A"]
+        try:
+            dinv = _block_diag_inverse(A.indptr, A.indices, A.data)
+        except np.linalg.LinAlgError:
+            return False
+        if not np.all(np.isfinite(dinv)):
+            return False
+        self.levels[0]["dinv"] = dinv
+        return True
+
     def _cycle(self, k, b, x):
         if k == len(self.levels):
             x[:] = np.asarray(self.coarse_solver(self.coarse_A, b), dtype=float).ravel()
@@ -1550,8 +1569,9 @@ def _banded_cholesky_solve(A, b, context):
         flat = ab.reshape(-1, order="F")  # a view (Fortran-contiguous)
         flat[plan["dst"]] = A.data[plan["src"]]
         try:
-            cb = cholesky_banded(ab, lower=True, overwrite_ab=True, check_finite=False)
-            y = cho_solve_banded((cb, True), bp, check_finite=False)
+            with one_blas_thread(bw >= BLOCKED_BANDWIDTH):  # msslib.blas_threads: shared cores
+                cb = cholesky_banded(ab, lower=True, overwrite_ab=True, check_finite=False)
+                y = cho_solve_banded((cb, True), bp, check_finite=False)
         except LinAlgError:  # not positive definite: banded LU (partial pivoting) from now on
             state["band_indefinite"] = True
     if y is None:
@@ -1571,11 +1591,11 @@ def _banded_cholesky_solve(A, b, context):
             full = plan["dst_full"]
             dst = plan["dst_lu"] = (full // (2 * bw + 1)) * rows + full % (2 * bw + 1) + bw
         ab.reshape(-1, order="F")[dst] = A.data
-        lu, piv, info = lapack.dgbtrf(ab, bw, bw, overwrite_ab=1)
-        if info != 0:  # exactly singular (info > 0) or bad input
-            return None
-        y, info = lapack.dgbtrs(lu, bw, bw, bp, piv, overwrite_b=1)
-        if info != 0:
+        with one_blas_thread(bw >= BLOCKED_BANDWIDTH):
+            lu, piv, info = lapack.dgbtrf(ab, bw, bw, overwrite_ab=1)
+            if info == 0:
+                y, info = lapack.dgbtrs(lu, bw, bw, bp, piv, overwrite_b=1)
+        if info != 0:  # exactly singular (info > 0 from gbtrf) or bad input
             return None
     x = np.empty(n)
     x[perm] = y
@@ -1600,9 +1620,10 @@ def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10, t
     ``context`` (optional dict) holds ``dim`` and ``coords`` (free nodes) for the AMG near-null
     space and a ``cache`` where the AMG hierarchy is kept and reused for the next matrices
     (Newton iterations, load steps, later static solves of the same problem, time steps) as long
-    as CG converges fast with it; a kept compiled V-cycle smooths with each new matrix's values
-    (:meth:`_VCycle.update`).  ``rtol`` is
-    the CG tolerance (relative to ``||b||``).  With ``truncate``, a CG run that meets negative
+    as CG converges fast with it (a kept one is given up as soon as CG passes that limit); a kept
+    compiled V-cycle smooths with each new matrix's values and diagonal blocks
+    (:meth:`_VCycle.update`, :meth:`_VCycle.refresh_diagonal`).  ``rtol`` is the CG tolerance
+    (relative to ``||b||``).  With ``truncate``, a CG run that meets negative
     curvature returns its last iterate (truncated Newton: used under an energy line search)
     instead of falling back to sparse LU."""
     if callable(method):
@@ -1623,15 +1644,17 @@ def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10, t
                 maxiter = max(1000, int(20 * np.sqrt(n)))
                 M = cache.get("M") if cache.get("shape") == A.shape else None
                 reused = M is not None
-                if reused and isinstance(M, _VCycle):
-                    M.update(A)  # the finest level smooths with this matrix's values
+                if reused and isinstance(M, _VCycle) and M.update(A):  # smooth with this matrix
+                    M.refresh_diagonal()
                 if M is None:
                     M = _preconditioner(A, context)
-                x, info, its = _pcg(A, b, M, rtol, maxiter)
-                total = its
                 # iterations per decade of residual reduction: comparable across tolerances
                 decades = max(1.0, -np.log10(max(rtol, 1e-300)))
-                if reused and (info > 0 or its > 2.0 * cache.get("per_decade", maxiter) * decades + 10):
+                limit = 2.0 * cache.get("per_decade", maxiter) * decades + 10
+                # a kept hierarchy is given up as soon as CG exceeds the limit, not at maxiter
+                x, info, its = _pcg(A, b, M, rtol, min(maxiter, int(limit) + 1) if reused else maxiter)
+                total = its
+                if reused and (info > 0 or its > limit):
                     # the kept hierarchy no longer fits the matrix: rebuild it and solve again
                     M = _preconditioner(A, context)
                     reused = False
