@@ -48,6 +48,8 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     :func:`msslib.mesh.read`): groups of its cells for ``materials``, groups of boundary facets
     (gmsh physical surfaces of a 3D mesh, curves of a 2D mesh) and nodes for ``select``.  A group
     is known by its name, a gmsh physical group without a name by its number (``3`` or ``"3"``).
+    ``refine: k`` (optional) refines the mesh uniformly ``k`` times (:func:`msslib.refine.uniform`:
+    nested meshes of one domain, the coarse nodes keeping their numbers).
 ``materials``
     A non-empty list (every material used by some cell) of ``{E, nu, density}``: Young's modulus ``E > 0`` (Pa), Poisson's ratio
     ``-1 < nu < 0.5`` and the density (kg/m^3, > 0).  ``density`` may be omitted unless the scene
@@ -138,7 +140,8 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
 ``solver``
     ``{type: static, load_steps: 1, tol: 1.0e-8, max_iter: 50}`` (default; load-stepped Newton
     of :func:`msslib.solvers.static_solve` for MSS, :func:`msslib.fem.solve_nonlinear` for the
-    non-linear FEM; ``fem_linear`` ignores them), or ``{type: dynamic, method:
+    non-linear FEM; ``fem_linear`` ignores them; ``linear: true`` makes one solve with the
+    stiffness at rest instead: the MSS model's Hessian, or linear FEM), or ``{type: dynamic, method:
     symplectic_euler | velocity_verlet | implicit_euler, dt: 1.0e-4, t_end: 0.1, damping: 0.0,
     save_every: 1, allow_unstable: false}`` (MSS only, :func:`msslib.solvers.integrate` from rest;
     ``damping`` is a mass-proportional ``alpha`` (1/s) or a Rayleigh pair ``[alpha, beta]``).  An
@@ -517,10 +520,13 @@ def _generator_function(name):
 
 
 def _geometry(path, value, base_dir: Path):
-    _mapping(path, value, ("generator", "args", "file"))
+    _mapping(path, value, ("generator", "args", "file", "refine"))
     has_gen, has_file = "generator" in value, "file" in value
     if has_gen == has_file:
         _fail(path, "give exactly one of 'generator' (with 'args') or 'file'")
+    # uniform midpoint refinements of the mesh (msslib.refine.uniform); only stored when asked for
+    refine = {"refine": _integer(f"{path}.refine", value["refine"], minimum=0, maximum=8,
+                                 why=" (each multiplies the cells by 4 or 8)")} if "refine" in value else {}
     if has_file:
         if "args" in value:
             _fail(f"{path}.args", "only used with 'generator'")
@@ -536,7 +542,7 @@ def _geometry(path, value, base_dir: Path):
             _mesh.check_mesh_suffix(file_path)
         except ValueError as exc:
             _fail(f"{path}.file", str(exc))
-        return {"file": file_path}
+        return {"file": file_path, **refine}
     name = _choice(f"{path}.generator", value["generator"], tuple(GENERATORS), "generator")
     args = value.get("args") or {}
     if not isinstance(args, Mapping):
@@ -553,7 +559,7 @@ def _geometry(path, value, base_dir: Path):
     missing = [p.name for p in sig.parameters.values() if p.default is inspect.Parameter.empty and p.name not in args]
     if missing:
         _fail(f"{path}.args", f"{name} needs the argument(s) {', '.join(missing)}")
-    return {"generator": name, "args": converted}
+    return {"generator": name, "args": converted, **refine}
 
 
 def _generator_arg(path, value):
@@ -723,8 +729,10 @@ def _solver(path, value, model):
         _fail(path, f"expected a mapping with 'type' (static or dynamic), got {value!r}")
     kind = _choice(f"{path}.type", value.get("type", "static"), SOLVER_TYPES, "solver type")
     if kind == "static":
-        _mapping(path, value, ("type", "load_steps", "tol", "max_iter"))
-        return {
+        _mapping(path, value, ("type", "load_steps", "tol", "max_iter", "linear"))
+        # linear: one solve with the stiffness at rest (the model's Hessian, or linear FEM)
+        linear = {"linear": True} if _boolean(f"{path}.linear", value.get("linear", False)) else {}
+        return {**linear,
             "type": "static",
             "load_steps": _integer(f"{path}.load_steps", value.get("load_steps", 1), maximum=MAX_LOAD_STEPS,
                                    why=" (each load step is a Newton solve)"),
@@ -799,6 +807,7 @@ def _check_size(root, geometry, model, solver, output, checks, n_nodes=None, dim
         n_nodes, _n_cells, dim = resources.generated_mesh_size(geometry["generator"], geometry["args"])
         if not math.isfinite(n_nodes):
             return
+        n_nodes *= (2**dim) ** geometry.get("refine", 0)  # about: a refinement multiplies the nodes by 2^dim
     n_saved = _saved_states(solver, output)
     estimate = resources.run_memory(n_nodes, dim, fem=model in FEM_MODELS, n_saved=n_saved)
     history = resources.history_memory(n_saved, n_nodes * dim)
@@ -924,6 +933,10 @@ def _build_mesh(scene: Scene) -> _mesh.Mesh:
             mesh = fn(**geo["args"])
         except (ValueError, TypeError) as exc:
             _fail("scene.geometry", f"{geo['generator']}: {exc}")
+    if geo.get("refine"):
+        from msslib.refine import uniform
+
+        mesh = uniform(mesh, geo["refine"])
     if scene.thickness is not None and mesh.dim == 3:
         _fail("scene.thickness", "applies to 2D meshes only; the mesh is 3D")
     groups = scene.material_groups
@@ -1365,7 +1378,7 @@ def _solve_fem(setup: Setup, report):
     if mesh.dim == 2:
         kw.update(thickness=setup.thickness, plane=scene.model_options["plane"])
     law = FEM_MODELS[scene.model]
-    if law is None:
+    if law is None or scene.solver.get("linear"):
         res = fem.solve_linear(mesh, E, nu, **kw)
     else:
         s = scene.solver
@@ -1387,6 +1400,8 @@ def _solve_mss_static(setup: Setup, report):
     def cb(info):
         report(info["load"], f"load {info['load']:.3g} it {info['iteration']} |r| {info['residual']:.2e}")
 
+    if s.get("linear"):
+        return _solve_mss_linear(setup)
     res = static_solve(model, model.x0, load_steps=s["load_steps"], tol=s["tol"], max_iter=s["max_iter"], progress=cb)
     u = (res.x - model.x0).reshape(-1, model.dim)
     stats = {
@@ -1400,6 +1415,22 @@ def _solve_mss_static(setup: Setup, report):
     energy = model.energy(res.x, 1.0)
     extra = {"potential_energy": "None" if energy is None else energy}
     return {"displacement": u, "reaction": model.reaction(res.x, 1.0), "stats": stats, "extra_attrs": extra}
+
+
+def _solve_mss_linear(setup: Setup):
+    """One sparse solve with the model's stiffness (Hessian) at rest: the linearised MSS."""
+    from msslib.fem import _solve_sparse
+
+    model, t0 = setup.model, time.perf_counter()
+    x = model.apply_prescribed(model.x0, 1.0)
+    du, free = x - model.x0, model.free
+    K, f = model.stiffness(model.x0, 1.0), model.force(model.x0, 1.0)
+    du[free] = _solve_sparse(K[free][:, free], f[free] - K[free][:, ~free] @ du[~free])
+    reaction = np.where(free, 0.0, K @ du - f).reshape(-1, model.dim)  # of the linearised forces
+    stats = {"type": "static", "linear": True, "wall_time": time.perf_counter() - t0, "solver": "one solve with the "
+             "stiffness at rest, scipy.sparse.linalg.spsolve (SuperLU, MMD_AT_PLUS_A ordering)"}
+    return {"displacement": du.reshape(-1, model.dim), "reaction": reaction, "stats": stats,
+            "extra_attrs": {"potential_energy": "None"}}
 
 
 def _solve_mss_dynamic(setup: Setup, report):
