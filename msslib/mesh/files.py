@@ -1,0 +1,381 @@
+"""Mesh files: :func:`read` (any mesh file meshio reads; every failure one ValueError naming the
+file; keeps the file's physical groups, cell sets and node sets), :func:`write_vtu`,
+:func:`readable_suffixes` and :func:`check_mesh_suffix`.  meshio is imported when a file is read
+or written, not with this module.
+"""
+
+from __future__ import annotations
+
+import os
+import uuid
+from pathlib import Path
+
+import numpy as np
+
+from .core import CELL_TYPES, COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _fmt_point
+from .hygiene import resolve_coincident_nodes
+
+
+def readable_suffixes() -> list[str]:
+    """The file suffixes meshio knows (``.msh``, ``.vtu``, ...), sorted; compound ones such as
+    ``.vol.gz`` included."""
+    import meshio
+
+    return sorted(meshio.extension_to_filetypes)
+
+
+def check_mesh_suffix(path) -> None:
+    """Raise ValueError naming ``path`` and the suffixes meshio knows when its suffix is not one
+    of them (meshio would otherwise give up on the file with :class:`SystemExit` or an error)."""
+    path = Path(path)
+    known = set(readable_suffixes())
+    suffixes = [s.lower() for s in path.suffixes]
+    if not any("".join(suffixes[i:]) in known for i in range(len(suffixes))):
+        shown = repr(path.suffix) if path.suffix else "(none)"
+        raise ValueError(f"{path}: unknown mesh file suffix {shown}; allowed: the suffixes meshio reads, "
+                         f"{' '.join(sorted(known))}")
+
+
+def _meshio_read(path: Path):
+    """``meshio.read`` that never exits the interpreter: any failure (meshio calls ``sys.exit``
+    for some files and raises anything from ``struct.error`` to ``UnicodeDecodeError`` for others)
+    becomes one ValueError naming the file.  What meshio prints is captured: part of the message on
+    failure; on success returned with the mesh and the warnings it raised, ``(mesh, printed,
+    warnings)``, for :func:`read` to pass on once the mesh has passed its own checks."""
+    import io
+    import warnings
+    from contextlib import redirect_stderr, redirect_stdout
+
+    import meshio
+
+    printed = io.StringIO()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            with redirect_stdout(printed), redirect_stderr(printed):
+                m = meshio.read(path)
+        except (Exception, SystemExit) as exc:  # noqa: BLE001 - every failure of a reader is bad input
+            said = " ".join(printed.getvalue().replace("Error:", " ").split())
+            if isinstance(exc, UnicodeDecodeError):
+                detail = (f"not UTF-8 text where the {path.suffix or 'chosen'} reader expects text "
+                          f"({exc.reason} at byte {exc.start})")
+            elif isinstance(exc, SystemExit):
+                detail = said or "meshio gave up on it"
+            else:
+                text = " ".join(str(exc).split())
+                detail = f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+                if said and said not in detail:
+                    detail += f" ({said})"
+            if "Incompatible cell data 'gmsh:physical'" in str(exc):
+                detail += (" (meshio reads gmsh physical groups only when every element is in one: save without "
+                           "Mesh.SaveAll, or put every entity in a physical group)")
+            if len(detail) > 300:
+                detail = detail[:297] + "..."
+            raise ValueError(f"{path}: cannot read mesh: {detail}; allowed: a valid mesh file in a format meshio "
+                             f"reads, chosen by its suffix") from None
+    return m, " ".join(printed.getvalue().split()), caught
+
+
+def read(path, material_key: str = "material", coincident_nodes: str = "merge",
+         coincident_rtol: float = COINCIDENT_RTOL) -> Mesh:
+    """Read any mesh file meshio can read.
+
+    The cells are the blocks of the highest-dimensional supported type (``tetra`` or
+    ``hexahedron`` before ``triangle`` or ``quad``; between two types of the same dimension the
+    one with more cells); blocks of that type are concatenated.  Nodes no chosen cell uses are
+    dropped (the others keep their order).  For 2D cells the z coordinate must be constant and is
+    dropped.  ``cell_data[material_key]`` (one integer per cell), when present, becomes
+    ``material``; otherwise every cell has material 0, also when the file has groups (the scenes
+    assign materials by group, :func:`materials_from_groups`).  Two cells on the same nodes are
+    an error (a gmsh 2 file repeats an element for every physical group it belongs to).
+
+    Groups (:class:`Mesh`): the gmsh physical groups (``cell_data["gmsh:physical"]``, named by
+    ``field_data`` ``{name: [tag, dim]}``; a group without a name is known by its tag, ``"3"``;
+    meshio keeps one physical tag per element, the first) and meshio's ``cell_sets`` (gmsh 4
+    named groups, Abaqus ELSET, ...; sets named ``gmsh:...`` are meshio's bookkeeping and are
+    skipped) become ``cell_groups`` for elements of the chosen cell type, ``facet_groups`` for
+    elements of its facet type (lines in 2D, triangles for tetra, quads for hexahedron cells) and
+    ``node_groups`` (the nodes of the elements) for other lower-dimensional elements (gmsh
+    physical points and curves of a 3D mesh, triangles of a hexahedron mesh); meshio's
+    ``point_sets`` (Abaqus NSET, Exodus node sets) become ``node_groups``.  A group of the same
+    name from both sources is their union.  Elements of other types of the cells' dimension and
+    of higher dimensions are ignored, with their groups.  A facet or node group on a node no chosen
+    cell uses is dropped with a :class:`msslib.errors.MsslibWarning` naming it (it could not carry
+    its load or support).  VTU files hold no sets (meshio writes them as cell data it cannot split
+    back reliably): their groups come from a ``gmsh:physical`` cell data array, by number.
+
+    Coincident nodes (closer than ``coincident_rtol`` times the bounding-box diagonal, see
+    :func:`resolve_coincident_nodes`) are merged with a :class:`msslib.errors.MsslibWarning`
+    (``coincident_nodes="merge"``, the default), refused (``"error"``) or kept (``"keep"``); the
+    messages give node numbers of the file.
+
+    Raises FileNotFoundError for a missing file, and a one-line ValueError naming the file for
+    everything else: a directory, an unknown suffix (listing the suffixes meshio knows), an empty
+    or unreadable file (whatever meshio raises, :class:`SystemExit` included), no cells or no
+    supported cell type (naming the types found), cells referring to nodes that do not exist,
+    non-finite coordinates, material values that are not integers, duplicate cells, a cell
+    collapsed by merging.
+    """
+    if coincident_nodes not in COINCIDENT_POLICIES:
+        raise ValueError(f"coincident_nodes must be one of {', '.join(COINCIDENT_POLICIES)}, got {coincident_nodes!r}")
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{path}: is a directory; allowed: a mesh file")
+    if not path.exists():
+        raise FileNotFoundError(f"mesh file not found: {path}")
+    if not path.is_file():
+        raise ValueError(f"{path}: not a regular file; allowed: a mesh file")
+    check_mesh_suffix(path)
+    if path.stat().st_size == 0:
+        raise ValueError(f"{path}: cannot read mesh: the file is empty; allowed: a mesh file with cells")
+    m, said, caught = _meshio_read(path)
+    try:
+        mesh, used, notes = _mesh_from_meshio(path, m, material_key)
+    except (ValueError, TypeError, IndexError, KeyError) as exc:  # one line naming the file, whatever it is
+        text = " ".join(str(exc).split()) or type(exc).__name__
+        if not text.startswith(str(path)):
+            text = f"{path}: cannot read mesh: {type(exc).__name__}: {text}"
+        if said:  # what meshio printed while reading explains the problem
+            text += f"; meshio said: {said[:200]}"
+        raise ValueError(text) from None
+    import warnings
+
+    for w in caught:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if said:
+        from msslib.errors import MsslibWarning
+
+        warnings.warn(f"{path}: meshio says: {said}", MsslibWarning, stacklevel=2)
+    if notes:
+        from msslib.errors import MsslibWarning
+
+        for note in notes:
+            warnings.warn(f"{path}: {note}", MsslibWarning, stacklevel=2)
+    hint = " (coincident_nodes: merge merges them)" if coincident_nodes == "error" else ""
+    return resolve_coincident_nodes(mesh, coincident_nodes, coincident_rtol, source=str(path), node_ids=used,
+                                    hint=hint)
+
+
+def _mesh_from_meshio(path: Path, m, material_key: str):
+    """The :class:`Mesh` of :func:`read` from a meshio mesh, the file numbers of its nodes, and the
+    notes on dropped groups to warn about."""
+    allowed = f"allowed: {', '.join(CELL_TYPES)} cells"
+    blocks_all = [b for b in m.cells if len(b.data)]
+    if not blocks_all:
+        raise ValueError(f"{path}: the mesh has no cells ({len(m.points)} points); {allowed}")
+    found = [block.type for block in blocks_all]
+    supported = [t for t in CELL_TYPES if t in found]
+    if not supported:
+        raise ValueError(f"{path}: no supported cell type; found {sorted(set(found))}, supported {sorted(CELL_TYPES)}")
+
+    def rank(t):
+        return CELL_TYPES[t][0], sum(len(b.data) for b in m.cells if b.type == t)
+
+    cell_type = max(supported, key=rank)
+    dim = CELL_TYPES[cell_type][0]
+    blocks = [k for k, b in enumerate(m.cells) if b.type == cell_type and len(b.data)]
+    cells = np.concatenate([np.asarray(m.cells[k].data).reshape(len(m.cells[k].data), -1) for k in blocks])
+    points = np.asarray(m.points, dtype=float)
+    if points.ndim != 2 or not 2 <= points.shape[1] <= 3:
+        raise ValueError(f"{path}: points have shape {points.shape}; allowed: 2 or 3 coordinates per point")
+    n_file = len(points)
+    outside = (cells < 0) | (cells >= n_file)
+    if outside.any():
+        c = int(np.flatnonzero(outside.any(axis=1))[0])
+        node = int(cells[c][outside[c]][0])
+        raise ValueError(f"{path}: {cell_type} cell {c} refers to node {node}, which does not exist; "
+                         f"allowed: nodes 0 to {n_file - 1}")
+    cells = cells.astype(np.int64)
+    material = None
+    if material_key in m.cell_data:
+        values = np.concatenate([np.asarray(m.cell_data[material_key][k]).reshape(len(m.cells[k].data), -1)
+                                 for k in blocks])
+        if values.shape[1] != 1:
+            raise ValueError(f"{path}: cell data {material_key!r} has {values.shape[1]} values per cell; "
+                             f"allowed: one integer material index per cell")
+        values = values[:, 0]
+        if not np.issubdtype(values.dtype, np.number) or np.issubdtype(values.dtype, np.complexfloating):
+            raise ValueError(f"{path}: cell data {material_key!r} has type {values.dtype}; allowed: integers")
+        bad = np.flatnonzero(~np.isfinite(values) | (values != np.rint(values)))
+        if len(bad):
+            raise ValueError(f"{path}: cell data {material_key!r} of cell {int(bad[0])} is {values[bad[0]].item()!r}; "
+                             f"allowed: integer material indices")
+        material = np.rint(values).astype(np.int64)
+    _check_duplicate_cells(path, cells, cell_type)
+    used = np.unique(cells)  # file numbers of the nodes the cells use, ascending
+    groups, notes = _file_groups(m, cell_type, blocks, used)
+    points = points[used]
+    cells = np.searchsorted(used, cells)
+    bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+    if len(bad):
+        raise ValueError(f"{path}: node {int(used[bad[0]])} has coordinates {_fmt_point(points[bad[0]])} "
+                         f"({len(bad)} node(s) with NaN or infinite coordinates); allowed: finite coordinates")
+    if points.shape[1] < dim:
+        points = np.pad(points, ((0, 0), (0, dim - points.shape[1])))
+    if dim == 2 and points.shape[1] == 3:
+        z = points[:, 2]
+        scale = max(np.ptp(points[:, :2], axis=0).max(initial=0.0), 1e-300)
+        if len(z) and np.ptp(z) > 1e-9 * scale:
+            raise ValueError(f"{path}: {cell_type} cells are not in a plane z = const; cannot make a 2D mesh")
+        points = points[:, :2]
+    return Mesh(points, cells, cell_type, material, **groups), used, notes
+
+
+def _check_duplicate_cells(path: Path, cells: np.ndarray, cell_type: str) -> None:
+    """Two cells on the same nodes (in any order) are a ValueError naming both."""
+    if len(cells) < 2:
+        return
+    keys = np.sort(cells, axis=1)
+    _, first, inverse, counts = np.unique(keys, axis=0, return_index=True, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    dup = np.flatnonzero(counts[inverse] > 1)
+    dup = dup[dup != first[inverse[dup]]]
+    if len(dup):
+        c = int(dup[0])
+        raise ValueError(f"{path}: {cell_type} cells {int(first[inverse[c]])} and {c} have the same nodes ({len(dup)} "
+                         f"duplicate cell(s)); allowed: each cell once (a gmsh 2 file repeats an element for every "
+                         f"physical group it belongs to: save it in gmsh format 4 or put each element in one group)")
+
+
+#: topological dimension of meshio cell types that may carry groups (others are looked up in meshio)
+_TOPOLOGICAL_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
+                    "quad9": 2, "polygon": 2, "tetra": 3, "tetra10": 3, "hexahedron": 3, "hexahedron20": 3,
+                    "hexahedron27": 3, "wedge": 3, "pyramid": 3}
+
+#: the element type of the facets of each cell type
+_FACET_TYPE = {"triangle": "line", "quad": "line", "tetra": "triangle", "hexahedron": "quad"}
+
+
+def _block_dim(cell_type: str) -> int | None:
+    if cell_type in _TOPOLOGICAL_DIM:
+        return _TOPOLOGICAL_DIM[cell_type]
+    try:
+        from meshio._mesh import topological_dimension
+    except ImportError:  # pragma: no cover - depends on meshio's internals
+        return None
+    return topological_dimension.get(cell_type)
+
+
+def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray) -> tuple[dict, list]:
+    """The groups of a meshio mesh (see :func:`read`) as keyword arguments of :class:`Mesh` (cell
+    indices into the concatenated ``blocks``, node indices into ``used``), and the notes on the
+    groups dropped because they touch nodes no chosen cell uses."""
+    dim = CELL_TYPES[cell_type][0]
+    offsets = {}
+    start = 0
+    for k in blocks:
+        offsets[k] = start
+        start += len(m.cells[k].data)
+    names = {}  # (dim, tag) -> name, from gmsh's $PhysicalNames
+    for name, value in (m.field_data or {}).items():
+        value = np.asarray(value).ravel()
+        if value.size == 2 and value.dtype.kind in "iu":
+            names[(int(value[1]), int(value[0]))] = str(name)
+    physical = (m.cell_data or {}).get("gmsh:physical")
+    cell_sets = {str(k): v for k, v in (m.cell_sets or {}).items() if not str(k).startswith("gmsh:")}
+    cells_acc, facets_acc, nodes_acc = {}, {}, {}
+    for k, block in enumerate(m.cells):
+        n = len(block.data)
+        if n == 0:
+            continue
+        bdim = _block_dim(block.type)
+        if block.type == cell_type:
+            if k not in offsets:
+                continue
+            target = cells_acc
+        elif bdim is None or bdim >= dim:
+            continue  # another cell type of the same or a higher dimension: not in the mesh
+        else:
+            target = facets_acc if (bdim == dim - 1 and block.type == _FACET_TYPE[cell_type]) else nodes_acc
+        members = []  # (group name, element indices in the block)
+        if physical is not None and k < len(physical):
+            tags = np.asarray(physical[k]).reshape(n, -1)[:, 0]
+            if tags.dtype.kind in "iuf":
+                for tag in np.unique(tags):
+                    if tag != int(tag):
+                        continue
+                    members.append((names.get((bdim, int(tag)), str(int(tag))), np.flatnonzero(tags == tag)))
+        for name, per_block in cell_sets.items():
+            if k < len(per_block) and per_block[k] is not None and len(per_block[k]):
+                members.append((name, np.asarray(per_block[k], dtype=np.int64).ravel()))
+        data = np.asarray(block.data)
+        for name, idx in members:
+            if target is cells_acc:
+                cells_acc.setdefault(name, []).append(offsets[k] + idx)
+            elif target is facets_acc:
+                facets_acc.setdefault(name, []).append(data[idx].reshape(len(idx), -1))
+            else:
+                nodes_acc.setdefault(name, []).append(data[idx].ravel())
+    for name, nodes in (m.point_sets or {}).items():
+        if not str(name).startswith("gmsh:") and len(nodes):
+            nodes_acc.setdefault(str(name), []).append(np.asarray(nodes, dtype=np.int64).ravel())
+
+    notes = []
+
+    def to_mesh_nodes(kind, name, file_nodes):
+        """File node numbers -> mesh node indices; None (and a note) if one is not a mesh node."""
+        file_nodes = np.asarray(file_nodes, dtype=np.int64)
+        pos = np.clip(np.searchsorted(used, file_nodes), 0, len(used) - 1)
+        missing = used[pos] != file_nodes
+        if missing.any():
+            notes.append(f"{kind} group {name!r} dropped: {int(missing.sum())} of its node entries (e.g. node "
+                         f"{int(file_nodes[missing].ravel()[0])}) belong to no {cell_type} cell, so it could not "
+                         f"carry its loads or supports")
+            return None
+        return pos
+
+    facet_groups, node_groups = {}, {}
+    for name, parts in facets_acc.items():
+        facets = to_mesh_nodes("facet", name, np.concatenate(parts))
+        if facets is not None:
+            _, first = np.unique(np.sort(facets, axis=1), axis=0, return_index=True)
+            facet_groups[name] = facets[np.sort(first)]  # a facet in the group twice (two sources) once
+    for name, parts in nodes_acc.items():
+        nodes = to_mesh_nodes("node", name, np.unique(np.concatenate(parts)))
+        if nodes is not None:
+            node_groups[name] = nodes
+    cell_groups = {name: np.unique(np.concatenate(parts)) for name, parts in cells_acc.items()}
+    return {"cell_groups": cell_groups, "facet_groups": facet_groups, "node_groups": node_groups}, notes
+
+
+def _pad_columns(a: np.ndarray, dim: int) -> np.ndarray:
+    if dim == 2 and a.ndim == 2 and a.shape[1] == 2:
+        return np.pad(a, ((0, 0), (0, 1)))
+    return a
+
+
+def write_vtu(path, mesh: Mesh, point_data: dict | None = None, cell_data: dict | None = None) -> Path:
+    """Write ``mesh`` as a VTK unstructured grid (.vtu) that ParaView opens.
+
+    2D points get ``z = 0``; on a 2D mesh, data arrays of shape ``(n, 2)`` (vectors) are padded
+    to 3 components as well.  ``point_data`` arrays have ``n_nodes`` rows, ``cell_data`` arrays
+    ``n_cells`` rows; ``material`` is always written as cell data.  The file is written to a
+    temporary file in the same directory and moved into place with :func:`os.replace`, so a
+    reader never sees a partial file.  Returns the path.
+    """
+    import meshio
+
+    path = Path(path)
+    point_data = {} if point_data is None else dict(point_data)
+    cell_data = {} if cell_data is None else dict(cell_data)
+    pdata, cdata = {}, {"material": [mesh.material]}
+    for name, values in point_data.items():
+        values = np.asarray(values)
+        if len(values) != mesh.n_nodes:
+            raise ValueError(f"point_data[{name!r}] has {len(values)} rows, the mesh {mesh.n_nodes} nodes")
+        pdata[name] = _pad_columns(values, mesh.dim)
+    for name, values in cell_data.items():
+        values = np.asarray(values)
+        if len(values) != mesh.n_cells:
+            raise ValueError(f"cell_data[{name!r}] has {len(values)} rows, the mesh {mesh.n_cells} cells")
+        cdata[name] = [_pad_columns(values, mesh.dim)]
+    points = _pad_columns(mesh.points, mesh.dim)
+    out = meshio.Mesh(points, [(mesh.cell_type, mesh.cells)], point_data=pdata, cell_data=cdata)
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    try:
+        meshio.write(tmp, out, file_format="vtu")
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
