@@ -3,19 +3,15 @@ and the crossover budget (experiments/performance/front.py and reference.py)."""
 
 import copy
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
 
+from experiments.performance import front
+from experiments.performance import reference as R
 from msslib import fem
 from msslib.scene import load_scene, prepare, run_scene
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "experiments" / "performance"))
-import front
-import reference as R
 
 MEMBRANE = {
     "name": "m", "geometry": {"generator": "triangle_grid_equilateral", "args": {"width": 0.0720534, "height": 0.0521, "n": 6}},

@@ -109,8 +109,7 @@ def reference(raw, base_dir, levels, law_model, progress, below=1):
     """Quadratic-element non-linear reference on the level ``below`` (1 or 0) levels under the
     finest (on the level below, its dofs are the finest level's nodes), solved on up to two coarser
     levels too for its error estimate."""
-    import reference as R
-
+    from experiments.performance import reference as R
     from msslib.scene import FEM_MODELS, prepare
 
     law = FEM_MODELS[law_model]
@@ -283,9 +282,6 @@ def main(scene: str, levels, quick_levels=(0, 1), below=1):
     p.add_argument("--out", required=True)
     p.add_argument("--quick", action="store_true")
     a = p.parse_args()
-    import sys
-
-    sys.path.insert(0, str(HERE))
     front = measure(HERE / "scenes" / scene, quick_levels if a.quick else levels, repeats=1 if a.quick else 3,
                     progress=lambda s: print(s, flush=True), below=below)
     front.attrs["scene_file"] = f"experiments/performance/scenes/{scene}"
