@@ -6,8 +6,9 @@ values (an edge of a triangle mesh: the sum over its one or two triangles). Spri
 N/m, rest-length factors are dimensionless (rest length = factor x rest distance), volume
 coefficients as documented per function.
 
-The formulas are not typed in here: they come from ``msslib.generated`` (``python -m
-derivations.codegen``). Where a published formula is wrong or ambiguous (see ``paper/errata.md``),
+The functions live with their models, one module per family in :mod:`msslib.models` (found by
+its registry); this module gathers them under one name. The formulas are not typed in: they come
+from ``msslib.generated`` (``python -m derivations.codegen``). Where a published formula is wrong or ambiguous (see ``paper/errata.md``),
 the function returns the derived one, and ``published=True`` returns the paper's as printed.
 Out-of-domain input raises ``ValueError`` naming the value; a formula used where it is not exact
 (e.g. the triangle formula at nu != 1/3) issues a ``FormulaValidityWarning``.
@@ -24,246 +25,30 @@ naming the inputs.
 
 from __future__ import annotations
 
-import numbers
-import warnings
-from dataclasses import dataclass, fields
+from msslib.models import families as _families
+from msslib.models.checks import FormulaValidityWarning, brief, poisson, positive, same_shape, warn_nu
 
-import numpy as np
+__all__ = ["FormulaValidityWarning", "VALID_NU", "check_material"]
 
-from msslib.generated import cube_baudet as _baudet
-from msslib.generated import cube_golec as _golec
-from msslib.generated import square as _square
-from msslib.generated import tetrahedron as _tet
-from msslib.generated import triangle as _tri
+#: parameter function -> the Poisson's ratio at which it is exact (or optimal), from every family
+VALID_NU: dict = {}
 
-
-class FormulaValidityWarning(UserWarning):
-    """A formula is used outside the conditions under which it was derived."""
-
-
-def _brief(value) -> str:
-    """A value for a message: arrays by shape and dtype, long reprs cut."""
-    if isinstance(value, np.ndarray) and value.ndim:
-        return f"array of shape {value.shape} ({value.dtype})"
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _real(name, value):
-    """``value`` if it is a real number or a numpy array of real numbers, else ValueError."""
-    if isinstance(value, np.ndarray):
-        if value.dtype.kind not in "iuf":
-            raise ValueError(f"{name} must be a real number or a numpy array of real numbers, "
-                             f"got an array of dtype {value.dtype}: {_brief(value)}")
-        return value
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.integer, np.floating)):
-        raise ValueError(f"{name} must be a real number or a numpy array of real numbers, "
-                         f"got {type(value).__name__} {_brief(value)}")
-    try:
-        float(value)
-    except OverflowError:
-        raise ValueError(f"{name} is too large for double precision, got {_brief(value)}") from None
-    return value
-
-
-def _flag(name, value):
-    if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name} must be True or False, got {type(value).__name__} {_brief(value)}")
-    return bool(value)
-
-
-def _same_shape(function, **args):
-    """All array arguments of one call have the same shape (scalars go with any)."""
-    shapes = {k: np.shape(v) for k, v in args.items() if isinstance(v, np.ndarray) and v.ndim}
-    if len(set(shapes.values())) > 1:
-        shown = ", ".join(f"{k} {s}" for k, s in shapes.items())
-        raise ValueError(f"{function}: array arguments must all have the same shape (no broadcasting), got {shown}")
-
-
-def _evaluate(function, formula, cls, **args):
-    """``cls(*formula(*args))``; a field that overflows to inf or comes out NaN is refused."""
-    shown = ", ".join(f"{k}={_brief(v)}" for k, v in args.items())
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore", under="ignore"):
-        try:
-            values = formula(*args.values())
-        except (OverflowError, ZeroDivisionError):
-            raise ValueError(f"{function}({shown}): the result overflows double precision; the inputs are "
-                             f"out of its range") from None
-    values = values if isinstance(values, tuple) else (values,)
-    for f, v in zip(fields(cls), values):
-        bad = ~np.isfinite(np.asarray(v, dtype=float))
-        if np.any(bad):
-            what = "is infinite" if np.any(np.isinf(np.asarray(v, dtype=float))) else "is NaN"
-            raise ValueError(f"{function}({shown}): {f.name} {what}; the inputs are out of the range "
-                             f"of double precision")
-    return cls(*values)
-
-
-def _offending(value, bad):
-    """The value itself (scalars) or the first offending entry and where it is (arrays)."""
-    v = np.asarray(value, dtype=float)
-    if v.ndim == 0:
-        return repr(value)
-    i = int(np.flatnonzero(bad.ravel())[0])
-    return f"{float(v.ravel()[i])!r} (entry {i} of {v.size})"
-
-
-def _positive(name, value):
-    _real(name, value)
-    v = np.asarray(value, dtype=float)
-    bad = ~np.isfinite(v) | (v <= 0)
-    if np.any(bad):
-        raise ValueError(f"{name} must be finite and > 0, got {_offending(value, bad)}")
-    return value
-
-
-def _poisson(nu, low=-1.0, high=0.5):
-    _real("Poisson's ratio nu", nu)
-    v = np.asarray(nu, dtype=float)
-    bad = ~np.isfinite(v) | (v <= low) | (v >= high)
-    if np.any(bad):
-        raise ValueError(f"Poisson's ratio nu must lie in ({low:g}, {high:g}), got {_offending(nu, bad)}")
-    return nu
-
-
-def _warn_nu(nu, exact, model):
-    if nu is None:
-        return
-    off = np.abs(np.asarray(nu, dtype=float) - exact) > 1e-9
-    if np.any(off):
-        warnings.warn(f"{model} is exact only for nu = {exact:.6g}; got nu = {_offending(nu, off)}",
-                      FormulaValidityWarning, stacklevel=3)
-
-
-VALID_NU = {"lloyd_triangle": 1 / 3, "van_gelder_triangle": 1 / 3, "lloyd_square": 1 / 3, "lloyd_tetrahedron": 1 / 4}
+for _module in _families():
+    VALID_NU.update(getattr(_module, "VALID_NU", {}))
+    for _name in _module.__all__:
+        globals()[_name] = getattr(_module, _name)
+        __all__.append(_name)
+del _module, _name
 
 
 def check_material(E, nu, model=None):
     """Validate E > 0 and -1 < nu < 1/2 (scalars or arrays; ValueError naming the value) and warn
-    (``FormulaValidityWarning``) when ``model`` is exact or optimal only at another nu."""
-    _positive("E", E)
-    _poisson(nu)
-    _same_shape("check_material", E=E, nu=nu)
+    (``FormulaValidityWarning``) when ``model`` (a parameter function's name) is exact or optimal
+    only at another nu."""
+    positive("E", E)
+    poisson(nu)
+    same_shape("check_material", E=E, nu=nu)
     if model is not None and not isinstance(model, str):
-        raise ValueError(f"model must be a model name or None, got {type(model).__name__} {_brief(model)}")
+        raise ValueError(f"model must be a model name or None, got {type(model).__name__} {brief(model)}")
     if model in VALID_NU:
-        _warn_nu(nu, VALID_NU[model], model)
-
-
-@dataclass(frozen=True)
-class TriangleSprings:
-    k: float  # N/m, per element
-
-
-@dataclass(frozen=True)
-class SquareSprings:
-    k_edge: float
-    k_diagonal: float
-    rest_factor_edge: float
-    rest_factor_diagonal: float
-
-
-@dataclass(frozen=True)
-class TetrahedronSprings:
-    k: float
-
-
-@dataclass(frozen=True)
-class TetrahedronVolumeSprings:
-    k: float  # N/m
-    k_volume: float  # J: coefficient of k_V/(2 V0^2) (V - V0)^2
-
-
-@dataclass(frozen=True)
-class BaudetCube:
-    k_edge: float
-    k_diagonal: float
-    correction_factor: float  # F_perp = factor x F_i, resultants per face
-
-
-@dataclass(frozen=True)
-class GolecCube:
-    k_edge: float
-    k_face: float
-    k_inner: float
-    kappa: float  # Pa: coefficient of kappa/(2 V0) (V - V0)^2
-
-
-def lloyd_triangle(E, t, *, nu=None) -> TriangleSprings:
-    """Lloyd et al. eq. 8: k = sqrt(3)/4 E t per equilateral triangle (exact for nu = 1/3)."""
-    _positive("E", E), _positive("thickness t", t)
-    if nu is not None:
-        _poisson(nu)
-    _same_shape("lloyd_triangle", E=E, t=t, nu=nu)
-    _warn_nu(nu, 1 / 3, "lloyd_triangle")
-    return _evaluate("lloyd_triangle", _tri.lloyd_triangle, TriangleSprings, E=E, t=t)
-
-
-def van_gelder_triangle(E, t, area, length, *, nu=None) -> TriangleSprings:
-    """Van Gelder: k = E t A_e / l^2 per triangle of area A_e, for its edge of length l (Lloyd eq. 9)."""
-    _positive("E", E), _positive("thickness t", t), _positive("area", area), _positive("length", length)
-    if nu is not None:
-        _poisson(nu)
-    _same_shape("van_gelder_triangle", E=E, t=t, area=area, length=length, nu=nu)
-    _warn_nu(nu, 1 / 3, "van_gelder_triangle")
-    return _evaluate("van_gelder_triangle", _tri.van_gelder_triangle, TriangleSprings, E=E, t=t, area=area,
-                     length=length)
-
-
-def lloyd_square(E, t, *, nu=None) -> SquareSprings:
-    """Lloyd et al. eqs. 10-11: prestrained square (exact for nu = 1/3)."""
-    _positive("E", E), _positive("thickness t", t)
-    if nu is not None:
-        _poisson(nu)
-    _same_shape("lloyd_square", E=E, t=t, nu=nu)
-    _warn_nu(nu, 1 / 3, "lloyd_square")
-    return _evaluate("lloyd_square", _square.lloyd_square, SquareSprings, E=E, t=t)
-
-
-def equivalent_edge_length(volume):
-    """Lloyd et al. eq. 13: edge of the regular tetrahedron of the given volume [m]."""
-    _positive("volume", volume)
-    return _tet.equivalent_edge_length(volume)
-
-
-def lloyd_tetrahedron(E, l, *, nu=None) -> TetrahedronSprings:
-    """Lloyd et al. eq. 12: least-squares k = 2 sqrt(2)/25 E l (nu = 1/4); with ``nu`` given, the
-    least-squares optimum for that nu (derived; eq. 12 is its value at 1/4)."""
-    _positive("E", E), _positive("edge length l", l)
-    if nu is None:
-        _same_shape("lloyd_tetrahedron", E=E, l=l)
-        return _evaluate("lloyd_tetrahedron", _tet.lloyd_tetrahedron, TetrahedronSprings, E=E, l=l)
-    _poisson(nu)
-    _same_shape("lloyd_tetrahedron", E=E, l=l, nu=nu)
-    return _evaluate("lloyd_tetrahedron", _tet.lloyd_tetrahedron_general_nu, TetrahedronSprings, E=E, nu=nu, l=l)
-
-
-def lloyd_tetrahedron_volume(E, l, nu=0.25, *, published=False) -> TetrahedronVolumeSprings:
-    """Lloyd et al. eq. 14 with the volume energy: the least-squares optimum for ``nu`` (derived);
-    ``published=True`` gives eq. 14 as printed (its value at nu = 1/4, whatever ``nu``)."""
-    _positive("E", E), _positive("edge length l", l), _poisson(nu)
-    _same_shape("lloyd_tetrahedron_volume", E=E, l=l, nu=nu)
-    if _flag("published", published):
-        return _evaluate("lloyd_tetrahedron_volume", _tet.lloyd_tetrahedron_volume_published, TetrahedronVolumeSprings,
-                         E=E, l=l)
-    return _evaluate("lloyd_tetrahedron_volume", _tet.lloyd_tetrahedron_volume, TetrahedronVolumeSprings,
-                     E=E, nu=nu, l=l)
-
-
-def baudet_cube(E, nu, a, *, published=False) -> BaudetCube:
-    """Baudet et al. eqs. 7-8 for a cube of edge a; the correction factor is for resultants per face
-    (derived: -(4 nu - 1)/2); ``published=True`` gives the printed -(4 nu - 1)/16."""
-    _positive("E", E), _poisson(nu), _positive("cube edge a", a)
-    _same_shape("baudet_cube", E=E, nu=nu, a=a)
-    f = _baudet.baudet_cube_published if _flag("published", published) else _baudet.baudet_cube
-    return _evaluate("baudet_cube", f, BaudetCube, E=E, nu=nu, a=a)
-
-
-def golec_cube(E, nu, a, A, *, published=False) -> GolecCube:
-    """Golec et al.'s hybrid cube with ratio A = k_inner/k_face (derived per-element constants that
-    make the lattice exactly isotropic with E and nu); ``published=True`` gives the printed values
-    (k_edge and k_face there are interior totals, see the errata)."""
-    _positive("E", E), _poisson(nu), _positive("cube edge a", a), _positive("ratio A", A)
-    _same_shape("golec_cube", E=E, nu=nu, a=a, A=A)
-    f = _golec.golec_cube_published if _flag("published", published) else _golec.golec_cube
-    return _evaluate("golec_cube", f, GolecCube, E=E, nu=nu, a=a, A=A)
+        warn_nu(nu, VALID_NU[model], model)

@@ -24,13 +24,32 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-MODELS = {
-    "triangle": ["lloyd_triangle", "van_gelder", "fem_linear", "fem_svk"],
-    "quad": ["lloyd_square", "fem_linear", "fem_svk"],
-    "tetra": ["lloyd_tetrahedron", "lloyd_tetrahedron_volume", "fem_linear", "fem_neohookean"],
-    "hexahedron": ["baudet_cube", "golec_cube", "fem_linear", "fem_neohookean"],
-}
-REFERENCE = {"triangle": "fem_svk", "quad": "fem_svk", "tetra": "fem_neohookean", "hexahedron": "fem_neohookean"}
+#: the non-linear FEM reference of each dimension (2D: St Venant-Kirchhoff, 3D: neo-Hookean)
+_REFERENCE_LAW = {2: "fem_svk", 3: "fem_neohookean"}
+
+
+def _cell_dims():
+    """Cell type -> dimension, of every cell type some mass-spring model runs on."""
+    from msslib import models
+
+    return {cell: spec.dim for spec in models.registry().values() if spec.kind == "mss" for cell in spec.cells}
+
+
+_DIM = _cell_dims()
+
+
+def _models_for(cell_type):
+    """The models compared on ``cell_type`` cells: every mass-spring model of the registry that runs
+    on them, then linear FEM and the dimension's non-linear reference."""
+    from msslib import models
+
+    return [*models.for_cells(cell_type, "mss"), "fem_linear", _REFERENCE_LAW[_DIM[cell_type]]]
+
+
+#: cell type -> models compared by default (from the registry of msslib.models)
+MODELS = {cell: _models_for(cell) for cell in _DIM}
+#: cell type -> the converged reference model
+REFERENCE = {cell: _REFERENCE_LAW[dim] for cell, dim in _DIM.items()}
 SCALED = {"nx", "ny", "nz", "n", "n_rings"}
 
 
@@ -146,16 +165,19 @@ def _max_error(value):
 
 
 def _with_model(raw, model):
+    """The scene with ``model``, keeping the scene's model options that ``model`` takes (its spec in
+    :mod:`msslib.models`) except ``A``, ``published`` and ``terms`` (each model at its defaults)."""
+    from msslib import models
+
     out = copy.deepcopy(raw)
     m = out.get("model")
-    opts = {k: v for k, v in m.items() if k not in ("type", "published", "terms", "A")} if isinstance(m, dict) else {}
-    if model.startswith("fem"):
-        opts = {k: v for k, v in opts.items() if k == "plane"}
+    spec = models.registry().get(model)
+    takes = {o.name for o in spec.options} - {"A"} if spec is not None else set()
+    opts = {k: v for k, v in m.items() if k in takes} if isinstance(m, dict) else {}
+    if spec is not None and spec.kind == "fem":
         sol = out.get("solver") or {}
         if isinstance(sol, dict) and sol.get("type") == "dynamic":
             raise ValueError("planning compares static solves; the scene is dynamic")
-    else:  # mass-spring models are plane stress and take no FEM option
-        opts = {k: v for k, v in opts.items() if k != "plane"}
     out["model"] = {"type": model, **opts}
     return out
 
@@ -191,7 +213,8 @@ def check_scene(scene, *, levels=(1, 2, 3), models=None):
     level with every model, a mesh that can be built at the first level, a static solver.
     Returns ``(raw, base_dir, cell_type, models, reference_model)``; ValueError (or
     FileNotFoundError) naming what is wrong."""
-    from msslib.scene import FEM_MODELS, MSS_MODELS, load_scene, prepare
+    from msslib import models as registry
+    from msslib.scene import load_scene, prepare
 
     levels = check_arguments(levels=levels, models=models)
     raw, base_dir = _raw(scene)
@@ -203,7 +226,7 @@ def check_scene(scene, *, levels=(1, 2, 3), models=None):
     if setup.scene.is_dynamic:
         raise ValueError("scene.solver: planning compares static solves; the scene is dynamic")
     models = list(models or MODELS[cell_type])
-    fitting = [*FEM_MODELS, *(m for m, (cells, _) in MSS_MODELS.items() if cells == cell_type)]
+    fitting = list(registry.for_cells(cell_type))
     wrong = [m for m in models if m not in fitting]
     if wrong:
         raise ValueError(f"models: {', '.join(wrong)} cannot run on {cell_type} cells; expected some of "

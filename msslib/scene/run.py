@@ -1,0 +1,207 @@
+"""Solving a scene: FEM references, static (non-linear or linear) and dynamic mass-spring runs, and
+:func:`run_scene`, which returns the result dataset."""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Callable
+
+import numpy as np
+
+from msslib import models as _models
+from msslib.scene.prepare import Setup, prepare
+from msslib.scene.progress import TextProgress
+from msslib.scene.schema import load_scene
+
+
+def _moduli(scene):
+    E = [m.E for m in scene.materials]
+    nu = [m.nu for m in scene.materials]
+    if len(E) == 1:
+        return E[0], nu[0]
+    return np.array(E), np.array(nu)
+
+
+def _solve_fem(setup: Setup, report):
+    from msslib import fem
+    from msslib.solvers import ConvergenceError
+
+    scene, mesh = setup.scene, setup.mesh
+    E = [m.E for m in scene.materials]
+    nu = [m.nu for m in scene.materials]
+    body = None
+    if setup.gravity is not None:
+        body = setup.cell_density[:, None] * setup.gravity[None, :]
+    kw = dict(fixed=setup.fixed, prescribed=setup.prescribed, nodal_forces=setup.surface_forces, body_force=body)
+    if mesh.dim == 2:
+        kw.update(thickness=setup.thickness, plane=scene.model_options["plane"])
+    law = _models.get(scene.model).law
+    if law is None or scene.solver.get("linear"):
+        res = fem.solve_linear(mesh, E, nu, **kw)
+    else:
+        s = scene.solver
+        try:
+            res = fem.solve_nonlinear(mesh, E, nu, law=law, steps=s["load_steps"], tol=s["tol"], max_iter=s["max_iter"],
+                                      progress=lambda k, n: report(k / n, f"load step {k}/{n}"), **kw)
+        except RuntimeError as exc:
+            raise ConvergenceError(f"{scene.model}: {exc}") from None
+    stats = {"type": "static", **res.stats}
+    return {"displacement": res.displacement, "reaction": res.reaction, "stats": stats,
+            "extra_attrs": {"strain_energy": res.strain_energy}}
+
+
+def _solve_mss_static(setup: Setup, report):
+    from msslib.solvers import static_solve
+
+    model, s = setup.model, setup.scene.solver
+
+    def cb(info):
+        report(info["load"], f"load {info['load']:.3g} it {info['iteration']} |r| {info['residual']:.2e}")
+
+    if s.get("linear"):
+        return _solve_mss_linear(setup)
+    res = static_solve(model, model.x0, load_steps=s["load_steps"], tol=s["tol"], max_iter=s["max_iter"], progress=cb)
+    u = (res.x - model.x0).reshape(-1, model.dim)
+    stats = {
+        "type": "static", "load_steps": s["load_steps"], "tol": s["tol"], "n_load_steps": res.n_load_steps,
+        "n_cuts": res.n_cuts, "iterations": res.iterations, "total_iterations": res.total_iterations,
+        "final_residual": res.residuals[-1][-1] if res.residuals and res.residuals[-1] else 0.0,
+        "force_scale": res.force_scale, "roundoff_floor": res.roundoff_floor, "threshold": res.threshold,
+        "roundoff_steps": res.roundoff_steps, "line_search_merit": res.line_search_merit, "wall_time": res.wall_time,
+        "messages": res.messages,
+    }
+    energy = model.energy(res.x, 1.0)
+    extra = {"potential_energy": "None" if energy is None else energy}
+    return {"displacement": u, "reaction": model.reaction(res.x, 1.0), "stats": stats, "extra_attrs": extra}
+
+
+def _solve_mss_linear(setup: Setup):
+    """One sparse solve with the model's stiffness (Hessian) at rest: the linearised MSS."""
+    from msslib.fem import _solve_sparse
+
+    model, t0 = setup.model, time.perf_counter()
+    x = model.apply_prescribed(model.x0, 1.0)
+    du, free = x - model.x0, model.free
+    K, f = model.stiffness(model.x0, 1.0), model.force(model.x0, 1.0)
+    du[free] = _solve_sparse(K[free][:, free], f[free] - K[free][:, ~free] @ du[~free])
+    reaction = np.where(free, 0.0, K @ du - f).reshape(-1, model.dim)  # of the linearised forces
+    stats = {"type": "static", "linear": True, "wall_time": time.perf_counter() - t0, "solver": "one solve with the "
+             "stiffness at rest, scipy.sparse.linalg.spsolve (SuperLU, MMD_AT_PLUS_A ordering)"}
+    return {"displacement": du.reshape(-1, model.dim), "reaction": reaction, "stats": stats,
+            "extra_attrs": {"potential_energy": "None"}}
+
+
+def _solve_mss_dynamic(setup: Setup, report):
+    from msslib.solvers import integrate
+
+    model, s = setup.model, setup.scene.solver
+    x_start = model.apply_prescribed(model.x0, 1.0)
+
+    def cb(info):
+        n = max(info["n_steps"], 1)
+        report(info["step"] / n, f"t = {info['t']:.4g} s")
+
+    res = integrate(model, x_start, np.zeros(model.n_dof), dt=s["dt"], t_end=s["t_end"], method=s["method"],
+                    damping=s["damping"], save_every=s["save_every"], progress=cb,
+                    allow_unstable=s.get("allow_unstable", False))
+    n, dim = model.n_nodes, model.dim
+    u = (res.x_final - model.x0).reshape(n, dim)
+    out = {"displacement": u, "reaction": model.reaction(res.x_final, 1.0),
+           "stats": {"type": "dynamic", **res.stats}, "extra_attrs": {}}
+    if setup.scene.output["history"]:
+        n_t = len(res.t)
+        out["history"] = {"time": res.t, "displacement": (res.x - model.x0).reshape(n_t, n, dim),
+                          "velocity": res.v.reshape(n_t, n, dim),
+                          "reaction": np.stack([model.reaction(x, 1.0) for x in res.x]) if n_t else
+                          np.zeros((0, n, dim))}
+        extra = {"kinetic_energy": (("time",), res.kinetic_energy, {"units": "J", "long_name": "kinetic energy"})}
+        if res.potential_energy is not None:
+            extra["potential_energy"] = (("time",), res.potential_energy,
+                                         {"units": "J", "long_name": "potential energy (internal minus load work)"})
+        out["extra_vars"] = extra
+    return out
+
+
+def run_scene(scene, progress=True):
+    """Build and solve a scene (a :class:`Scene`, a path or a dict) and return its result dataset.
+
+    ``progress``: True draws a text progress bar on stderr for runs longer than half a second,
+    False/None is silent, a callable receives ``(fraction, text)``.  Raises ValueError /
+    FileNotFoundError for bad scenes, :class:`msslib.solvers.ConvergenceError` when a static solve
+    fails and :class:`msslib.solvers.DivergenceError` when a dynamic run blows up.
+
+    The final state, and every saved state of a dynamic run with ``output.history``, is checked
+    for inverted and collapsed cells (:func:`msslib.quality.guard`, for every model and cell type):
+    the result records ``inverted_cells``, ``collapsed_cells``, ``min_relative_jacobian``, ... (0
+    counts for a clean run) and the cell variables ``cell_state`` and ``relative_jacobian``; a
+    flagged state is one :class:`msslib.errors.MsslibWarning`, or with ``checks: {inverted:
+    error}`` an :class:`msslib.errors.UnphysicalStateError` (no dataset is returned).
+    """
+    from msslib.io import make_dataset
+    from msslib.quality import guard
+
+    scene = load_scene(scene)
+    t0 = time.perf_counter()
+    bar = None
+    if progress is True:
+        total = None
+        if scene.is_dynamic:  # time steps per second and the time left
+            total = math.ceil(scene.solver["t_end"] / scene.solver["dt"] - 1e-9) if scene.solver["t_end"] > 0 else None
+        bar = TextProgress(label=scene.name, total=total, unit="steps")
+        report: Callable = bar
+    elif callable(progress):
+        report = progress
+    else:
+        def report(_fraction, _text=""):
+            return None
+    try:
+        setup = prepare(scene)
+        if scene.is_fem:
+            out = _solve_fem(setup, report)
+        elif scene.is_dynamic:
+            out = _solve_mss_dynamic(setup, report)
+        else:
+            out = _solve_mss_static(setup, report)
+    finally:
+        if bar is not None:
+            bar.close()
+    wall = time.perf_counter() - t0
+    hist = out.get("history") or {}
+    guard_attrs, guard_vars = guard(
+        setup.mesh, out["displacement"], history_displacement=hist.get("displacement"),
+        history_time=hist.get("time"), policy=scene.checks["inverted"], label=f"{scene.name} ({scene.model})")
+
+    springs = k = rest = None
+    if setup.model is not None:
+        from msslib.terms import Springs
+
+        sp = [t for t in setup.model.terms if isinstance(t, Springs)]
+        if sp:
+            springs = np.concatenate([t.pairs for t in sp])
+            k = np.concatenate([t.k for t in sp])
+            rest = np.concatenate([t.rest_length for t in sp])
+    E, nu = _moduli(scene)
+    extra_attrs = dict(out.get("extra_attrs", {}))
+    energy = extra_attrs.pop("potential_energy", None)  # static MSS: a number, or "None" without one
+    attrs = {"scene_name": scene.name, "scene_description": scene.description,
+             "model_published": scene.model_options.get("published", False),
+             "model_terms": list(scene.model_options["terms"]) if scene.model_options.get("terms") else None,
+             **extra_attrs, **guard_attrs}
+    if scene.model_options.get("A") is not None:
+        attrs["model_A"] = scene.model_options["A"]
+    if scene.model_options.get("correction") is not None:
+        attrs["model_correction"] = scene.model_options["correction"]
+    extra_vars = {**(out.get("extra_vars") or {}), **guard_vars}
+    if energy is not None and not isinstance(energy, str):
+        extra_vars["potential_energy"] = ((), float(energy), {
+            "units": "J", "long_name": "potential energy of the final state (internal minus load work)"})
+    return make_dataset(
+        setup.mesh, out["displacement"], model=scene.model, E=E, nu=nu, scene=scene.text,
+        density=[m.density for m in scene.materials],
+        material_names=None if scene.material_groups is None else list(scene.material_groups),
+        thickness=setup.thickness if setup.mesh.dim == 2 else None,
+        springs=springs, spring_constant=k, rest_length=rest, reaction=out["reaction"], fixed=setup.fixed,
+        history=out.get("history"), solver_stats=out["stats"], wall_time=wall,
+        extra_vars=extra_vars, extra_attrs=attrs,
+    )
