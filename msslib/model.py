@@ -4,45 +4,50 @@
 :mod:`msslib.solvers` (``n_dof``, ``force``, ``stiffness``, ``energy``, ``free``, ``mass``,
 ``symmetric``, ``apply_prescribed``, ``damping``, ``dim``), plus ``x0`` and :meth:`Model.reaction`.
 
-The builders turn a mesh and its materials into spring terms whose constants come from
-:mod:`msslib.parameters` (per element, then summed over the elements sharing a node pair):
-
-* :func:`assemble_springs` — generic: per (pair, cell) constant, summed per pair;
-* :func:`lloyd_triangle_springs`, :func:`van_gelder_springs` (triangles, plane stress, thickness t);
-* :func:`lloyd_square_springs` (quads; prestrained edges and diagonals);
-* :func:`lloyd_tet_springs` (tetrahedra, optionally with Lloyd's volume term);
-* :func:`baudet_cube_springs`, :func:`baudet_correction` (cubes);
-* :func:`golec_cube_springs` (cubes: springs plus the volume correction).
-
-``materials`` is a list of ``(E, nu)`` pairs (Pa, -) indexed by ``mesh.material``.  Every builder
-first runs :func:`msslib.mesh.check_cells` (ValueError on inverted or degenerate cells) and
-returns a list of terms, to be combined with loads into a :class:`Model`.
+The builders that turn a mesh and its materials into terms (:func:`assemble_springs`,
+:func:`lloyd_triangle_springs`, :func:`van_gelder_springs`, :func:`lloyd_square_springs`,
+:func:`lloyd_tet_springs`, :func:`baudet_cube_springs`, :func:`baudet_correction`,
+:func:`golec_cube_springs`, :func:`material_arrays`) live in :mod:`msslib.builders`, one module
+per model family; they are importable from here too.
 """
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 import scipy.sparse as sp
-from numba import njit
 
 from msslib import mesh as _mesh
-from msslib.generated import kernels as _K
-from msslib.terms import (
-    BaudetCorrection,
-    ExternalForce,
-    HexVolume,
-    Springs,
-    Term,
-    TetVolume,
+from msslib.builders import (
+    assemble_springs,
+    baudet_correction,
+    baudet_cube_springs,
+    golec_cube_springs,
+    lloyd_square_springs,
+    lloyd_tet_springs,
+    lloyd_triangle_springs,
+    material_arrays,
+    van_gelder_springs,
+)
+from msslib.builders.common import _combine as _combine
+from msslib.builders.common import _cube_edges as _cube_edges
+from msslib.builders.common import _field as _field
+from msslib.builders.common import _merge_springs as _merge_springs
+from msslib.builders.common import _pair_lengths as _pair_lengths
+from msslib.builders.common import _pairs_of as _pairs_of
+from msslib.builders.common import _parameters as _parameters
+from msslib.builders.common import _per_cell as _per_cell
+from msslib.builders.common import _require as _require
+from msslib.builders.common import _springs_from as _springs_from
+from msslib.builders.golec import _hex_rest_volumes as _hex_rest_volumes
+from msslib.builders.lloyd import _tet_rest_volumes as _tet_rest_volumes
+from msslib.terms import ExternalForce, Springs, Term, _ElementTerm
+from msslib.terms.assembly import (
     _block_scatter_bsr,
     _block_scatter_csr,
-    _ElementTerm,
+    _expand_block_pattern,
     _scatter_add,
     _spring3d_hessian_bsr,
     _spring3d_hessian_csr,
-    sum_external_forces,
 )
 
 __all__ = [
@@ -423,298 +428,3 @@ def _is_block_term(term, dim) -> bool:
     (the default :meth:`msslib.terms._ElementTerm.hessian_pattern`)."""
     return (isinstance(term, _ElementTerm) and type(term).hessian_pattern is _ElementTerm.hessian_pattern
             and type(term).hessian_values is _ElementTerm.hessian_values and term.dim == dim)
-
-
-@njit(cache=True, nogil=True)
-def _expand_block_pattern(nptr, ucol, dim, indices, indptr):
-    """Dof-level CSR (indices, indptr) of a node-level pattern (nptr, ucol): every node entry
-    becomes a dim x dim block; row ``dim a + i`` lists ``dim b + j`` for the nodes ``b`` of node
-    row ``a`` (sorted), ``j = 0..dim-1``."""
-    nn = nptr.shape[0] - 1
-    for a in range(nn):
-        deg = nptr[a + 1] - nptr[a]
-        for i in range(dim):
-            start = dim * dim * nptr[a] + i * dim * deg
-            indptr[dim * a + i] = start
-            q = start
-            for e in range(nptr[a], nptr[a + 1]):
-                for j in range(dim):
-                    indices[q] = dim * ucol[e] + j
-                    q += 1
-    indptr[dim * nn] = dim * dim * nptr[nn]
-
-
-# --------------------------------------------------------------------------------------------
-# helpers for the builders
-# --------------------------------------------------------------------------------------------
-
-
-def _parameters():
-    from msslib import parameters  # imported lazily
-
-    return parameters
-
-
-def material_arrays(mesh, materials) -> tuple[np.ndarray, np.ndarray]:
-    """``(E, nu)`` per cell from ``materials`` (list of ``(E, nu)``) and ``mesh.material``."""
-    materials = [tuple(m) for m in materials]
-    if not materials:
-        raise ValueError("materials is empty")
-    if any(len(m) != 2 for m in materials):
-        raise ValueError("materials must be a list of (E, nu) pairs")
-    if mesh.n_cells and (mesh.material.min() < 0 or mesh.material.max() >= len(materials)):
-        raise ValueError(f"mesh.material refers to materials up to {mesh.material.max()}, only {len(materials)} given")
-    table = np.asarray(materials, dtype=float)
-    return table[mesh.material, 0], table[mesh.material, 1]
-
-
-def _field(result, name):
-    """Field ``name`` of a parameters result (a dataclass), or the result itself if it is a number."""
-    if hasattr(result, name):
-        return getattr(result, name)
-    if np.ndim(result) == 0 and not hasattr(result, "__dataclass_fields__"):
-        return result
-    raise AttributeError(f"{type(result).__name__} has no field {name!r}")
-
-
-def _per_cell(fn, fields, *args):
-    """Call a parameters function on per-cell arrays; returns one float array per field.
-
-    Tries one vectorised call; if the function only takes scalars, calls it cell by cell
-    (genuine errors, e.g. an invalid nu, are then raised by the scalar call)."""
-    arrays = [np.asarray(a, dtype=float) for a in args]
-    m = max((a.size for a in arrays if a.ndim), default=1)
-    arrays = [np.broadcast_to(a, (m,)) for a in arrays]
-    try:
-        res = fn(*arrays)
-        out = [np.broadcast_to(np.asarray(_field(res, f), dtype=float), (m,)).copy() for f in fields]
-        return out
-    except (TypeError, ValueError, AttributeError):
-        pass
-    out = [np.empty(m) for _ in fields]
-    cache = {}
-    for i in range(m):
-        key = tuple(float(a[i]) for a in arrays)
-        if key not in cache:
-            res = fn(*key)
-            cache[key] = [float(_field(res, f)) for f in fields]
-        for o, v in zip(out, cache[key]):
-            o[i] = v
-    return out
-
-
-def _pairs_of(mesh, pair_kind):
-    if isinstance(pair_kind, _mesh.NodePairs):
-        return pair_kind
-    table = {
-        "edges": _mesh.unique_edges,
-        "face_diagonals": _mesh.face_diagonals,
-        "inner_diagonals": _mesh.inner_diagonals,
-    }
-    if pair_kind not in table:
-        raise ValueError(f"pair_kind must be one of {sorted(table)} or a NodePairs, got {pair_kind!r}")
-    return table[pair_kind](mesh)
-
-
-def _combine(pairs: _mesh.NodePairs, k_inc, rest_inc):
-    """Sum per-incidence constants per pair; the rest length is the k-weighted mean (exact: the sum
-    of springs on one pair equals one spring of that constant and rest length, up to a constant)."""
-    n_pairs = len(pairs.pairs)
-    owner = np.repeat(np.arange(n_pairs), pairs.counts)
-    k = np.bincount(owner, weights=k_inc, minlength=n_pairs)
-    if rest_inc is None:
-        return k, None
-    with np.errstate(invalid="ignore", divide="ignore"):
-        rest = np.bincount(owner, weights=k_inc * rest_inc, minlength=n_pairs) / k
-    return k, rest
-
-
-def _springs_from(mesh, pairs, k, rest):
-    length = np.linalg.norm(mesh.points[pairs.pairs[:, 1]] - mesh.points[pairs.pairs[:, 0]], axis=1)
-    return Springs(pairs.pairs, k, length if rest is None else rest, mesh.dim)
-
-
-def assemble_springs(mesh, pair_kind, k_per_cell_fn) -> Springs:
-    """Springs on the node pairs of ``mesh`` with constants summed over the cells sharing a pair.
-
-    ``pair_kind``: ``"edges"``, ``"face_diagonals"``, ``"inner_diagonals"`` or a
-    :class:`msslib.mesh.NodePairs`.  ``k_per_cell_fn(cell_ids, node_pairs)`` receives, for every
-    (pair, cell) incidence, the cell id (m,) and the node pair (m, 2), and returns the constant
-    contributed by that cell (m,), or a tuple ``(k, rest_length)``.  The spring of a pair gets
-    ``k = sum`` of its contributions and the rest length: the distance of its nodes, or with
-    explicit rest lengths their k-weighted mean.  Raises ValueError (from :class:`Springs`) if a
-    summed constant is not positive.
-    """
-    pairs = _pairs_of(mesh, pair_kind)
-    node_pairs = np.repeat(pairs.pairs, pairs.counts, axis=0)
-    res = k_per_cell_fn(pairs.cells, node_pairs)
-    if isinstance(res, tuple):
-        k_inc, rest_inc = (np.broadcast_to(np.asarray(v, dtype=float), (len(node_pairs),)) for v in res)
-    else:
-        k_inc, rest_inc = np.broadcast_to(np.asarray(res, dtype=float), (len(node_pairs),)), None
-    k, rest = _combine(pairs, k_inc, rest_inc)
-    return _springs_from(mesh, pairs, k, rest)
-
-
-def _merge_springs(springs: list[Springs]) -> Springs:
-    """One Springs term from several on disjoint pair sets (e.g. edges and diagonals)."""
-    return Springs(np.concatenate([s.pairs for s in springs]), np.concatenate([s.k for s in springs]),
-                   np.concatenate([s.rest_length for s in springs]), springs[0].dim)
-
-
-def _require(mesh, cell_type):
-    if mesh.cell_type != cell_type:
-        raise ValueError(f"this model needs {cell_type} cells, got {mesh.cell_type}")
-    return _mesh.check_cells(mesh)
-
-
-def _pair_lengths(mesh, node_pairs):
-    return np.linalg.norm(mesh.points[node_pairs[:, 1]] - mesh.points[node_pairs[:, 0]], axis=1)
-
-
-def _cube_edges(mesh, rtol=1e-6):
-    """Edge length ``a`` per hexahedron; ValueError unless every cell is a cube (within rtol)."""
-    x = mesh.points[mesh.cells]
-    edges = _mesh._LOCAL_EDGES["hexahedron"]
-    lengths = np.linalg.norm(x[:, edges[:, 1]] - x[:, edges[:, 0]], axis=2)  # (m, 12)
-    a = lengths.mean(axis=1)
-    diag = np.linalg.norm(x[:, [6, 7, 4, 5]] - x[:, [0, 1, 2, 3]], axis=2)
-    bad = np.flatnonzero((np.abs(lengths - a[:, None]).max(axis=1) > rtol * a)
-                         | (np.abs(diag - np.sqrt(3.0) * a[:, None]).max(axis=1) > rtol * a))
-    if len(bad):
-        shown = ", ".join(f"cell {i} (edges {lengths[i].min():.4g}..{lengths[i].max():.4g} m)" for i in bad[:5])
-        raise ValueError(f"{len(bad)} hexahedra are not cubes (rtol {rtol}): {shown}")
-    return a
-
-
-# --------------------------------------------------------------------------------------------
-# builders
-# --------------------------------------------------------------------------------------------
-
-
-def lloyd_triangle_springs(mesh, materials, t: float) -> list[Term]:
-    """Lloyd et al.'s springs on the edges of a triangle mesh (plane stress, thickness ``t`` m):
-    per triangle ``parameters.lloyd_triangle(E, t).k`` on each of its edges, summed over the
-    triangles sharing an edge; rest lengths are the mesh distances."""
-    _require(mesh, "triangle")
-    E, nu = material_arrays(mesh, materials)
-    _parameters().check_material(E, nu, "lloyd_triangle")
-    (k,) = _per_cell(_parameters().lloyd_triangle, ("k",), E, t)
-    return [assemble_springs(mesh, "edges", lambda cells, _p: k[cells])]
-
-
-def van_gelder_springs(mesh, materials, t: float) -> list[Term]:
-    """Van Gelder's springs: per triangle ``parameters.van_gelder_triangle(E, t, A_e, l).k`` on each
-    edge of length ``l`` (``A_e`` the triangle's area), summed over the adjacent triangles."""
-    area = _require(mesh, "triangle")
-    E, nu = material_arrays(mesh, materials)
-    _parameters().check_material(E, nu, "van_gelder_triangle")
-    fn = _parameters().van_gelder_triangle
-
-    def k_fn(cells, node_pairs):
-        (k,) = _per_cell(fn, ("k",), E[cells], t, area[cells], _pair_lengths(mesh, node_pairs))
-        return k
-
-    return [assemble_springs(mesh, "edges", k_fn)]
-
-
-def lloyd_square_springs(mesh, materials, t: float) -> list[Term]:
-    """Lloyd et al.'s springs on a mesh of squares (quads): per element ``k_edge`` on its four
-    edges and ``k_diagonal`` on both diagonals (``parameters.lloyd_square(E, t)``), summed over
-    the elements sharing them; rest lengths are ``rest_factor_edge`` and ``rest_factor_diagonal``
-    times the mesh distances (prestrained springs)."""
-    _require(mesh, "quad")
-    E, nu = material_arrays(mesh, materials)
-    _parameters().check_material(E, nu, "lloyd_square")
-    k_e, k_d, f_e, f_d = _per_cell(_parameters().lloyd_square,
-                                   ("k_edge", "k_diagonal", "rest_factor_edge", "rest_factor_diagonal"), E, t)
-    edges = assemble_springs(mesh, "edges", lambda c, p: (k_e[c], f_e[c] * _pair_lengths(mesh, p)))
-    diags = assemble_springs(mesh, "face_diagonals", lambda c, p: (k_d[c], f_d[c] * _pair_lengths(mesh, p)))
-    return [_merge_springs([edges, diags])]
-
-
-def _tet_rest_volumes(mesh):
-    p = mesh.points[mesh.cells]  # (m, 4, 3)
-    return np.asarray(_K.tet_signed_volume(*[p[:, a, d] for a in range(4) for d in range(3)]), dtype=float)
-
-
-def lloyd_tet_springs(mesh, materials, volume: bool = False, published: bool = False) -> list[Term]:
-    """Lloyd et al.'s springs on the edges of a tetrahedral mesh.
-
-    Each tetrahedron of volume ``V`` is treated as a regular one of the same volume, edge
-    ``l_hat = (6 sqrt(2) V)^(1/3)``; its constant ``parameters.lloyd_tetrahedron(E, l_hat).k`` is
-    added to each of its edges.  With ``volume=True`` the constants come from
-    ``parameters.lloyd_tetrahedron_volume(E, l_hat, nu)`` (``k``, ``k_volume``) and a
-    :class:`TetVolume` term with ``k_v = k_volume`` and ``V0 = V`` is added; ``published=True`` uses
-    eq. 14 as printed (its values at nu = 1/4) instead of the optimum for each nu.
-    """
-    V = _require(mesh, "tetra")
-    E, nu = material_arrays(mesh, materials)
-    _parameters().check_material(E, nu, None if volume else "lloyd_tetrahedron")
-    l_hat = np.cbrt(6.0 * np.sqrt(2.0) * V)
-    P = _parameters()
-    if volume:
-        k, k_vol = _per_cell(partial(P.lloyd_tetrahedron_volume, published=published), ("k", "k_volume"), E, l_hat, nu)
-    else:
-        (k,) = _per_cell(P.lloyd_tetrahedron, ("k",), E, l_hat)
-    terms: list[Term] = [assemble_springs(mesh, "edges", lambda c, _p: k[c])]
-    if volume:
-        terms.append(TetVolume(mesh.cells, k_vol, _tet_rest_volumes(mesh)))
-    return terms
-
-
-def baudet_cube_springs(mesh, materials, published: bool = False) -> list[Term]:
-    """Baudet et al.'s springs on a mesh of cubes: per cube ``k_edge`` on its 12 edges (summed over
-    the cubes sharing an edge) and ``k_diagonal`` on its 4 inner diagonals
-    (``parameters.baudet_cube(E, nu, a)``, ``a`` the cube's edge).  Add :func:`baudet_correction`
-    for the Poisson effect under load. (The printed and derived spring constants agree;
-    ``published`` is accepted for symmetry with the other builders.)"""
-    _require(mesh, "hexahedron")
-    a = _cube_edges(mesh)
-    E, nu = material_arrays(mesh, materials)
-    k_e, k_d = _per_cell(partial(_parameters().baudet_cube, published=published), ("k_edge", "k_diagonal"), E, nu, a)
-    edges = assemble_springs(mesh, "edges", lambda c, _p: k_e[c])
-    inner = assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_d[c])
-    return [_merge_springs([edges, inner])]
-
-
-def baudet_correction(mesh, materials, loads, published: bool = False) -> BaudetCorrection:
-    """:class:`msslib.terms.BaudetCorrection` for a mesh of cubes with the per-cube factor
-    ``parameters.baudet_cube(E, nu, a).correction_factor``; ``loads`` (n, 3) nodal surface forces
-    at unit load, or a list of terms whose external forces are summed (leave gravity out).
-    ``published=True`` uses the printed factor -(4 nu - 1)/16 (see the errata)."""
-    _require(mesh, "hexahedron")
-    a = _cube_edges(mesh)
-    E, nu = material_arrays(mesh, materials)
-    (c,) = _per_cell(partial(_parameters().baudet_cube, published=published), ("correction_factor",), E, nu, a)
-    if not isinstance(loads, np.ndarray):
-        try:
-            loads = np.asarray(loads, dtype=float)
-        except (TypeError, ValueError):
-            loads = sum_external_forces(loads, mesh.n_nodes, 3)
-    return BaudetCorrection(mesh, loads, c)
-
-
-def _hex_rest_volumes(mesh):
-    p = mesh.points[mesh.cells]  # (m, 8, 3)
-    return np.asarray(_K.hex_averaged_volume(*[p[:, a, d] for a in range(8) for d in range(3)]), dtype=float)
-
-
-def golec_cube_springs(mesh, materials, A, published: bool = False) -> list[Term]:
-    """Golec et al.'s cube model: per cube ``parameters.golec_cube(E, nu, a, A)`` gives ``k_edge``
-    (12 edges), ``k_face`` (12 face diagonals) and ``k_inner`` (4 inner diagonals), each summed over
-    the cubes sharing the pair, and ``kappa`` for a :class:`HexVolume` term per cube with ``V0``
-    the averaged-edge volume at rest.  ``A`` (a scalar or one value per cell) is passed through to
-    ``golec_cube``. ``published=True`` uses the printed constants, per element (see the errata);
-    the volume term keeps the dimensionally consistent energy kappa/(2 V0) (V - V0)^2."""
-    _require(mesh, "hexahedron")
-    a = _cube_edges(mesh)
-    E, nu = material_arrays(mesh, materials)
-    k_e, k_f, k_i, kappa = _per_cell(partial(_parameters().golec_cube, published=published), ("k_edge", "k_face", "k_inner", "kappa"),
-                                     E, nu, a, A)
-    springs = _merge_springs([
-        assemble_springs(mesh, "edges", lambda c, _p: k_e[c]),
-        assemble_springs(mesh, "face_diagonals", lambda c, _p: k_f[c]),
-        assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_i[c]),
-    ])
-    return [springs, HexVolume(mesh.cells, kappa, _hex_rest_volumes(mesh))]

@@ -1,0 +1,106 @@
+"""Force terms of a mass-spring system: springs, volume energies, external loads, corrections.
+
+Every term works on the flat state ``x`` (node positions, ``n_nodes * dim`` long, interleaved by
+node, see :mod:`msslib.solvers`) and shares one interface:
+
+``energy(x) -> float or None``
+    Potential energy of the term (J) at unit load; ``None`` for a non-conservative term.
+``gradient(x) -> ndarray (n_dof,)``
+    ``dW/dx`` (N): the force of the term is minus this.  For a non-conservative term it is simply
+    minus its force (there is no ``W``).
+``hessian_pattern() -> (rows, cols)``
+    Dof indices of the term's Hessian entries, element by element (each element contributes a
+    dense ``n_local x n_local`` row-major block).  The pattern depends only on the topology: it
+    is computed once and cached.
+``hessian_values(x) -> ndarray``
+    Values of the entries of ``hessian_pattern()`` at ``x`` (N/m), filled by a numba loop.
+``hessian_coo(x) -> (rows, cols, vals)``
+    Convenience: the pattern and the values together (duplicates are to be summed).
+
+Class attributes describe how a :class:`msslib.model.Model` combines the terms:
+``conservative`` (False: the model's energy is ``None``), ``scales_with_load`` (True: external
+terms whose contribution is multiplied by the load factor) and ``symmetric`` (Hessian symmetry).
+
+Internal terms use the generated kernels of :mod:`msslib.generated.kernels` (energy, gradient and
+Hessian of the exact energies the derivations linearise), compiled by numba on first use with
+``cache=True``.  The first call of a kernel family compiles it (seconds; the hexahedron Hessian
+about ten seconds); later processes load it from ``msslib/terms/__pycache__``, which is dropped
+when the generated kernels change (:mod:`msslib.terms.jit`).
+
+Terms with no elements never call numba (cheap when absent).
+
+Contents of this package, one concern per module; every name below is importable from
+``msslib.terms``:
+
+* :mod:`msslib.terms.jit`: the numba decorators and the on-disk cache of the compiled loops;
+* :mod:`msslib.terms.loops`: numba loops of the internal terms (energy, gradient and Hessian
+  blocks of springs, tetrahedron and hexahedron volumes; the fast 3D spring force);
+* :mod:`msslib.terms.assembly`: element block patterns and the loops that add Hessian values into
+  CSR and BSR matrices with a node-blocked pattern (used by :class:`msslib.model.Model`);
+* :mod:`msslib.terms.base`: :class:`Term` and the element-term base class;
+* :mod:`msslib.terms.internal`: :class:`Springs`, :class:`TetVolume`, :class:`HexVolume`;
+* :mod:`msslib.terms.external`: :class:`ExternalForce`, :class:`NodalForces`, :class:`Gravity`,
+  :class:`Traction`, :func:`sum_external_forces`;
+* :mod:`msslib.terms.baudet`: :class:`BaudetCorrection` (Baudet's correction from the surface
+  loads).
+
+The modules import one another in one direction: ``jit`` <- ``loops``, ``assembly``;
+``assembly`` <- ``base``; ``base``, ``loops`` <- ``internal``; ``base`` <- ``external`` <-
+``baudet``.
+"""
+
+from __future__ import annotations
+
+from .assembly import _block_pattern as _block_pattern
+from .assembly import _block_scatter_bsr as _block_scatter_bsr
+from .assembly import _block_scatter_csr as _block_scatter_csr
+from .assembly import _expand_block_pattern as _expand_block_pattern
+from .assembly import _scatter_add as _scatter_add
+from .assembly import _spring3d_hessian_bsr as _spring3d_hessian_bsr
+from .assembly import _spring3d_hessian_csr as _spring3d_hessian_csr
+from .base import Term
+from .base import _as_flat as _as_flat
+from .base import _connectivity as _connectivity
+from .base import _ElementTerm as _ElementTerm
+from .base import _format_bad as _format_bad
+from .base import _per_element as _per_element
+from .baudet import _FACE_PAIRS as _FACE_PAIRS
+from .baudet import _HEX_FACES as _HEX_FACES
+from .baudet import BaudetCorrection
+from .external import ExternalForce, Gravity, NodalForces, Traction, sum_external_forces
+from .external import _traction_nodal as _traction_nodal
+from .internal import HexVolume, Springs, TetVolume
+from .internal import _check_rest_volumes as _check_rest_volumes
+from .jit import _FAST as _FAST
+from .jit import _U as _U
+from .jit import _drop_stale_numba_cache as _drop_stale_numba_cache
+from .jit import _jit as _jit
+from .jit import _jit_fast as _jit_fast
+from .loops import _gather3 as _gather3
+from .loops import _hex_energy_loop as _hex_energy_loop
+from .loops import _hex_gradient_loop as _hex_gradient_loop
+from .loops import _hex_hessian_loop as _hex_hessian_loop
+from .loops import _spring2d_energy_loop as _spring2d_energy_loop
+from .loops import _spring2d_gradient_loop as _spring2d_gradient_loop
+from .loops import _spring2d_hessian_loop as _spring2d_hessian_loop
+from .loops import _spring3d_energy_fast as _spring3d_energy_fast
+from .loops import _spring3d_energy_loop as _spring3d_energy_loop
+from .loops import _spring3d_gradient_fast as _spring3d_gradient_fast
+from .loops import _spring3d_gradient_loop as _spring3d_gradient_loop
+from .loops import _spring3d_hessian_loop as _spring3d_hessian_loop
+from .loops import _tet_energy_loop as _tet_energy_loop
+from .loops import _tet_gradient_loop as _tet_gradient_loop
+from .loops import _tet_hessian_loop as _tet_hessian_loop
+
+__all__ = [
+    "Term",
+    "Springs",
+    "TetVolume",
+    "HexVolume",
+    "ExternalForce",
+    "Gravity",
+    "NodalForces",
+    "Traction",
+    "BaudetCorrection",
+    "sum_external_forces",
+]
