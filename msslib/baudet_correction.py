@@ -203,35 +203,6 @@ class ElementBaudetCorrection(Term):
         return (self.map @ self.element_spring_stiffness(x)).ravel()
 
 
-def element_correction(mesh, materials, published: bool = False) -> ElementBaudetCorrection:
-    """:class:`ElementBaudetCorrection` for a mesh of cubes with each cube's ``k_edge``,
-    ``k_diagonal`` and ``correction_factor`` from ``parameters.baudet_cube(E, nu, a)``
-    (``published=True``: the printed factor -(4 nu - 1)/16)."""
-    from functools import partial
-
-    from msslib import model as M
-    from msslib import parameters as PR
-
-    M._require(mesh, "hexahedron")
-    a = M._cube_edges(mesh)
-    E, nu = M.material_arrays(mesh, materials)
-    k_e, k_d, c = M._per_cell(partial(PR.baudet_cube, published=published),
-                              ("k_edge", "k_diagonal", "correction_factor"), E, nu, a)
-    return ElementBaudetCorrection(mesh, k_e, k_d, c)
-
-
-def correction_term(reading, mesh, materials, loads, published: bool = False) -> Term:
-    """The correction term of ``reading`` (``boundary``: from the nodal surface ``loads``;
-    ``element``: from the forces on each cube, ``loads`` unused)."""
-    if reading == "element":
-        return element_correction(mesh, materials, published=published)
-    if reading == "boundary":
-        from msslib.model import baudet_correction
-
-        return baudet_correction(mesh, materials, loads, published=published)
-    raise ValueError(f"unknown Baudet correction reading {reading!r}; expected one of {', '.join(READINGS)}")
-
-
 # --------------------------------------------------------------------------------------------
 # the paper's algorithm, literally: outside forces from neighbours, loads and reactions
 # --------------------------------------------------------------------------------------------

@@ -7,8 +7,8 @@
 The builders that turn a mesh and its materials into terms (:func:`assemble_springs`,
 :func:`lloyd_triangle_springs`, :func:`van_gelder_springs`, :func:`lloyd_square_springs`,
 :func:`lloyd_tet_springs`, :func:`baudet_cube_springs`, :func:`baudet_correction`,
-:func:`golec_cube_springs`, :func:`material_arrays`) live in :mod:`msslib.builders`, one module
-per model family; they are importable from here too.
+:func:`golec_cube_springs`, :func:`material_arrays`) live with their models in
+:mod:`msslib.models`, one module per model family; they are importable from here too.
 """
 
 from __future__ import annotations
@@ -17,29 +17,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from msslib import mesh as _mesh
-from msslib.builders import (
-    assemble_springs,
-    baudet_correction,
-    baudet_cube_springs,
-    golec_cube_springs,
-    lloyd_square_springs,
-    lloyd_tet_springs,
-    lloyd_triangle_springs,
-    material_arrays,
-    van_gelder_springs,
-)
-from msslib.builders.common import _combine as _combine
-from msslib.builders.common import _cube_edges as _cube_edges
-from msslib.builders.common import _field as _field
-from msslib.builders.common import _merge_springs as _merge_springs
-from msslib.builders.common import _pair_lengths as _pair_lengths
-from msslib.builders.common import _pairs_of as _pairs_of
-from msslib.builders.common import _parameters as _parameters
-from msslib.builders.common import _per_cell as _per_cell
-from msslib.builders.common import _require as _require
-from msslib.builders.common import _springs_from as _springs_from
-from msslib.builders.golec import _hex_rest_volumes as _hex_rest_volumes
-from msslib.builders.lloyd import _tet_rest_volumes as _tet_rest_volumes
+from msslib.models.baudet import baudet_correction, baudet_cube_springs
+from msslib.models.common import _pairs_of as _pairs_of
+from msslib.models.common import assemble_springs, material_arrays
+from msslib.models.golec import golec_cube_springs
+from msslib.models.lloyd import lloyd_square_springs, lloyd_tet_springs, lloyd_triangle_springs, van_gelder_springs
 from msslib.terms import ExternalForce, Springs, Term, _ElementTerm
 from msslib.terms.assembly import (
     _block_scatter_bsr,

@@ -12,11 +12,11 @@ from msslib import terms as T
 from msslib.baudet_correction import (
     ElementBaudetCorrection,
     FrozenForce,
-    element_correction,
     fixed_point_solve,
     outside_pair_forces,
 )
 from msslib.metrics import mean_displacement_gradient
+from msslib.models.baudet import element_correction
 from msslib.scene import load_scene, prepare
 from msslib.solvers import integrate, static_solve
 

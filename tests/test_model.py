@@ -2,14 +2,11 @@
 
 from __future__ import annotations
 
-import dataclasses
-import types
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
-import msslib
 from msslib import mesh as M
 from msslib.model import (
     Model,
@@ -35,64 +32,10 @@ from msslib.terms import (
 E0, NU0, T0 = 2.0e3, 0.3, 0.01
 
 
-# --------------------------------------------------------------------------------------------
-# msslib.parameters: the real module when it exists, else a private stub for these tests only
-# --------------------------------------------------------------------------------------------
-
-
-def _stub_parameters():
-    @dataclasses.dataclass(frozen=True)
-    class K:
-        k: object
-
-    @dataclasses.dataclass(frozen=True)
-    class Square:
-        k_edge: object
-        k_diagonal: object
-        rest_factor_edge: object
-        rest_factor_diagonal: object
-
-    @dataclasses.dataclass(frozen=True)
-    class TetVol:
-        k: object
-        k_volume: object
-
-    @dataclasses.dataclass(frozen=True)
-    class Baudet:
-        k_edge: object
-        k_diagonal: object
-        correction_factor: object
-
-    @dataclasses.dataclass(frozen=True)
-    class Golec:
-        k_edge: object
-        k_face: object
-        k_inner: object
-        kappa: object
-
-    s2 = np.sqrt(2.0)
-    mod = types.ModuleType("msslib.parameters")
-    mod.lloyd_triangle = lambda E, t: K(np.sqrt(3.0) / 4 * E * t)
-    mod.van_gelder_triangle = lambda E, t, area, length: K(E * t * area / length**2)
-    mod.lloyd_square = lambda E, t: Square(5 / 16 * E * t, 7 / 16 * E * t, 6 / 5, 6 / 7)
-    mod.lloyd_tetrahedron = lambda E, l: K(2 * s2 / 25 * E * l)
-    mod.lloyd_tetrahedron_volume = lambda E, l, nu: TetVol(
-        2 * s2 / (21 * (1 + nu)) * E * l, s2 * E * l**3 * (13 * nu - 3) / (84 * (1 + nu) * (1 - 2 * nu)))
-    mod.baudet_cube = lambda E, nu, a: Baudet(E * a * (4 * nu + 1) / (8 * (1 + nu)), 3 * E * a / (8 * (1 + nu)),
-                                              -(4 * nu - 1) / 16)
-    # arbitrary but plausible values: only the assembly is tested with them
-    mod.golec_cube = lambda E, nu, a, A: Golec(0.2 * E * a, 0.1 * E * a, 0.05 * E * a, -0.01 * E * A)
-    return mod
-
-
 @pytest.fixture
-def params(monkeypatch):
-    try:
-        from msslib import parameters
-    except ImportError:
-        parameters = _stub_parameters()
-        monkeypatch.setitem(__import__("sys").modules, "msslib.parameters", parameters)
-        monkeypatch.setattr(msslib, "parameters", parameters, raising=False)
+def params():
+    from msslib import parameters
+
     return parameters
 
 

@@ -73,7 +73,7 @@ def block(n, nu, *, published=False, tractions=(), fixed_planes="xyz", fix_all_p
     # force at an edge where two loaded faces meet (pressure on a box); built face by face, each
     # face gets exactly its own normal resultant.
     if correction and reading == "element":
-        from msslib.baudet_correction import element_correction
+        from msslib.models.baudet import element_correction
 
         terms.append(element_correction(mesh, [(E, nu)], published=published))
     elif correction:

@@ -5,20 +5,33 @@ and its correction force for the Poisson effect, in two readings (:mod:`msslib.b
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
+import numpy as np
+
+from msslib.baudet_correction import READINGS, ElementBaudetCorrection
 from msslib.generated import cube_baudet as _baudet
 from msslib.models.checks import evaluate, flag, poisson, positive, same_shape
+from msslib.models.common import (
+    _cube_edges,
+    _merge_springs,
+    _per_cell,
+    _require,
+    assemble_springs,
+    material_arrays,
+)
 from msslib.models.spec import Exactness, ModelSpec, Option, choice, split_terms
+from msslib.terms import BaudetCorrection, Term, sum_external_forces
 
-__all__ = ["BaudetCube", "baudet_cube"]
+__all__ = ["BaudetCube", "baudet_cube"]  # the parameters (gathered by msslib.parameters)
 
 #: place in the registry's order
 RANK = 2
 
 VALID_NU: dict = {}
 
-#: readings of the correction force (scene option ``correction``; msslib.baudet_correction.READINGS)
-CORRECTION_READINGS = ("boundary", "element")
+#: readings of the correction force (scene option ``correction``)
+CORRECTION_READINGS = READINGS
 
 
 @dataclass(frozen=True)
@@ -37,15 +50,71 @@ def baudet_cube(E, nu, a, *, published=False) -> BaudetCube:
     return evaluate("baudet_cube", f, BaudetCube, E=E, nu=nu, a=a)
 
 
-def _build(ctx):
-    from msslib.model import baudet_cube_springs
 
+# --------------------------------------------------------------------------------------------
+# builders: a mesh and its materials turned into terms
+# --------------------------------------------------------------------------------------------
+
+
+def baudet_cube_springs(mesh, materials, published: bool = False) -> list[Term]:
+    """Baudet et al.'s springs on a mesh of cubes: per cube ``k_edge`` on its 12 edges (summed over
+    the cubes sharing an edge) and ``k_diagonal`` on its 4 inner diagonals
+    (``parameters.baudet_cube(E, nu, a)``, ``a`` the cube's edge).  Add :func:`baudet_correction`
+    for the Poisson effect under load. (The printed and derived spring constants agree;
+    ``published`` is accepted for symmetry with the other builders.)"""
+    _require(mesh, "hexahedron")
+    a = _cube_edges(mesh)
+    E, nu = material_arrays(mesh, materials)
+    k_e, k_d = _per_cell(partial(baudet_cube, published=published), ("k_edge", "k_diagonal"), E, nu, a)
+    edges = assemble_springs(mesh, "edges", lambda c, _p: k_e[c])
+    inner = assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_d[c])
+    return [_merge_springs([edges, inner])]
+
+
+def baudet_correction(mesh, materials, loads, published: bool = False) -> BaudetCorrection:
+    """:class:`msslib.terms.BaudetCorrection` for a mesh of cubes with the per-cube factor
+    ``parameters.baudet_cube(E, nu, a).correction_factor``; ``loads`` (n, 3) nodal surface forces
+    at unit load, or a list of terms whose external forces are summed (leave gravity out).
+    ``published=True`` uses the printed factor -(4 nu - 1)/16 (see the errata)."""
+    _require(mesh, "hexahedron")
+    a = _cube_edges(mesh)
+    E, nu = material_arrays(mesh, materials)
+    (c,) = _per_cell(partial(baudet_cube, published=published), ("correction_factor",), E, nu, a)
+    if not isinstance(loads, np.ndarray):
+        try:
+            loads = np.asarray(loads, dtype=float)
+        except (TypeError, ValueError):
+            loads = sum_external_forces(loads, mesh.n_nodes, 3)
+    return BaudetCorrection(mesh, loads, c)
+
+
+def element_correction(mesh, materials, published: bool = False) -> ElementBaudetCorrection:
+    """:class:`ElementBaudetCorrection` for a mesh of cubes with each cube's ``k_edge``,
+    ``k_diagonal`` and ``correction_factor`` from ``parameters.baudet_cube(E, nu, a)``
+    (``published=True``: the printed factor -(4 nu - 1)/16)."""
+    _require(mesh, "hexahedron")
+    a = _cube_edges(mesh)
+    E, nu = material_arrays(mesh, materials)
+    k_e, k_d, c = _per_cell(partial(baudet_cube, published=published),
+                            ("k_edge", "k_diagonal", "correction_factor"), E, nu, a)
+    return ElementBaudetCorrection(mesh, k_e, k_d, c)
+
+
+def correction_term(reading, mesh, materials, loads, published: bool = False) -> Term:
+    """The correction term of ``reading`` (``boundary``: from the nodal surface ``loads``;
+    ``element``: from the forces on each cube, ``loads`` unused)."""
+    if reading == "element":
+        return element_correction(mesh, materials, published=published)
+    if reading == "boundary":
+        return baudet_correction(mesh, materials, loads, published=published)
+    raise ValueError(f"unknown Baudet correction reading {reading!r}; expected one of {', '.join(CORRECTION_READINGS)}")
+
+
+def _build(ctx):
     opts, wanted = ctx.options, ctx.options["terms"]
     out = split_terms(baudet_cube_springs(ctx.mesh, ctx.materials, published=opts["published"]), wanted) \
         if "springs" in wanted else {}
     if "correction" in wanted:
-        from msslib.baudet_correction import correction_term
-
         out["correction"] = [correction_term(opts["correction"], ctx.mesh, ctx.materials, ctx.surface_forces,
                                              published=opts["published"])]
     return out

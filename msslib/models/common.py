@@ -1,4 +1,4 @@
-"""What the model builders share: material tables, parameter functions called per cell, spring
+"""What the model builders of the families share: material tables, parameter functions called per cell, spring
 constants summed over the cells sharing a node pair, and the checks of the mesh."""
 
 from __future__ import annotations
@@ -6,13 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from msslib import mesh as _mesh
+from msslib.models.checks import poisson, positive, same_shape, warn_nu
 from msslib.terms import Springs
-
-
-def _parameters():
-    from msslib import parameters  # imported lazily
-
-    return parameters
 
 
 def material_arrays(mesh, materials) -> tuple[np.ndarray, np.ndarray]:
@@ -145,3 +140,13 @@ def _cube_edges(mesh, rtol=1e-6):
         shown = ", ".join(f"cell {i} (edges {lengths[i].min():.4g}..{lengths[i].max():.4g} m)" for i in bad[:5])
         raise ValueError(f"{len(bad)} hexahedra are not cubes (rtol {rtol}): {shown}")
     return a
+
+
+def check_material(E, nu, model, valid_nu):
+    """Validate E > 0 and -1 < nu < 1/2 (ValueError naming the value) and warn
+    (``FormulaValidityWarning``) when ``model`` is exact or optimal only at ``valid_nu[model]``."""
+    positive("E", E)
+    poisson(nu)
+    same_shape("check_material", E=E, nu=nu)
+    if model in valid_nu:
+        warn_nu(nu, valid_nu[model], model)
