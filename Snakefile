@@ -22,10 +22,13 @@ import yaml
 QUICK = bool(int(config.get("quick", 0)))
 QFLAG = "--quick" if QUICK else ""
 PAPERS = ["lloyd", "baudet", "golec", "performance", "summary"]
-DERIVATIONS = ["triangle", "square", "rectangle", "tetrahedron", "cube_baudet", "cube_golec", "kernels"]
-# the derivation modules as notebooks: one HTML page each, beside the paper (linked as derivations/<module>.html)
+# the modules codegen derives (derivations/elements/, derivations/terms/; derivations.registry finds
+# them the same way), name -> source file, and the engine: every file directly in derivations/
+DERIVATIONS = {p.stem: str(p) for kind in ("elements", "terms")
+               for p in sorted(Path("derivations", kind).glob("*.py")) if not p.stem.startswith("_")}
+ENGINE = sorted(str(p) for p in Path("derivations").glob("*.py"))
+# the derivation modules as notebooks: one HTML page each, beside the paper (linked as derivations/<name>.html)
 NOTEBOOKS = [f"paper/build/derivations/{m}.html" for m in DERIVATIONS]
-ENGINE = ["__init__", "elasticity", "fem", "mss", "match", "lattice", "records", "codegen", "report"]
 SCENES = sorted(glob_wildcards("experiments/scenes/{name}.yaml").name)
 # every result depends on the library that computed it: a change in msslib reruns what it touches
 # (msslib/paper.py computes no result: only the paper rules depend on it)
@@ -89,7 +92,7 @@ rule all:
 rule codegen:
     """Re-derive every element family; regenerate msslib/generated/, the errata and the derivation results."""
     input:
-        expand("derivations/{m}.py", m=DERIVATIONS + ENGINE),
+        list(DERIVATIONS.values()) + ENGINE,
     output:
         "paper/errata.md",
         "paper/derivations.md",
@@ -155,7 +158,7 @@ rule experiment_compare:
 
 def shared(wc):
     """Helper modules next to a group's scripts (experiments/<paper>/*.py): edits rebuild."""
-    return sorted(str(p) for p in Path("experiments", wc.paper).glob("*.py"))
+    return sorted(str(p) for p in Path("experiments", wc.paper).glob("*.py")) + ["experiments/script.py"]
 
 
 rule study:
@@ -174,7 +177,7 @@ rule study:
     log:
         "logs/{paper}/studies/{name}.log",
     shell:
-        "python {input.script} --out {output} {params.quick} > {log} 2>&1"
+        "python -m experiments.{wildcards.paper}.studies.{wildcards.name} --out {output} {params.quick} > {log} 2>&1"
 
 
 rule figure:
@@ -189,7 +192,7 @@ rule figure:
     log:
         "logs/{paper}/figures/{name}.log",
     shell:
-        "python {input.script} --out paper/figures/{wildcards.paper}_{wildcards.name} > {log} 2>&1"
+        "python -m experiments.{wildcards.paper}.figures.{wildcards.name} --out paper/figures/{wildcards.paper}_{wildcards.name} > {log} 2>&1"
 
 
 rule table:
@@ -203,7 +206,7 @@ rule table:
     log:
         "logs/{paper}/tables/{name}.log",
     shell:
-        "python {input.script} --out {output} > {log} 2>&1"
+        "python -m experiments.{wildcards.paper}.tables.{wildcards.name} --out {output} > {log} 2>&1"
 
 
 rule stability:
@@ -292,8 +295,8 @@ rule derivation_notebook:
     """One derivation module as a notebook page: its cells run in order, prose as text, code with
     what it showed (matrices, equations, solution, checks) as MathML; one self-contained HTML file."""
     input:
-        module="derivations/{module}.py",
-        engine=expand("derivations/{m}.py", m=ENGINE + ["show", "notebook"]),
+        module=lambda wc: DERIVATIONS[wc.module],
+        engine=ENGINE,
         code="msslib/paper.py",
     output:
         "paper/build/derivations/{module}.html",

@@ -1,29 +1,33 @@
-"""Generate ``msslib/generated/`` from the derivations.
+"""Generate ``msslib/generated/`` from the derivation modules that :mod:`derivations.registry` finds.
 
-    python -m derivations.codegen            # (re)write the generated modules
-    python -m derivations.codegen --check    # exit 1 when a generated module is stale or edited
+    python -m derivations.codegen            # (re)write every generated file and the paper's derivation files
+    python -m derivations.codegen rectangle  # (re)write one module's generated files only
+    python -m derivations.codegen --check    # exit 1 when a generated file is stale, edited or orphaned
     python -m derivations.codegen --check --full   # re-derive everything and compare the text
 
-Every generated module records the SHA-256 of the derivation sources it came from (the engine and
-the element module) and of its own body. ``--check`` recomputes both: a changed derivation or a
-hand edit makes it fail, without re-deriving. ``--full`` re-derives and compares byte for byte.
-The errata collected from the derivations are written to ``paper/errata.md`` and the symbolic
-findings to ``paper/derivations.md``.
+Every module of ``derivations/elements/`` and ``derivations/terms/`` becomes
+``msslib/generated/<name>.py`` (numpy functions) and ``msslib/generated/c/msslib_<name>.h`` (C99).
+Each of the two records the SHA-256 of the derivation sources it came from, the engine (every file
+directly in ``derivations/``, :func:`derivations.registry.engine_files`) and its own module, and
+of its own body. ``--check`` recomputes both: a changed derivation or a hand edit makes it fail,
+without re-deriving. Adding a module changes no other module's hash. ``--full`` re-derives and
+compares byte for byte. The errata collected from the derivations are written to
+``paper/errata.md`` and the symbolic findings to ``paper/derivations.md`` (full runs only).
 
-A full run also writes one C99 header, ``msslib/generated/msslib_mss.h`` (:data:`C_HEADER`): every
-formula of every module (spring constants, rest-length factors, volume coefficients, and the
-energy, gradient and Hessian kernels) printed from the same SymPy expressions and the same common
-subexpressions as the Python modules, by SymPy's C99 printer. Its functions are ``static inline``
-unless ``MSSLIB_API`` is defined before the header is included (define it empty to compile the
-header into a library). It carries the same two hash lines, over the engine and every module, and
-``--check`` checks it like the Python modules.
+The C headers (:func:`render_c`) print every formula of a module (spring constants, rest-length
+factors, volume coefficients, and the energy, gradient and Hessian kernels) from the same SymPy
+expressions and the same common subexpressions as the Python modules, by SymPy's C99 printer.
+Functions are ``static inline`` unless ``MSSLIB_API`` is defined before a header is included
+(define it empty to compile them into a library). ``msslib/generated/c/msslib_mss.h``
+(:data:`C_UMBRELLA`) includes every module's header; it lists module names only (no hash) and
+is rewritten by every run, so adding a module rewrites it; ``--check`` compares it with the list.
 """
 
 from __future__ import annotations
 
 import argparse
 import hashlib
-import importlib
+import re
 import sys
 from pathlib import Path
 
@@ -31,29 +35,25 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 
+from derivations import registry
+
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "msslib" / "generated"
-ENGINE = ["__init__.py", "elasticity.py", "fem.py", "mss.py", "match.py", "lattice.py", "records.py", "codegen.py"]
-MODULES = ["triangle", "square", "rectangle", "tetrahedron", "cube_baudet", "cube_golec", "kernels"]
-C_HEADER = "msslib_mss.h"  # in OUT; generated from every module in MODULES
+C_DIR = "c"  # the C headers, in OUT
+C_UMBRELLA = "msslib_mss.h"  # in OUT / C_DIR: includes every module's header
+
+
+def c_header(module: str) -> str:
+    """File name of a module's C header (in ``OUT / C_DIR``)."""
+    return f"msslib_{module}.h"
 
 
 def source_hash(module: str) -> str:
+    """SHA-256 of the engine files and of the module's own source."""
     h = hashlib.sha256()
-    here = Path(__file__).resolve().parent
-    for name in ENGINE + [f"{module}.py"]:
-        h.update(name.encode())
-        h.update((here / name).read_bytes())
-    return h.hexdigest()
-
-
-def c_source_hash() -> str:
-    """SHA-256 of the engine and of every module the C header is printed from."""
-    h = hashlib.sha256()
-    here = Path(__file__).resolve().parent
-    for name in ENGINE + [f"{m}.py" for m in MODULES]:
-        h.update(name.encode())
-        h.update((here / name).read_bytes())
+    for path in registry.engine_files() + [registry.path(module)]:
+        h.update(path.relative_to(registry.ROOT).as_posix().encode())
+        h.update(path.read_bytes())
     return h.hexdigest()
 
 
@@ -81,11 +81,20 @@ def _function_code(f) -> str:
     return "\n".join(lines)
 
 
+def _derive(module: str, derivation=None):
+    return derivation if derivation is not None else registry.module(module).derive()
+
+
 def render(module: str, derivation=None) -> str:
-    mod = importlib.import_module(f"derivations.{module}")
-    d = derivation or mod.derive()
-    body = [f'"""{d.title}.', "", f"Generated from derivations/{module}.py by `python -m derivations.codegen`; do not edit.",
+    """The text of ``msslib/generated/<module>.py`` (``derivation``: its ``derive()``, default: derive)."""
+    module = registry.resolve(module)
+    d = _derive(module, derivation)
+    src = registry.relpath(module)
+    body = [f'"""{d.title}.', "", f"Generated from {src} by `python -m derivations.codegen`; do not edit.",
             '"""', "", "from numpy import sqrt  # noqa: F401", ""]
+    if registry.kind(module) == "elements":
+        body += ["", "# the simulator models whose parameters come from this module (its ELEMENT declaration)",
+                 f"MODELS = {tuple(registry.element(module).models)!r}", ""]
     body += ["", f"OUTPUTS = {{{', '.join(repr(f.name) + ': ' + repr(tuple(f.outputs)) for f in d.formulas + d.published)}}}", ""]
     for f in d.formulas:
         body += ["", _function_code(f), ""]
@@ -93,7 +102,7 @@ def render(module: str, derivation=None) -> str:
         body += ["", _function_code(f), ""]
     text = "\n".join(body).rstrip() + "\n"
     digest = hashlib.sha256(text.encode()).hexdigest()
-    header = (f"# Generated from derivations/{module}.py by `python -m derivations.codegen`. Do not edit.\n"
+    header = (f"# Generated from {src} by `python -m derivations.codegen`. Do not edit.\n"
               f"# source-sha256: {source_hash(module)}\n# body-sha256: {digest}\n")
     return header + text
 
@@ -150,19 +159,17 @@ def _c_index_macros(f, prefix: str = "MSSLIB_") -> list[str]:
     return out
 
 
-def render_c_header(derivations=None) -> str:
-    """The text of :data:`C_HEADER` (``derivations``: module name -> ``derive()``, default: derive)."""
-    derivations = dict(derivations or {})
-    for m in MODULES:
-        if m not in derivations:
-            derivations[m] = importlib.import_module(f"derivations.{m}").derive()
-    guard = "MSSLIB_MSS_H"
-    body = ["/* Spring constants, rest-length factors, volume coefficients and the energy, gradient and",
-            " * Hessian kernels of msslib's mass-spring models, in C99.",
+def render_c(module: str, derivation=None) -> str:
+    """The text of ``msslib/generated/c/msslib_<module>.h`` (``derivation`` as for :func:`render`)."""
+    module = registry.resolve(module)
+    d = _derive(module, derivation)
+    src = registry.relpath(module)
+    guard = f"MSSLIB_{module.upper()}_H"
+    body = [f"/* {_c_comment(d.title)}, in C99.",
             " *",
-            " * Printed by SymPy's C99 printer from the expressions that the Python modules of",
-            " * msslib/generated are printed from (the modules of derivations/), with the same common",
-            " * subexpressions; `python -m derivations.codegen` writes both, do not edit.",
+            f" * Printed by SymPy's C99 printer from the expressions that msslib/generated/{module}.py is",
+            f" * printed from ({src}), with the same common subexpressions;",
+            " * `python -m derivations.codegen` writes both, do not edit. msslib_mss.h includes every module.",
             " * SI units: E in Pa, lengths in m, spring constants in N/m, energies in J, gradients in N,",
             " * Hessians in N/m (row-major, node by node: x0, y0(, z0), x1, ...).",
             " * Functions are `static inline` unless MSSLIB_API is defined before this header is",
@@ -172,21 +179,35 @@ def render_c_header(derivations=None) -> str:
             "#ifndef MSSLIB_API", "#define MSSLIB_API static inline", "#endif", "",
             "#ifdef __cplusplus", 'extern "C" {', "#endif"]
     seen = set()
-    for m in MODULES:
-        d = derivations[m]
-        body += ["", f"/* ---- derivations/{m}.py: {_c_comment(d.title)} ---- */"]
-        for f in d.formulas + d.published:
-            if f.name in seen:
-                raise ValueError(f"formula {f.name!r} is defined twice; C names must be unique")
-            seen.add(f.name)
-            macros = _c_index_macros(f)
-            body += [""] + macros + ([""] if macros else []) + [_c_function_code(f)]
+    for f in d.formulas + d.published:
+        if f.name in seen:
+            raise ValueError(f"formula {f.name!r} is defined twice in {src}; C names must be unique")
+        seen.add(f.name)
+        macros = _c_index_macros(f)
+        body += [""] + macros + ([""] if macros else []) + [_c_function_code(f)]
     body += ["", "#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */"]
     text = "\n".join(body) + "\n"
     digest = hashlib.sha256(text.encode()).hexdigest()
-    header = ("// Generated from derivations/ by `python -m derivations.codegen`. Do not edit.\n"
-              f"// source-sha256: {c_source_hash()}\n// body-sha256: {digest}\n")
+    header = (f"// Generated from {src} by `python -m derivations.codegen`. Do not edit.\n"
+              f"// source-sha256: {source_hash(module)}\n// body-sha256: {digest}\n")
     return header + text
+
+
+def render_c_umbrella(modules=None) -> str:
+    """The text of :data:`C_UMBRELLA`: one ``#include`` per generated module (names only, no hash)."""
+    modules = registry.generated() if modules is None else modules
+    lines = ["// Generated from the modules of derivations/elements/ and derivations/terms/ by",
+             "// `python -m derivations.codegen`. Do not edit; rewritten when a module is added.",
+             "/* Every C header of msslib/generated/c: spring constants, rest-length factors, volume",
+             " * coefficients and the energy, gradient and Hessian kernels of msslib's mass-spring models.",
+             " * Each header also stands alone. */",
+             "#ifndef MSSLIB_MSS_H", "#define MSSLIB_MSS_H", ""]
+    lines += [f'#include "{c_header(m)}"' for m in modules]
+    lines += ["", "#endif /* MSSLIB_MSS_H */"]
+    return "\n".join(lines) + "\n"
+
+
+_C_FUNCTION = re.compile(r"^MSSLIB_API (?:double|void) (\w+)\(", flags=re.M)
 
 
 def _read_header(path: Path):
@@ -196,59 +217,92 @@ def _read_header(path: Path):
     return src, body, "".join(lines[3:])
 
 
-def check(full: bool = False) -> list[str]:
-    problems = []
-    for m in MODULES:
-        path = OUT / f"{m}.py"
-        if not path.exists():
-            problems.append(f"{path.relative_to(ROOT)} is missing")
-            continue
-        src, body, text = _read_header(path)
-        if src != source_hash(m):
-            problems.append(f"{path.relative_to(ROOT)} is stale: derivations/{m}.py or the engine changed")
-        if body != hashlib.sha256(text.encode()).hexdigest():
-            problems.append(f"{path.relative_to(ROOT)} was edited by hand")
-        if full and path.read_text() != render(m):
-            problems.append(f"{path.relative_to(ROOT)} differs from a fresh derivation")
-    path = OUT / C_HEADER
+def _check_file(path: Path, module: str, fresh, full: bool) -> list[str]:
+    rel = path.relative_to(ROOT)
     if not path.exists():
-        problems.append(f"{path.relative_to(ROOT)} is missing")
-    else:
-        src, body, text = _read_header(path)
-        if src != c_source_hash():
-            problems.append(f"{path.relative_to(ROOT)} is stale: a derivation module or the engine changed")
-        if body != hashlib.sha256(text.encode()).hexdigest():
-            problems.append(f"{path.relative_to(ROOT)} was edited by hand")
-        if full and path.read_text() != render_c_header():
-            problems.append(f"{path.relative_to(ROOT)} differs from a fresh derivation")
+        return [f"{rel} is missing"]
+    problems = []
+    src, body, text = _read_header(path)
+    if src != source_hash(module):
+        problems.append(f"{rel} is stale: {registry.relpath(module)} or the engine changed")
+    if body != hashlib.sha256(text.encode()).hexdigest():
+        problems.append(f"{rel} was edited by hand")
+    if full and path.read_text() != fresh():
+        problems.append(f"{rel} differs from a fresh derivation")
     return problems
 
 
-def write_all(modules=MODULES) -> None:
-    OUT.mkdir(parents=True, exist_ok=True)
+def check(full: bool = False) -> list[str]:
+    """What is wrong with ``msslib/generated/`` (empty: up to date)."""
+    problems = []
+    modules = registry.generated()
+    c_dir = OUT / C_DIR
+    derived = {}
+
+    def fresh(m, fn):
+        def text():
+            if m not in derived:
+                derived[m] = registry.module(m).derive()
+            return fn(m, derived[m])
+        return text
+
+    for m in modules:
+        problems += _check_file(OUT / f"{m}.py", m, fresh(m, render), full)
+        problems += _check_file(c_dir / c_header(m), m, fresh(m, render_c), full)
+    expected = {f"{m}.py" for m in modules} | {"__init__.py"}
+    for path in sorted(OUT.glob("*.py")):
+        if path.name not in expected:
+            problems.append(f"{path.relative_to(ROOT)} has no derivation module (remove it)")
+    expected = {c_header(m) for m in modules} | {C_UMBRELLA}
+    for path in sorted(c_dir.glob("*.h")):
+        if path.name not in expected:
+            problems.append(f"{path.relative_to(ROOT)} has no derivation module (remove it)")
+    umbrella = c_dir / C_UMBRELLA
+    if not umbrella.exists():
+        problems.append(f"{umbrella.relative_to(ROOT)} is missing")
+    elif umbrella.read_text() != render_c_umbrella(modules):
+        problems.append(f"{umbrella.relative_to(ROOT)} does not include exactly the generated modules")
+    owner = {}
+    for m in modules:  # every header goes into one translation unit: C names must be unique
+        path = c_dir / c_header(m)
+        for name in _C_FUNCTION.findall(path.read_text()) if path.exists() else []:
+            if name in owner:
+                problems.append(f"C function {name} is defined by both {owner[name]} and {m}")
+            owner[name] = m
+    return problems
+
+
+def write_all(modules=None) -> None:
+    """Write the generated files of ``modules`` (default: every module, and then the paper files)."""
+    everything = registry.generated()
+    modules = everything if not modules else [registry.resolve(m) for m in modules]
+    unknown = [m for m in modules if m not in everything]
+    if unknown:
+        raise SystemExit(f"not a generated module (derivations/elements/ or derivations/terms/): {', '.join(unknown)}")
+    c_dir = OUT / C_DIR
+    c_dir.mkdir(parents=True, exist_ok=True)
     init = OUT / "__init__.py"
     init.write_text('"""Code generated from ``derivations/`` by ``python -m derivations.codegen``; do not edit."""\n')
     derivations = {}
     for m in modules:
-        mod = importlib.import_module(f"derivations.{m}")
-        derivations[m] = mod.derive()
+        derivations[m] = registry.module(m).derive()
         (OUT / f"{m}.py").write_text(render(m, derivations[m]))
-        print(f"wrote msslib/generated/{m}.py", flush=True)
-    if set(modules) == set(MODULES):
-        (OUT / C_HEADER).write_text(render_c_header(derivations))
-        print(f"wrote msslib/generated/{C_HEADER}", flush=True)
+        (c_dir / c_header(m)).write_text(render_c(m, derivations[m]))
+        print(f"wrote msslib/generated/{m}.py and msslib/generated/{C_DIR}/{c_header(m)}", flush=True)
+    (c_dir / C_UMBRELLA).write_text(render_c_umbrella(everything))
+    print(f"wrote msslib/generated/{C_DIR}/{C_UMBRELLA}", flush=True)
+    if set(modules) == set(everything):
         from derivations import report
         report.write(derivations)
-    else:  # the paper's errata and findings and the C header need every module: leave them to a full run
-        print(f"paper/errata.md, paper/derivations.* and msslib/generated/{C_HEADER} not rewritten "
-              f"(only some modules derived)")
+    else:  # the paper's errata and findings need every module: leave them to a full run
+        print("paper/errata.md and paper/derivations.* not rewritten (only some modules derived)")
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python -m derivations.codegen", description=__doc__.splitlines()[0])
     p.add_argument("--check", action="store_true", help="fail when generated code is stale or edited")
     p.add_argument("--full", action="store_true", help="with --check: re-derive and compare the text")
-    p.add_argument("modules", nargs="*", help="only these derivation modules")
+    p.add_argument("modules", nargs="*", help="only these derivation modules (names, e.g. rectangle)")
     args = p.parse_args(argv)
     if args.check:
         problems = check(args.full)
@@ -259,7 +313,7 @@ def main(argv=None) -> int:
             return 1
         print("generated code is up to date")
         return 0
-    write_all(args.modules or MODULES)
+    write_all(args.modules)
     return 0
 
 

@@ -3,12 +3,14 @@
     python -m derivations.notebook triangle --out triangle.md
     python -m msslib.paper notebook triangle --out paper/build/derivations/triangle.html
 
+A module is named as :func:`derivations.registry.resolve` accepts it: ``triangle``,
+``elements/triangle`` or ``derivations/elements/triangle.py``, wherever it lives.
 The module's cells run in order in one namespace, as ``__main__`` (as in Jupyter). A markdown cell
 (``# %% [markdown]``) becomes Markdown text; a code cell becomes a code block followed by what it
 showed: the math of :mod:`derivations.show` as ``$$...$$`` and its printed output as a text block.
 The paper stage (``python -m msslib.paper notebook``) turns the Markdown into one self-contained HTML
 page by the same path as the paper's HTML (pandoc, math as MathML, no script), beside the paper
-(``paper/build/derivations/``), so that the paper links them as ``derivations/<module>.html``. This
+(``paper/build/derivations/``), so that the paper links them as ``derivations/<name>.html``. This
 module imports nothing of msslib: the derivations come first in the workflow.
 """
 
@@ -21,7 +23,7 @@ import sys
 from contextlib import redirect_stdout
 from pathlib import Path
 
-from derivations import show
+from derivations import registry, show
 
 HERE = Path(__file__).resolve().parent
 CELL = re.compile(r"^# %%(.*)$")
@@ -91,9 +93,17 @@ def _outputs(items) -> list[str]:
     return blocks
 
 
+def find(module: str) -> Path | None:
+    """The source file of a derivation module, or None when there is none."""
+    try:
+        return registry.path(module)
+    except KeyError:
+        return None
+
+
 def to_markdown(module: str) -> str:
-    """Run ``derivations/<module>.py`` cell by cell and return the notebook as Markdown."""
-    path = HERE / f"{module}.py"
+    """Run a derivation module (e.g. ``triangle``) cell by cell and return the notebook as Markdown."""
+    path = registry.path(module)
     source = path.read_text(encoding="utf-8")
     namespace = {"__name__": "__main__", "__file__": str(path), "__builtins__": __builtins__}
     parts = []
@@ -115,8 +125,8 @@ def main(argv=None) -> int:
     p.add_argument("module", help="derivation module, e.g. triangle")
     p.add_argument("--out", "-o", required=True, help="Markdown file")
     args = p.parse_args(argv)
-    if not (HERE / f"{args.module}.py").is_file():
-        print(f"no derivation module derivations/{args.module}.py", file=sys.stderr)
+    if find(args.module) is None:
+        print(f"no derivation module {args.module!r} in derivations/elements/, terms/ or analyses/", file=sys.stderr)
         return 2
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -40,3 +40,20 @@ class Derivation:
 
 def latex(e) -> str:
     return sp.latex(e)
+
+
+@dataclass(frozen=True)
+class Element:
+    """What an element module (``derivations/elements/<name>.py``) declares at module level as
+    ``ELEMENT``: the registry finds the module, codegen writes ``msslib/generated/<name>.py``.
+
+    ``cell`` is the :mod:`derivations.fem` cell type it derives (``triangle``, ``quad``, ``tetra``,
+    ``hexahedron``); ``models`` the simulator models (scene model names) whose parameters come from
+    the generated code; ``source`` the paper and section it derives; ``extends`` the element it
+    generalises, if any (its derivation is listed after that one)."""
+
+    name: str
+    cell: str
+    models: tuple = ()
+    source: str = ""
+    extends: str | None = None

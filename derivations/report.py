@@ -8,6 +8,8 @@ from pathlib import Path
 
 import sympy as sp
 
+from derivations import registry
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -21,7 +23,7 @@ def _errata_md(derivations) -> str:
             n += 1
             out += [f"### {n}. {e.paper}, {e.where}", "",
                     f"- printed: ${e.printed}$", f"- derived: ${e.correct}$", "",
-                    e.explanation, "", f"Proof: `{e.proof}` (derivation `derivations/{m}.py`).", ""]
+                    e.explanation, "", f"Proof: `{e.proof}` (derivation `{registry.relpath(m)}`).", ""]
     return "\n".join(out)
 
 
@@ -65,7 +67,7 @@ def _findings_md(derivations) -> str:
     for m, d in derivations.items():
         if not d.findings:
             continue
-        out += [f"### {d.title}", "", f"Source: `derivations/{m}.py`", ""]
+        out += [f"### {d.title}", "", f"Source: `{registry.relpath(m)}`", ""]
         for label, text in d.findings:
             is_tex = "\\" in text or "=" in text  # LaTeX (words in \\text{}); else plain words
             out.append(f"- **{label}**: {_finding_math(text)}" if is_tex else f"- **{label}**: {text}")
@@ -79,7 +81,7 @@ def write(derivations) -> None:
     (paper / "errata.md").write_text(_errata_md(derivations))
     (paper / "derivations.md").write_text(_findings_md(derivations))
     data = {m: {"title": d.title,
-                "formulas": {f.name: {k: sp.srepr(v) for k, v in f.outputs.items()} for f in d.formulas if m != "kernels"},
+                "formulas": {f.name: {k: sp.srepr(v) for k, v in f.outputs.items()} for f in d.formulas if registry.kind(m) == "elements"},
                 "findings": dict(d.findings),
                 "errata": [e.__dict__ for e in d.errata]} for m, d in derivations.items()}
     (paper / "derivations.json").write_text(json.dumps(data, indent=1, sort_keys=True))

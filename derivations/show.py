@@ -6,7 +6,7 @@ works in three places:
 
 - in Jupyter (IPython with a kernel), it displays ``IPython.display.Math`` (and ``Markdown`` for
   prose); IPython is imported only there;
-- as a script (``python -m derivations.triangle``), it prints a readable plain form
+- as a script (``python -m derivations.elements.triangle``), it prints a readable plain form
   (``sympy.pretty``);
 - while :mod:`derivations.notebook` renders a module (inside :func:`collecting`), it appends
   Markdown with ``$$...$$`` display math (``sympy.latex``) to the collected output.

@@ -36,8 +36,9 @@ displacements, the loads and gravity. The writers turn it into
     ConstantForceField, StaticSolver (static scenes) or EulerImplicitSolver (dynamic scenes,
     Rayleigh damping), CGLinearSolver. Volume terms: not carried, said in a comment.
 ``c``
-    The generated C header ``msslib_mss.h`` (:mod:`derivations.codegen`): the spring-constant
-    formulas and the energy, gradient and Hessian kernels, copied beside the outputs.
+    The generated C headers (:mod:`derivations.codegen`): ``msslib_mss.h``, which includes one
+    header per derivation module (``msslib_<module>.h``: its spring-constant formulas, or the energy,
+    gradient and Hessian kernels), all copied beside the outputs (:func:`c_header_paths`).
 
 Units are SI throughout.
 """
@@ -55,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["FORMATS", "SPRINGS_ONLY_FORMATS", "SCHEMA", "SCHEMA_VERSION",
-           "C_HEADER_PATH", "Column", "Table", "MssExport", "build", "from_setup", "parse_formats", "default_formats",
+           "C_HEADER_PATH", "c_header_paths", "Column", "Table", "MssExport", "build", "from_setup", "parse_formats", "default_formats",
            "not_carried", "output_paths", "stem_for", "file_writer", "csv_text", "read_csv", "json_document",
            "json_text", "read_json", "write_vtu"]
 
@@ -65,7 +66,14 @@ FORMATS = ("csv", "json", "vtu", "mjcf", "sofa", "c")
 SPRINGS_ONLY_FORMATS = ("mjcf", "sofa")
 SCHEMA = "msslib-mss-export"
 SCHEMA_VERSION = 1
-C_HEADER_PATH = Path(__file__).resolve().parent / "generated" / "msslib_mss.h"
+#: the umbrella C header; every module's header is beside it (msslib/generated/c/)
+C_HEADER_PATH = Path(__file__).resolve().parent / "generated" / "c" / "msslib_mss.h"
+
+
+def c_header_paths() -> list[Path]:
+    """The C headers the ``c`` format copies: :data:`C_HEADER_PATH` and every header beside it
+    (the ones it includes), umbrella first."""
+    return [C_HEADER_PATH] + sorted(p for p in C_HEADER_PATH.parent.glob("*.h") if p != C_HEADER_PATH)
 
 AXES = "xyz"
 UNITS = {"length": "m", "mass": "kg", "force": "N", "stiffness": "N/m", "pressure": "Pa", "energy": "J",
@@ -377,8 +385,8 @@ def _safe_name(name: str) -> str:
 def output_paths(exp: MssExport, stem: Path, formats) -> list[tuple[str, str, Path, str | None]]:
     """``(format, what, path, table)`` of every file the formats write (``table``: the table of a
     CSV file, else None), ``stem`` the path prefix: CSV ``STEM_TABLE.csv``, JSON ``STEM.json``, VTU
-    ``STEM.vtu``, MuJoCo ``STEM_mujoco.xml``, SOFA ``STEM.scn``, C ``msslib_mss.h`` in the stem's
-    directory."""
+    ``STEM.vtu``, MuJoCo ``STEM_mujoco.xml``, SOFA ``STEM.scn``, C ``msslib_mss.h`` and the headers it
+    includes in the stem's directory (``table``: the header's file name)."""
     stem = Path(stem)
     out = []
     for fmt in formats:
@@ -394,7 +402,7 @@ def output_paths(exp: MssExport, stem: Path, formats) -> list[tuple[str, str, Pa
         elif fmt == "sofa":
             out.append(("sofa", "SOFA scene", stem.with_name(f"{stem.name}.scn"), None))
         elif fmt == "c":
-            out.append(("c", "C header", stem.with_name(C_HEADER_PATH.name), None))
+            out += [("c", f"C header {p.name}", stem.with_name(p.name), p.name) for p in c_header_paths()]
         else:
             raise ValueError(f"unknown format {fmt!r}")
     return out
@@ -420,7 +428,7 @@ def file_writer(exp: MssExport, fmt: str, table: str | None = None):
         make = export_simulators.mjcf_text if fmt == "mjcf" else export_simulators.sofa_text
         return text(lambda: make(exp))
     if fmt == "c":
-        return text(lambda: C_HEADER_PATH.read_text(encoding="utf-8"))
+        return text(lambda: (C_HEADER_PATH.parent / (table or C_HEADER_PATH.name)).read_text(encoding="utf-8"))
     raise ValueError(f"unknown format {fmt!r}")
 
 

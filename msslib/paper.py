@@ -437,12 +437,12 @@ def html_from_markdown(markdown, out) -> Path:
 
 
 def notebook_html(module, out) -> Path:
-    """The derivation module ``derivations/<module>.py`` as a notebook page: its cells run in order
-    (:func:`derivations.notebook.to_markdown`), rendered like the paper's HTML."""
-    from derivations.notebook import HERE, to_markdown
+    """A derivation module (e.g. ``triangle``, wherever it lives in ``derivations/``) as a notebook
+    page: its cells run in order (:func:`derivations.notebook.to_markdown`), rendered like the paper's HTML."""
+    from derivations.notebook import find, to_markdown
 
-    if not (HERE / f"{module}.py").is_file():
-        raise ValueError(f"no derivation module derivations/{module}.py")
+    if find(module) is None:
+        raise ValueError(f"no derivation module {module!r} in derivations/elements/, terms/ or analyses/")
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     return write_text(out, render_html(to_markdown(module)))

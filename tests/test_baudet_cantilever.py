@@ -2,19 +2,15 @@
 tensor against the symbolic derivation, the cubic-elasticity solver against msslib's FEM and beam
 theory, and the error statistics on fields with known errors."""
 
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "experiments" / "baudet"))
-import cantilever_common as K  # noqa: E402
+from experiments.baudet import cantilever_common as K
 
 
 @pytest.mark.parametrize("nu", [0.1, 0.3, 0.45])
 def test_lattice_tensor_is_the_derivation(nu):
-    from derivations import cube_baudet as cb
+    from derivations.elements import cube_baudet as cb
     from derivations.elasticity import E
     from derivations.elasticity import nu as snu
 

@@ -1,4 +1,4 @@
-"""Baudet's Table 1 as counted by derivations/baudet_table1.py, against counts reasoned independently.
+"""Baudet's Table 1 as counted by derivations/analyses/baudet_table1.py, against counts reasoned independently.
 
 The expected values are not produced by the module: they come from the geometry of the springs
 (which springs a homogeneous shear or elongation stretches), from the symmetry of the compliance
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from derivations import baudet_table1 as T
+from derivations.analyses import baudet_table1 as T
 from derivations.elasticity import E
 from msslib.fem import element_stiffness as fem_element_stiffness
 

@@ -4,7 +4,7 @@ The tables (CSV, JSON) read back equal to the model's terms; the VTU has one lin
 the MuJoCo model, loaded by the real ``mujoco`` package, has msslib's static equilibrium as its own
 (residual at msslib's solution, and a damped run that comes to rest there); the SOFA scene uses
 only documented components and attributes and carries the same springs, masses and constraints;
-the generated C header compiles warning-free and agrees with the generated Python code; the
+the generated C headers compile warning-free and agrees with the generated Python code; the
 command refuses outputs that are inputs and writes all files or none.
 """
 
@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 import yaml
 
-from derivations import codegen
+from derivations import codegen, registry
 from msslib import cli, export, export_simulators
 from msslib.solvers import static_solve
 from msslib.terms import BaudetCorrection, HexVolume, Springs, TetVolume
@@ -364,7 +364,7 @@ def _compiler():
 
 def _python_functions():
     out = {}
-    for m in codegen.MODULES:
+    for m in registry.generated():
         gen = importlib.import_module(f"msslib.generated.{m}")
         for name, outputs in gen.OUTPUTS.items():
             out[name] = (getattr(gen, name), outputs)
@@ -374,13 +374,19 @@ def _python_functions():
 def test_c_header_compiles_and_matches_the_python_code(tmp_path):
     cc = _compiler()
     header = export.C_HEADER_PATH
-    text = header.read_text()
     functions = _python_functions()
-    declared = re.findall(r"^MSSLIB_API (?:double|void) msslib_(\w+)\(", text, flags=re.M)
-    assert sorted(declared) == sorted(functions)  # every generated formula and kernel, nothing else
+    included = re.findall(r'^#include "(msslib_\w+\.h)"$', header.read_text(), flags=re.M)
+    assert included == [codegen.c_header(m) for m in registry.generated()]  # one header per module
+    declared = [name for h in included for name in re.findall(r"^MSSLIB_API (?:double|void) msslib_(\w+)\(",
+                                                              (header.parent / h).read_text(), flags=re.M)]
+    assert sorted(declared) == sorted(functions)  # every generated formula and kernel, nothing else, once
     src = tmp_path / "use.c"
     src.write_text('#include "msslib_mss.h"\n')
     flags = ["-std=c99", "-Wall", "-Wextra", "-pedantic", "-Werror", f"-I{header.parent}"]
+    for h in included:  # each module's header stands alone
+        alone = tmp_path / f"alone_{h}.c"
+        alone.write_text(f'#include "{h}"\n')
+        subprocess.run([cc, *flags, "-c", str(alone), "-o", str(tmp_path / "alone.o")], check=True, capture_output=True)
     # as shipped (static inline; strict C99 and the compiler's default dialect) and compiled into a
     # shared library (external linkage)
     subprocess.run([cc, *flags, "-c", str(src), "-o", str(tmp_path / "use.o")], check=True, capture_output=True)
@@ -421,24 +427,38 @@ def test_codegen_check_covers_the_c_header(tmp_path, monkeypatch):
     monkeypatch.setattr(codegen, "OUT", out)
     monkeypatch.setattr(codegen, "ROOT", tmp_path)
     assert codegen.check() == []
-    path = out / codegen.C_HEADER
-    path.write_text(path.read_text().replace("(1.0/4.0)*sqrt(3)*E*t", "(1.0/3.0)*sqrt(3)*E*t"))
-    assert codegen.check() == [f"generated/{codegen.C_HEADER} was edited by hand"]
+    name = f"generated/c/{codegen.c_header('triangle')}"
+    path = tmp_path / name
+    original = path.read_text()
+    path.write_text(original.replace("(1.0/4.0)*sqrt(3)*E*t", "(1.0/3.0)*sqrt(3)*E*t"))
+    assert codegen.check() == [f"{name} was edited by hand"]
     path.unlink()
-    assert codegen.check() == [f"generated/{codegen.C_HEADER} is missing"]
+    assert codegen.check() == [f"{name} is missing"]
+    path.write_text(original)
+    umbrella = out / "c" / codegen.C_UMBRELLA
+    umbrella.write_text(umbrella.read_text().replace('#include "msslib_square.h"\n', ""))
+    assert codegen.check() == [f"generated/c/{codegen.C_UMBRELLA} does not include exactly the generated modules"]
+    umbrella.unlink()
+    assert codegen.check() == [f"generated/c/{codegen.C_UMBRELLA} is missing"]
 
 
 def test_codegen_check_finds_a_stale_c_header(monkeypatch):
-    monkeypatch.setattr(codegen, "c_source_hash", lambda: "0" * 64)
-    assert codegen.check() == [f"msslib/generated/{codegen.C_HEADER} is stale: a derivation module or the engine "
-                               f"changed"]
+    real = codegen.source_hash
+    monkeypatch.setattr(codegen, "source_hash", lambda m: "0" * 64 if m == "cube_golec" else real(m))
+    assert codegen.check() == [
+        f"msslib/generated/{f} is stale: derivations/elements/cube_golec.py or the engine changed"
+        for f in ("cube_golec.py", f"c/{codegen.c_header('cube_golec')}")]
 
 
-def test_export_copies_the_c_header(tmp_path, capsys):
+def test_export_copies_the_c_headers(tmp_path, capsys):
     scene = _scene_file(tmp_path, BAUDET)
     code, err = _cli(capsys, "export", scene, "--out", tmp_path / "b", "--format", "c")
     assert code == 0, err
-    assert (tmp_path / "msslib_mss.h").read_bytes() == export.C_HEADER_PATH.read_bytes()
+    headers = sorted(export.C_HEADER_PATH.parent.glob("*.h"))
+    assert len(headers) == len(registry.generated()) + 1
+    assert sorted(p.name for p in tmp_path.glob("*.h")) == [h.name for h in headers]
+    for h in headers:
+        assert (tmp_path / h.name).read_bytes() == h.read_bytes()
 
 
 # ---- the command: inputs, outputs, errors ------------------------------------------------------

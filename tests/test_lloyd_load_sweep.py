@@ -1,27 +1,13 @@
 """The Lloyd load sweep and ratio studies: load scaling, deformation measures, load distributions,
 the constant-strain split of the square mesh, and the error law of an MSS that matches FEM exactly."""
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from experiments.lloyd.studies import load_sweep as sweep
+from experiments.lloyd.studies import ratio_causes as causes
 from msslib import fem
 from msslib import mesh as M
-
-STUDIES = Path(__file__).resolve().parents[1] / "experiments" / "lloyd" / "studies"
-
-
-def _module(name):
-    spec = importlib.util.spec_from_file_location(f"lloyd_{name}", STUDIES / f"{name}.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-sweep = _module("load_sweep")
-causes = _module("ratio_causes")
 
 
 def test_scaled_multiplies_only_load_magnitudes():

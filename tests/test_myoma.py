@@ -2,17 +2,15 @@
 generator writes, and it has the shape the experiment describes (volume, loaded cap, fixed base)."""
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from experiments.lloyd.meshes import make_myoma as G
 from msslib import mesh as M
 
 HERE = Path(__file__).resolve().parents[1] / "experiments" / "lloyd" / "meshes"
-sys.path.insert(0, str(HERE))
-import make_myoma as G  # noqa: E402
 
 pytest.importorskip("gmsh")
 

@@ -28,12 +28,12 @@ def triangle_html(triangle_markdown):
 
 
 def test_cells_split_markdown_and_code():
-    cells = notebook.cells((ROOT / "derivations" / "triangle.py").read_text())
+    cells = notebook.cells((ROOT / "derivations" / "elements" / "triangle.py").read_text())
     kinds = [c[0] for c in cells]
     assert kinds[0] == "markdown" and cells[0][1].startswith("# Triangle")  # header left out, "# " stripped
     assert "code" in kinds and kinds.count("markdown") >= 3
     assert not any("jupytext" in text for _, text, _ in cells)
-    source = (ROOT / "derivations" / "triangle.py").read_text().splitlines()
+    source = (ROOT / "derivations" / "elements" / "triangle.py").read_text().splitlines()
     kind, text, start = next(c for c in cells if c[0] == "code")
     assert source[start - 1] == text.splitlines()[0]  # line numbers for tracebacks
 
@@ -70,7 +70,7 @@ def test_show_block_of_a_big_matrix():
 
 
 def test_triangle_notebook_shows_the_matrices(triangle_markdown):
-    from derivations import triangle
+    from derivations.elements import triangle
     md = triangle_markdown
     assert md.startswith("# Triangle")
     assert f"$$K_{{\\text{{FEM}}}} = {sp.latex(triangle.K_fem())}$$" in md
@@ -102,6 +102,8 @@ def test_notebook_commands_write_markdown_and_html(tmp_path, monkeypatch):
     assert notebook.main(["triangle", "--out", str(md)]) == 0
     assert md.read_text() == "# T\n\n$$x = \\frac{1}{2}$$\n"
     assert notebook.main(["no_such_module", "--out", str(md)]) == 2
+    for name in ("elements/triangle", "derivations/elements/triangle.py", "derivations.elements.triangle"):
+        assert notebook.main([name, "--out", str(md)]) == 0  # the module wherever it lives
     out = tmp_path / "derivations" / "t.html"
     assert paper.main(["notebook", "triangle", "--out", str(out)]) == 0
     assert "<math" in out.read_text()
@@ -112,7 +114,7 @@ def test_derivations_import_nothing_downstream():
     """The workflow's one direction: the derivations import neither msslib nor the experiments."""
     import ast
 
-    for path in sorted((ROOT / "derivations").glob("*.py")):
+    for path in sorted((ROOT / "derivations").rglob("*.py")):
         for node in ast.walk(ast.parse(path.read_text())):
             names = ([a.name for a in node.names] if isinstance(node, ast.Import)
                      else [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
@@ -120,10 +122,10 @@ def test_derivations_import_nothing_downstream():
 
 
 def test_triangle_imports_silently_and_runs_as_script():
-    r = subprocess.run([sys.executable, "-c", "import derivations.triangle"], capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-c", "import derivations.elements.triangle"], capture_output=True, text=True,
                        timeout=120, cwd=ROOT)
     assert r.returncode == 0 and r.stdout == "", r.stderr
-    r = subprocess.run([sys.executable, "-m", "derivations.triangle"], capture_output=True, text=True,
+    r = subprocess.run([sys.executable, "-m", "derivations.elements.triangle"], capture_output=True, text=True,
                        timeout=120, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     assert "K_FEM =" in r.stdout and "check: K_FEM - K_MSS = 0 at the solution: holds" in r.stdout

@@ -1,4 +1,4 @@
-"""The rectangle derivation (derivations/rectangle.py): exact-match conditions, least squares, lattice."""
+"""The rectangle derivation (derivations/elements/rectangle.py): exact-match conditions, least squares, lattice."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import sympy as sp
 import pytest
 
 from derivations import match
-from derivations import rectangle as R
+from derivations.elements import rectangle as R
 from derivations.elasticity import E, elasticity_matrix, t
 
 LLOYD = dict(zip(R.K_SYM + R.C_SYM, (5 * E * t / 16, 5 * E * t / 16, 7 * E * t / 16,

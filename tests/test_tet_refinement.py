@@ -1,21 +1,14 @@
 """The tetrahedral refinement study: per-element FEM and spring stiffness, fit residuals, element
 quality, strains, the load continuation, and the mirror symmetry of a spring tetrahedron."""
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from experiments.lloyd.studies import tet_refinement as T
 from msslib import fem
 from msslib import mesh as M
 from msslib.model import Model, lloyd_tet_springs
 from msslib.quality import relative_jacobians
-
-STUDY = Path(__file__).resolve().parents[1] / "experiments" / "lloyd" / "studies" / "tet_refinement.py"
-_spec = importlib.util.spec_from_file_location("lloyd_tet_refinement", STUDY)
-T = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(T)
 
 E, NU = 14630.0, 0.25
 L = 0.003
@@ -75,7 +68,7 @@ def test_lloyd_builder_sums_per_element_constants_over_shared_edges():
 def test_regular_tetrahedron_fit_is_eq12_with_the_derived_residual():
     import sympy as sp
 
-    from derivations import tetrahedron
+    from derivations.elements import tetrahedron
     from derivations.elasticity import nu
 
     _, V = T.gradients(REGULAR[None])

@@ -262,6 +262,26 @@ def open_result(path):
         return ds.load()
 
 
+# the panels of the E, nu and B figures ({title: selection}): the cube under the boundary reading with the
+# derived and the printed factor, and under the element reading with the derived factor
+CUBE_PANELS = {"boundary reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "boundary"},
+               "boundary reading, printed factor": {"geometry": "cube", "factor": "printed", "reading": "boundary"},
+               "element reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "element"}}
+
+
+def comparison(doc, labels, inputs, **kw):
+    """A figure of MSS wireframes over the FEM reference and per-node error maps, side view (xz) in mm:
+    one column per label, with the MSS result of the same position in ``inputs`` against the reference,
+    the last of ``inputs``; ``kw`` goes to :func:`msslib.plotting.comparison_figure`."""
+    from msslib import plotting
+
+    args = figure_args(doc)
+    ref = open_result(inputs[-1])
+    pairs = {k: (open_result(p), ref) for k, p in zip(labels, inputs[:-1], strict=True)}
+    fig = plotting.comparison_figure(pairs, plane="xz", length_unit="mm", node_errors=True, **kw)
+    plotting.save(fig, args.out)
+
+
 NU_COLORS = {"0.1": "tab:blue", "0.2": "tab:orange", "0.3": "tab:green", "0.4": "tab:red", "0.499": "tab:purple"}
 
 

@@ -4,7 +4,7 @@
   with another model, resolution, density or solver (the experiment file stays the one source of
   the geometry, material and load);
 * :func:`lattice_moduli` -- the cubic elastic constants of the assembled Baudet lattice (no
-  correction inside a body), its energy under homogeneous strain as ``derivations.cube_baudet``
+  correction inside a body), its energy under homogeneous strain as ``derivations.elements.cube_baudet``
   derives it;
 * :func:`solve_cubic` -- linear elasticity with cubic-symmetric constants (C11, C12, C44), trilinear
   (Q1) or triquadratic (Q2) hexahedra on a ``nx x ny x nz`` box, clamped at x = 0, under a body
@@ -93,7 +93,7 @@ def lattice_tensor(E, nu, a=1.0):
     of its springs under a homogeneous strain, ``C_ijkl = sum_s k_s r_i r_j r_k r_l / (|r|^2 V)`` over
     one cube's 12 edges and 4 inner diagonals (rest vectors ``r``, per-element constants of
     :func:`msslib.parameters.baudet_cube`, i.e. the derived k_x and k_d), per cube volume ``V = a^3``.
-    The same quantity as ``derivations.cube_baudet.assembled_lattice`` (symbolic; checked equal in
+    The same quantity as ``derivations.elements.cube_baudet.assembled_lattice`` (symbolic; checked equal in
     tests/test_baudet_cantilever.py), numerically and in milliseconds."""
     from msslib.parameters import baudet_cube
 

@@ -1,12 +1,16 @@
-# Generated from derivations/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: abc85281fd1c91c1236f7beaf81846e175b65840ee4b41f02fe4c658642c8c5a
-# body-sha256: a35ff5265d287f0040075799752d846c04cfcc02c51cc80aa3045cf95055a64d
+# Generated from derivations/elements/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: 59a40e91d9ca8a711c2de83bfe66d3b106ef598d9f286589f5c5eeeef076fd87
+# body-sha256: ead1efdd2788a93d1bcf1adc1fdb9209f754b2834f6888e42bd556b419504f40
 """Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.).
 
-Generated from derivations/cube_baudet.py by `python -m derivations.codegen`; do not edit.
+Generated from derivations/elements/cube_baudet.py by `python -m derivations.codegen`; do not edit.
 """
 
 from numpy import sqrt  # noqa: F401
+
+
+# the simulator models whose parameters come from this module (its ELEMENT declaration)
+MODELS = ('baudet_cube',)
 
 
 OUTPUTS = {'baudet_cube': ('k_edge', 'k_diagonal', 'correction_factor'), 'baudet_cube_published': ('k_edge', 'k_diagonal', 'correction_factor')}

@@ -1,12 +1,16 @@
-# Generated from derivations/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 48e6382c03ac0e98548b6daa821b9fc84ed8bb63fc581530b74273be85d73357
-# body-sha256: 27a48c1508e2c336a6de6ee220c683003e0ac46e9e9f1ac653a3e8238d975b82
+# Generated from derivations/elements/cube_golec.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: 592b8f8add175381c28a61ac8bf37715a4ced0b94611ed0dc1d12d5a90ac5260
+# body-sha256: ead38ff0979f342e371691d41eaa2c1fcc80bd8a3ec45ce6848072726eb1950e
 """Cube with edge, face and inner springs and volume correction (Golec et al.).
 
-Generated from derivations/cube_golec.py by `python -m derivations.codegen`; do not edit.
+Generated from derivations/elements/cube_golec.py by `python -m derivations.codegen`; do not edit.
 """
 
 from numpy import sqrt  # noqa: F401
+
+
+# the simulator models whose parameters come from this module (its ELEMENT declaration)
+MODELS = ('golec_cube',)
 
 
 OUTPUTS = {'golec_cube': ('k_edge', 'k_face', 'k_inner', 'kappa'), 'golec_cube_published': ('k_edge', 'k_face', 'k_inner', 'kappa')}

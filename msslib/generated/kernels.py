@@ -1,9 +1,9 @@
-# Generated from derivations/kernels.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 2b68a7fe76422dbe2aa7c04555faca72cefd5a4226efa778cf75748123f22f3b
-# body-sha256: 697db20548f54e3fa8340025635f2b0c82ddf3f46b91b62364777ff0a18ee566
+# Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: 1182560a2f7a13168c90c1c208673628652d84b0c593a1fc54d9a45687e47ccc
+# body-sha256: 3d373773da99006a61be809dfa382060e5f3e52fab7de0235f0cb4b483a8f761
 """Energy, gradient and Hessian kernels.
 
-Generated from derivations/kernels.py by `python -m derivations.codegen`; do not edit.
+Generated from derivations/terms/kernels.py by `python -m derivations.codegen`; do not edit.
 """
 
 from numpy import sqrt  # noqa: F401

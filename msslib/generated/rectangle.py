@@ -1,12 +1,16 @@
-# Generated from derivations/rectangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: fd7421382c91cdefac01a432604392f1ab0c7b8e510b546a95b3208d5f63f72f
-# body-sha256: a12cb5a0f8c951f64d4017cf31409c8628780887755be05ccb4859e5988cfd00
+# Generated from derivations/elements/rectangle.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: 1127b880abc9c50b0e712883e7d4cab098dc97253eb8716e6435eb1cebb4db36
+# body-sha256: db29faa74ff7404feba006e6ace82b27c52bd21abe4f6887e99cdde9589f8694
 """Rectangle of aspect ratio r, plane stress, six prestrained springs (generalising Lloyd et al. Sec. 4.1).
 
-Generated from derivations/rectangle.py by `python -m derivations.codegen`; do not edit.
+Generated from derivations/elements/rectangle.py by `python -m derivations.codegen`; do not edit.
 """
 
 from numpy import sqrt  # noqa: F401
+
+
+# the simulator models whose parameters come from this module (its ELEMENT declaration)
+MODELS = ('lloyd_rectangle',)
 
 
 OUTPUTS = {'rectangle_least_squares': ('k_h', 'k_v', 'k_d', 'c_h', 'c_v', 'c_d'), 'rectangle_least_squares_equilibrium': ('k_h', 'k_v', 'k_d', 'c_h', 'c_v', 'c_d'), 'rectangle_least_squares_nu': ('k_h', 'k_v', 'k_d', 'c_h', 'c_v', 'c_d')}

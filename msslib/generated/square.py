@@ -1,12 +1,16 @@
-# Generated from derivations/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: c0069f9f6eb5a78a05fa70496f1202aaaf0f27c52251913c1f32c13bc7b6e248
-# body-sha256: 7ecb914d1852416401807e86d947e0367f8126e72b51da001538baf27e8712cf
+# Generated from derivations/elements/square.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: ac06af23d91b87d622122cd8e616a69b2b29ff6d459be4058aff212b70958e23
+# body-sha256: 1dd982c2337e75087dee499cd350e6dc2d1ddc93b1216533dccefec5767742ed
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 
-Generated from derivations/square.py by `python -m derivations.codegen`; do not edit.
+Generated from derivations/elements/square.py by `python -m derivations.codegen`; do not edit.
 """
 
 from numpy import sqrt  # noqa: F401
+
+
+# the simulator models whose parameters come from this module (its ELEMENT declaration)
+MODELS = ('lloyd_square',)
 
 
 OUTPUTS = {'lloyd_square': ('k_edge', 'k_diagonal', 'rest_factor_edge', 'rest_factor_diagonal')}

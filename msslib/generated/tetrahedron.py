@@ -1,12 +1,16 @@
-# Generated from derivations/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 11640693c13ed3ffe5c4ee54f681aece245e04121c2ff8e0f9b437708fdf1364
-# body-sha256: 5716b40384f04f492eacbd021bad8b372a273de563323bb760142807fd1ce70c
+# Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: bd4656877f02f102e15d177d8680b220787ecaa0361e012b9f4bbc782d853741
+# body-sha256: 0b2dbb0b56041ab2d1c0d5c290b0fcfc5ecc68a47555a831b2b6251b8cfd020f
 """Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14).
 
-Generated from derivations/tetrahedron.py by `python -m derivations.codegen`; do not edit.
+Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`; do not edit.
 """
 
 from numpy import sqrt  # noqa: F401
+
+
+# the simulator models whose parameters come from this module (its ELEMENT declaration)
+MODELS = ('lloyd_tetrahedron', 'lloyd_tetrahedron_volume')
 
 
 OUTPUTS = {'lloyd_tetrahedron': ('k',), 'lloyd_tetrahedron_general_nu': ('k',), 'lloyd_tetrahedron_volume': ('k', 'k_volume'), 'equivalent_edge_length': ('l',), 'lloyd_tetrahedron_volume_published': ('k', 'k_volume')}

@@ -1,12 +1,16 @@
-# Generated from derivations/triangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 3f66ca96955156fe7cbad8f6629de3b00e6197115b582e69663d5e890b262d9b
-# body-sha256: c6ba7510b590fab05b555a4882f6db07bb64bbe5ac2fa7a67658d8e149997bb2
+# Generated from derivations/elements/triangle.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: 5b409d72455b61c613b24876e03c61a9a03d6b0b5a08bca2e30917b340aaa5a1
+# body-sha256: 4015acd45b86546c6a6abfcd250b2d8757c57c8cce0e75c00be6d90ffeb475b9
 """Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9).
 
-Generated from derivations/triangle.py by `python -m derivations.codegen`; do not edit.
+Generated from derivations/elements/triangle.py by `python -m derivations.codegen`; do not edit.
 """
 
 from numpy import sqrt  # noqa: F401
+
+
+# the simulator models whose parameters come from this module (its ELEMENT declaration)
+MODELS = ('lloyd_triangle', 'van_gelder')
 
 
 OUTPUTS = {'lloyd_triangle': ('k',), 'van_gelder_triangle': ('k',)}

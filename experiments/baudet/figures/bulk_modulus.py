@@ -1,12 +1,8 @@
 """Baudet Fig. 8: error of the bulk modulus against the volume change (deflation < 0 < inflation), under
 the boundary and the element reading of the correction force."""
 
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-from msslib import plotting  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib import plotting
 
 INPUTS = ["results/baudet/studies/bulk.nc"]
 
@@ -14,9 +10,7 @@ INPUTS = ["results/baudet/studies/bulk.nc"]
 def main():
     args = C.figure_args(__doc__)
     ds = C.open_result(INPUTS[0])
-    panels = {"boundary reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "boundary"},
-              "boundary reading, printed factor": {"geometry": "cube", "factor": "printed", "reading": "boundary"},
-              "element reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "element"}}
+    panels = C.CUBE_PANELS
     fig = C.curves(ds["B_error_by_reading"], ds["volume_change"].values, xlabel="volume change dV/V0 (%)", ylabel="B error (%)",
                    panels=panels, dashed={"block of 4x4x4 cubes": {"geometry": "block"}})
     plotting.save(fig, args.out)

@@ -1,24 +1,12 @@
-"""Baudet Fig. 10: cantilever under gravity, MSS wireframes over the FEM reference and per-node error maps."""
+"""Baudet Fig. 10: cantilever under gravity, MSS wireframes over the FEM reference and per-node error maps.
 
-import sys
-from pathlib import Path
+    python -m experiments.baudet.figures.cantilever --out paper/figures/baudet_cantilever
+"""
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-from msslib import plotting  # noqa: E402
+from experiments.baudet import baudet_common as C
 
 RES = ("4x1x1", "8x2x2", "16x4x4")
 INPUTS = [f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES] + ["results/baudet/cantilever/gravity__fem.nc"]
 
-
-def main():
-    args = C.figure_args(__doc__)
-    ref = C.open_result(INPUTS[-1])
-    pairs = {f"{r} cubes": C.open_result(p) for r, p in zip(RES, INPUTS[:-1])}
-    fig = plotting.comparison_figure({k: (ds, ref) for k, ds in pairs.items()}, plane="xz", length_unit="mm",
-                                     magnify=100.0, node_errors=True, panel_width=3.6, panel_height=1.6)
-    plotting.save(fig, args.out)
-
-
 if __name__ == "__main__":
-    main()
+    C.comparison(__doc__, [f"{r} cubes" for r in RES], INPUTS, magnify=100.0, panel_width=3.6, panel_height=1.6)

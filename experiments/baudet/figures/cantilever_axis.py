@@ -1,11 +1,7 @@
 """Baudet Figs. 9-10: deflection of the cantilever's neutral axis, MSS (and 32x8x8 beyond the paper) and FEM against eq. 10."""
 
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-from msslib import plotting  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib import plotting
 
 RES = ("4x1x1", "8x2x2", "16x4x4", "32x8x8")
 INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]

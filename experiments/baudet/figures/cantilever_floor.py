@@ -1,15 +1,10 @@
 """Baudet Figs. 9-10: the cantilever's errors against the resolution, down to the uncorrected lattice's floor."""
 
-import sys
-from pathlib import Path
-
 import numpy as np
 from matplotlib.ticker import NullLocator
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-
-from msslib import plotting  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib import plotting
 
 INPUTS = ["results/baudet/studies/cantilever_floor.nc", "results/baudet/cantilever/comparison.nc"]
 

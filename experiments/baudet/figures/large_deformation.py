@@ -1,15 +1,10 @@
 """Baudet Fig. 11 re-made: the cantilever under growing weight, MSS and linear FEM against neo-Hookean FEM."""
 
-import sys
-from pathlib import Path
-
 import numpy as np
 from matplotlib.patches import Polygon, Rectangle
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-
-from msslib import plotting  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib import plotting
 
 INPUTS = ["results/baudet/studies/large_deformation.nc"]
 COLORS = {"mss_4x1x1": "tab:red", "mss_8x2x2": "tab:orange", "mss_16x4x4": "tab:blue", "mss_32x8x8": "tab:purple",

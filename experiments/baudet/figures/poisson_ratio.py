@@ -1,14 +1,10 @@
 """Baudet Fig. 5: signed error of Poisson's ratio against the axial strain, with the +-5 % band, under
 the boundary and the element reading of the correction force."""
 
-import sys
-from pathlib import Path
+import matplotlib.ticker
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-import matplotlib.ticker  # noqa: E402
-
-from msslib import plotting  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib import plotting
 
 INPUTS = ["results/baudet/studies/tension.nc"]
 BAND = 5.0  # %, the tolerance drawn
@@ -17,9 +13,7 @@ BAND = 5.0  # %, the tolerance drawn
 def main():
     args = C.figure_args(__doc__)
     ds = C.open_result(INPUTS[0])
-    panels = {"boundary reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "boundary"},
-              "boundary reading, printed factor": {"geometry": "cube", "factor": "printed", "reading": "boundary"},
-              "element reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "element"}}
+    panels = C.CUBE_PANELS
     fig = C.curves(ds["nu_error_by_reading"], ds["strain"].values, xlabel="axial strain (%)",
                    ylabel="nu error, (nu_MSS - nu)/nu (%)", panels=panels,
                    dashed={"beam of 4x4x12 cubes": {"geometry": "beam"}})

@@ -1,12 +1,8 @@
 """Baudet Fig. 6: error of the shear modulus of a cube against the shear angle, without correction and
 with it under the boundary reading (derived, printed factor) and the element reading (derived)."""
 
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-from msslib import plotting  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib import plotting
 
 INPUTS = ["results/baudet/studies/shear.nc"]
 

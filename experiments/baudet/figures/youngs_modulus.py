@@ -1,12 +1,8 @@
 """Baudet Fig. 4: error of Young's modulus against the axial strain, derived vs printed factor, and the
 correction read at element level (every cube corrected from the forces on it from outside)."""
 
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-from msslib import plotting  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib import plotting
 
 INPUTS = ["results/baudet/studies/tension.nc"]
 PUBLISHED = [(10.0, 2.7, "0.3"), (10.0, 2.0, "0.4"), (10.0, 1.5, "0.499")]  # Sec. 5 text, nu = 0.5 as 0.499
@@ -15,9 +11,7 @@ PUBLISHED = [(10.0, 2.7, "0.3"), (10.0, 2.0, "0.4"), (10.0, 1.5, "0.499")]  # Se
 def main():
     args = C.figure_args(__doc__)
     ds = C.open_result(INPUTS[0])
-    panels = {"boundary reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "boundary"},
-              "boundary reading, printed factor": {"geometry": "cube", "factor": "printed", "reading": "boundary"},
-              "element reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "element"}}
+    panels = C.CUBE_PANELS
     fig = C.curves(ds["E_error_by_reading"], ds["strain"].values, xlabel="axial strain (%)", ylabel="E error (%)",
                    panels=panels, dashed={"beam of 4x4x12 cubes": {"geometry": "beam"}},
                    marks={k: PUBLISHED for k in panels if "derived" in k})

@@ -11,16 +11,13 @@ is corrected from the forces acting on it from outside (msslib.baudet_correction
 ``V_by_reading`` has the ``reading`` dimension, ``V`` is its ``boundary`` slice.
 """
 
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-from msslib.metrics import mesh_volume  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib.metrics import mesh_volume
 
 GEOMETRIES = {"cube": (1, 1, 1), "block": (2, 2, 2)}
 LEVELS = {"dv-10": -0.10, "dv-05": -0.05, "dv-01": -0.01, "dv+01": 0.01, "dv+05": 0.05, "dv+10": 0.10}

@@ -6,7 +6,6 @@ stay consistent). Also the Timoshenko shear term rho_l g (L x - x^2/2) / (kappa 
 which eq. 10 (nu = 0, slender beam) leaves out.
 """
 
-import sys
 import time
 from pathlib import Path
 
@@ -14,8 +13,7 @@ import numpy as np
 import xarray as xr
 import yaml
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
+from experiments.baudet import baudet_common as C
 
 EXP = Path(__file__).resolve().parents[1] / "cantilever.yaml"
 

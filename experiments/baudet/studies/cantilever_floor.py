@@ -13,16 +13,13 @@ Errors as in the comparison (per node, relative to the largest reference displac
 tip deflection (mean -u_z of the end section).
 """
 
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-import cantilever_common as K  # noqa: E402
+from experiments.baudet import baudet_common as C
+from experiments.baudet import cantilever_common as K
 
 RES = ((4, 1, 1), (8, 2, 2), (16, 4, 4), (24, 6, 6), (32, 8, 8))
 REF = (48, 12, 12)  # the experiment's reference mesh (Q1)

@@ -12,16 +12,13 @@ displacement, and to each node's own) of every model against the non-linear and 
 FEM, and the tip deflection (mean -u_z of the end section).
 """
 
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-import cantilever_common as K  # noqa: E402
+from experiments.baudet import baudet_common as C
+from experiments.baudet import cantilever_common as K
 
 FEM_N = (24, 6, 6)
 MSS = ((4, 1, 1), (8, 2, 2), (16, 4, 4))

@@ -17,16 +17,13 @@ components grow as theta^2); ``none`` is the same run under both. Every variable
 has the ``reading`` dimension, ``V`` is its ``boundary`` slice.
 """
 
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-from msslib import mesh as M  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib import mesh as M
 
 FACTORS = ("derived", "printed", "none")
 LEVELS = {"deg02": 2.0, "deg05": 5.0, "deg10": 10.0, "deg15": 15.0}

@@ -12,16 +12,13 @@ signed, relative to the input values. Every variable ``V_by_reading`` has the ``
 ``V`` (without it) is its ``boundary`` slice.
 """
 
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-from msslib.metrics import mean_displacement_gradient  # noqa: E402
+from experiments.baudet import baudet_common as C
+from msslib.metrics import mean_displacement_gradient
 
 GEOMETRIES = {"cube": (1, 1, 1), "beam": (2, 2, 6)}
 LEVELS = {"eps05": 0.05, "eps10": 0.10, "eps14": 0.14, "eps15": 0.15, "eps20": 0.20}
@@ -84,7 +81,7 @@ def main():
     ds["nu_error"] = (dims, NU / nu_in - 1.0, {"units": "1", "long_name": "relative error of nu (signed)"})
     ds["nu_abs_error"] = (dims, NU - nu_in, {"units": "1", "long_name": "error of nu (measured - input)"})
     d3 = ("reading", "geometry", "factor", "nu")
-    ds["E_small_strain"] = (d3, E_lin, {"units": "Pa", "long_name": f"E at the first load level"})
+    ds["E_small_strain"] = (d3, E_lin, {"units": "Pa", "long_name": "E at the first load level"})
     ds["nu_small_strain"] = (d3, NU_lin, {"units": "1", "long_name": "nu at the first load level"})
     # values at the strains the paper quotes, on a string coordinate (for the paper's placeholders)
     lv = list(LEVELS)

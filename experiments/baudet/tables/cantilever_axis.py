@@ -1,13 +1,7 @@
 """Tip deflection of the cantilever's neutral axis: MSS resolutions and FEM against eq. 10."""
 
-import argparse
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-
-from msslib.io import write_text  # noqa: E402
+from experiments import script
+from experiments.baudet import baudet_common as C
 
 RES = ("4x1x1", "8x2x2", "16x4x4", "32x8x8")
 INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]
@@ -15,9 +9,7 @@ INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--out", required=True)
-    args = p.parse_args()
+    args = script.args(__doc__)
     eq = C.open_result(INPUTS[-1])
     tip, tip_s = float(eq["tip_eq10"]), float(eq["tip_timoshenko"])
     lines = ["**Cantilever: tip deflection of the neutral axis** (mean vertical displacement of the free end section)", "",
@@ -28,8 +20,7 @@ def main():
     for name, path in [("FEM linear 48x12x12", INPUTS[n])] + [(f"MSS {r}", q) for r, q in zip(RES, INPUTS[:n])]:
         _, w = C.section_deflection(C.open_result(path))
         lines.append(f"| {name} | {w[-1] * 1e3:.4g} | {100 * (w[-1] / tip - 1):+.3g} | {100 * (w[-1] / tip_s - 1):+.3g} |")
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

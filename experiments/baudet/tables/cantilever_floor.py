@@ -1,16 +1,10 @@
 """Cantilever: MSS, same-mesh linear FEM and the uncorrected lattice's floor at every resolution; the
 reference's own discretisation error."""
 
-import argparse
-import sys
-from pathlib import Path
-
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-
-from msslib.io import write_text  # noqa: E402
+from experiments import script
+from experiments.baudet import baudet_common as C
 
 INPUTS = ["results/baudet/studies/cantilever_floor.nc", "results/baudet/cantilever/comparison.nc"]
 
@@ -20,9 +14,7 @@ def pc(v, fmt=".3g"):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--out", required=True)
-    args = p.parse_args()
+    args = script.args(__doc__)
     ds = C.open_result(INPUTS[0])
     cmp = C.open_result(INPUTS[1])
     lines = [f"**Cantilever: errors against the resolution and the floor of the uncorrected lattice** (per-node error / "
@@ -60,8 +52,7 @@ def main():
         name = str(c).replace("_", " ") + (" (the reference)" if str(c) == f"Q1_{ds.attrs['reference'].split()[-1]}" else "")
         lines.append(f"| {name} | {pc(e['reference_error'].sel(stat='mean'))} | {pc(e['reference_error'].sel(stat='max'))} | "
                      f"{pc(e['reference_tip_error'], '+.3g')} |")
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

@@ -1,15 +1,9 @@
 """Cantilever: what Baudet's M / SD / MAX may measure, each reading against the published numbers."""
 
-import argparse
-import sys
-from pathlib import Path
-
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-
-from msslib.io import write_text  # noqa: E402
+from experiments import script
+from experiments.baudet import baudet_common as C
 
 INPUTS = ["results/baudet/studies/cantilever_floor.nc", "results/baudet/studies/large_deformation.nc",
           "results/baudet/cantilever/comparison.nc"]
@@ -25,9 +19,7 @@ def ratio(v):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--out", required=True)
-    args = p.parse_args()
+    args = script.args(__doc__)
     fl, ld, cmp = (C.open_result(f) for f in INPUTS)
     levels = [r for r in LEVELS if r in fl.resolution.values]
     nxt = dict(zip(levels[:-1], levels[1:]))
@@ -94,8 +86,7 @@ def main():
             lines.append(row(lab, "M", large(reading, ref, "max_mean"), pubs("mean")))
             lines.append(row("", "SD", large(reading, ref, "max_sd"), pubs("std")))
             lines.append(row("", "MAX", large(reading, ref, "max_max"), pubs("max")))
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

@@ -2,22 +2,14 @@
 composite also under the element reading of the correction (every cube corrected from the forces
 acting on it from outside; for one cube both readings agree)."""
 
-import argparse
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-
-from msslib.io import write_text  # noqa: E402
+from experiments import script
+from experiments.baudet import baudet_common as C
 
 INPUTS = ["results/baudet/studies/tension.nc", "results/baudet/studies/shear.nc", "results/baudet/studies/bulk.nc"]
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--out", required=True)
-    args = p.parse_args()
+    args = script.args(__doc__)
     t, s, b = (C.open_result(q) for q in INPUTS)
     rows = []
 
@@ -70,8 +62,7 @@ def main():
              "derived - published (or: claim holds) |",
              "|---|---|---|---|---|---|---|---|---|"]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

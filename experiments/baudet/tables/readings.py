@@ -2,16 +2,10 @@
 by the loads on the body's loaded faces) and ``element`` (every cube driven by the forces acting on it
 from outside: neighbours, loads, gravity, supports; msslib.baudet_correction). Derived factor."""
 
-import argparse
-import sys
-from pathlib import Path
-
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import baudet_common as C  # noqa: E402
-
-from msslib.io import write_text  # noqa: E402
+from experiments import script
+from experiments.baudet import baudet_common as C
 
 INPUTS = ["results/baudet/studies/tension.nc", "results/baudet/studies/shear.nc", "results/baudet/studies/bulk.nc",
           "results/baudet/shear_beam/comparison.nc", "results/baudet/cantilever/comparison.nc",
@@ -28,9 +22,7 @@ def yes(ok):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__)
-    p.add_argument("--out", required=True)
-    args = p.parse_args()
+    args = script.args(__doc__)
     t, s, b, sb, cl, lb = (C.open_result(q) for q in INPUTS)
     rows = []
 
@@ -111,8 +103,7 @@ def main():
              "", "| claim | published (%) | boundary reading | holds | element reading | holds |",
              "|---|---|---|---|---|---|"]
     lines += ["| " + " | ".join(r) + " |" for r in rows]
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

@@ -1,13 +1,11 @@
 """Baudet's Table 1 (unknown spring constants and equations of the configurations M1-M3), counted by
-the derivation engine (derivations/baudet_table1.py), beside the published counts."""
-
-import argparse
+the derivation engine (derivations/analyses/baudet_table1.py), beside the published counts."""
 
 import sympy as sp
 
-from msslib.io import write_text
+from experiments import script
 
-INPUTS = ["derivations/baudet_table1.py", "derivations/lattice.py", "derivations/mss.py", "derivations/fem.py",
+INPUTS = ["derivations/analyses/baudet_table1.py", "derivations/lattice.py", "derivations/mss.py", "derivations/fem.py",
           "derivations/match.py", "derivations/elasticity.py"]
 
 # Baudet et al. (2007), Sec. 4 "Our 3D Model", Table 1 "Number of equations and unknowns according to the
@@ -29,10 +27,8 @@ def _nu(values):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args()
-    from derivations import baudet_table1 as T
+    args = script.args(__doc__)
+    from derivations.analyses import baudet_table1 as T
 
     t = T.table()
     P = PUBLISHED
@@ -82,7 +78,7 @@ def main():
                  "conditions on the element's response (rank of their Jacobian with respect to its compliance entries). "
                  "A is the linear map from the spring constants to the element's 9 orthotropic elastic constants, b "
                  "the isotropic target. Solutions on the cube (edge a): " + "; ".join(sols) + ".")
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

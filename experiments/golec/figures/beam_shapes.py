@@ -1,17 +1,12 @@
 """Golec Fig. 2 (3-4): cantilever beam under gravity, side view (xz), and the wrinkle of the
 classical MSS without face diagonals near the clamp (difference to its symmetric equilibrium)."""
 
-import argparse
-import sys
-from pathlib import Path
-
 import numpy as np
 
+from experiments import script
+from experiments.golec.wrinkle_states import positions_dataset, study_state
 from msslib import plotting
 from msslib.io import read_result
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from wrinkle_states import positions_dataset, study_state  # noqa: E402,F401
 
 R = "results/golec/beam"
 INPUTS = ["results/golec/beam/default__fem.nc", "results/golec/beam/default__golec.nc",
@@ -21,9 +16,7 @@ AMPLIFY = 20.0
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args()
+    args = script.args(__doc__)
     fem, golec, classical, published = (read_result(p) for p in INPUTS[:4])
     w = read_result(INPUTS[-1])
     wrinkled = study_state(w, "beam", "wrinkled")

@@ -1,16 +1,11 @@
 """Golec Fig. 2 (1-2): the 5 cm cube compressed by 10 % (clamped faces), side view (xz plane)."""
 
-import argparse
-import sys
-from pathlib import Path
-
 import numpy as np
 
+from experiments import script
+from experiments.golec.wrinkle_states import study_state
 from msslib import plotting
 from msslib.io import read_result
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from wrinkle_states import positions_dataset, study_state  # noqa: E402,F401
 
 R = "results/golec/compression"
 INPUTS = ["results/golec/compression/clamped__mss_classical.nc", "results/golec/compression/clamped__golec.nc",
@@ -19,9 +14,7 @@ INPUTS = ["results/golec/compression/clamped__mss_classical.nc", "results/golec/
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args()
+    args = script.args(__doc__)
     w = read_result(INPUTS[-1])
     wr = w.sel(experiment="compression")
     panels = [

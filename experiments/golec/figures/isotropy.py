@@ -1,10 +1,9 @@
 """Effective Poisson's ratio and shear moduli of the Golec lattice against A (isotropy study)."""
 
-import argparse
-
 import matplotlib.ticker
 from matplotlib.lines import Line2D
 
+from experiments import script
 from msslib import plotting
 from msslib.io import read_result
 
@@ -16,9 +15,7 @@ STYLES = {"nu0.3": "-", "nu0.4999": "--"}
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args()
+    args = script.args(__doc__)
     ds = read_result(INPUTS[0])
     fig = plotting.figure(figsize=(13, 4))
     ax1, ax2, ax3 = fig.subplots(1, 3)

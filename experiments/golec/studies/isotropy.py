@@ -30,8 +30,8 @@ from msslib.mesh import hex_grid
 from msslib.metrics import mesh_volume, shear_modulus, youngs_modulus_poisson
 from msslib.model import Model, assemble_springs, golec_cube_springs
 from msslib.parameters import golec_cube
-from msslib.terms import HexVolume, Springs
 from msslib.solvers import static_solve
+from msslib.terms import HexVolume, Springs
 
 L, N, STRAIN = 0.04, 4, 1e-3
 MATERIALS = {"nu0.3": (4.0e5, 0.3), "nu0.4999": (2.0e4, 0.4999)}

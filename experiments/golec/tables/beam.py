@@ -1,10 +1,9 @@
 """Beam under gravity (Golec Fig. 2 (3-4)): deflection, volume, error against FEM, stability."""
 
-import argparse
-
 import numpy as np
 
-from msslib.io import read_result, write_text
+from experiments import script
+from msslib.io import read_result
 
 INPUTS = ["results/golec/studies/wrinkles.nc", "results/golec/beam/comparison.nc"]
 VARIANTS = {
@@ -17,9 +16,7 @@ VARIANTS = {
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args()
+    args = script.args(__doc__)
     w = read_result(INPUTS[0]).sel(experiment="beam")
     cmp_ = read_result(INPUTS[1]).sel(case="default")
     lines = ["**Golec Fig. 2 (3-4): 20 x 4 x 4 cm cantilever under gravity (E = 400 kPa, nu = 0.3).** "
@@ -43,7 +40,7 @@ def main():
         amp_s = "-" if not np.isfinite(amp) else f"{amp * 1e3:.2g}"
         lines.append(f"| {v} | {text} | {100 * float(r.tip_deflection):.3f} | {100 * float(r.volume_change):+.3f} | "
                      f"{em} | {ex} | {lam_s} | {amp_s} |")
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

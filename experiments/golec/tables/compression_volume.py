@@ -1,10 +1,9 @@
 """Volumes after 10 % compression (Golec Fig. 2 (1-2)) beside the printed ones, and stability."""
 
-import argparse
-
 import numpy as np
 
-from msslib.io import mesh_from_result, read_result, write_text
+from experiments import script
+from msslib.io import mesh_from_result, read_result
 from msslib.metrics import mesh_volume
 
 R = "results/golec/compression"
@@ -33,9 +32,7 @@ def volume(path):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args()
+    args = script.args(__doc__)
     w = read_result(INPUTS[-1]).sel(experiment="compression")
     lines = ["**Golec Fig. 2 (1-2): volume of the 5 cm cube (V0 = 125 cm^3) after 10 % compression, bottom and top clamped.** "
              "Symmetric static equilibria; the smallest eigenvalue of the stiffness (clamped case, free dofs) "
@@ -55,7 +52,7 @@ def main():
             lam_w = float(w.min_eigenvalue_wrinkled.sel(variant=v))
             lines.append(f"| {v} (wrinkled) | same, wrinkled equilibrium (amplitude {amp:.2g} mm) | {Vw * 1e6:.3f} | "
                          f"{100 * (Vw / V0 - 1):+.2f} | {lam_w:.3g} | {PUBLISHED[v]} |")
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

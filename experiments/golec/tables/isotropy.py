@@ -1,8 +1,7 @@
 """Effective moduli of the Golec lattice at A = 1 (and their spread over A), derived vs printed."""
 
-import argparse
-
-from msslib.io import read_result, write_text
+from experiments import script
+from msslib.io import read_result
 
 INPUTS = ["results/golec/studies/isotropy.nc"]
 LABELS = {"derived": "derived (per element)", "published": "printed, used per element",
@@ -10,9 +9,7 @@ LABELS = {"derived": "derived (per element)", "published": "printed, used per el
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args()
+    args = script.args(__doc__)
     ds = read_result(INPUTS[0])
     A = ds.A.values
     lines = [f"**Isotropy of the Golec lattice in simulation** ({ds.attrs['sample']}, strain {float(ds.attrs['strain']):g}). "
@@ -33,7 +30,7 @@ def main():
             lines.append(f"| E = {E_t / 1e3:g} kPa, nu = {nu_t:g} | {LABELS[str(c)]} | {cell(r, 'E_ratio', '.3f')} | "
                          f"{cell(r, 'nu_eff', '.4f')} | {cell(r, 'G_ratio', '.3f')} | {cell(r, 'G45_ratio', '.3f')} | "
                          f"{cell(r, 'anisotropy', '.3f')} |")
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

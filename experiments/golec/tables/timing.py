@@ -1,16 +1,13 @@
 """Wall time of a 10 s simulation of 1,000 Golec cubes beside the paper's 2.88 s on 8 cores."""
 
-import argparse
-
-from msslib.io import read_result, write_text
+from experiments import script
+from msslib.io import read_result
 
 INPUTS = ["results/golec/studies/timing.nc"]
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args()
+    args = script.args(__doc__)
     d = read_result(INPUTS[0])
     v = {k: float(d[k]) for k in d.data_vars}
     quick = " (quick build: simulated time shortened, wall time scaled to 10 s)" if int(d.attrs.get("quick", 0)) else ""
@@ -44,7 +41,7 @@ def main():
              f"{v['break_even_dt_wall'] * 1e6:.3g} µs, and {cores} fully used cores ({v['published_core_seconds']:.3g} core-seconds) "
              f"with a step of {v['break_even_dt_core'] * 1e6:.3g} µs; the explicit stability limit of this lattice is "
              f"{v['comparable_dt_critical'] * 1e6:.3g} µs."]
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

@@ -3,15 +3,14 @@
 Circles: the computed MSS equilibria; solid lines: straight lines through the origin fitted to the
 compression and to the stretch points; dashed: linear FEM of the same element.
 
-    python force_displacement.py --out paper/figures/lloyd_force_displacement
+    python -m experiments.lloyd.figures.force_displacement --out paper/figures/lloyd_force_displacement
 """
 
-import argparse
 from pathlib import Path
 
-import numpy as np
 import xarray as xr
 
+from experiments import script
 from msslib import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -20,9 +19,7 @@ TITLES = {"triangle": "a) equilateral triangle", "square": "b) square"}
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="output stem: writes STEM.png and STEM.pdf")
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     ds = xr.load_dataset(ROOT / INPUTS[0])
     fig = plotting.figure(figsize=(8.0, 3.6))
     axes = fig.subplots(1, 2, sharey=True)

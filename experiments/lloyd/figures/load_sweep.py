@@ -4,10 +4,9 @@ One panel per experiment (shared axes): solid lines the maximum, dashed the mean
 per load case, one marker per MSS variant; grey band: the deformation the paper states for the
 experiment; stars: the published maximum error, drawn across the stated range.
 
-    python load_sweep.py --out paper/figures/lloyd_load_sweep
+    python -m experiments.lloyd.figures.load_sweep --out paper/figures/lloyd_load_sweep
 """
 
-import argparse
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +14,7 @@ import xarray as xr
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from experiments import script
 from msslib import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -30,9 +30,7 @@ MARKERS = ["o", "s", "^", "D"]
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="output stem: writes STEM.png and STEM.pdf")
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     ds = xr.load_dataset(ROOT / INPUTS[0])
     done = np.isfinite(ds.error_max.values).any(axis=1)  # the quick build leaves most experiments out
     names = list(dict.fromkeys(str(e) for e, ok in zip(ds.experiment.values, done) if ok))

@@ -1,26 +1,13 @@
 """Lloyd et al. Fig. 9 (Sec. 5.1): equilateral-triangle MSS (eq. 8, red) over linear FEM.
 
-Top row: the MSS wireframe (red) over the reference, coloured by its displacement magnitude, the
-rest shape in grey; bottom row: the distance between MSS and reference at every node.
-
-    python membrane_equilateral.py --out paper/figures/lloyd_membrane_equilateral
+    python -m experiments.lloyd.figures.membrane_equilateral --out paper/figures/lloyd_membrane_equilateral
 """
 
-import sys
-from pathlib import Path
+from experiments.lloyd.comparison_figure import main
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from comparison_figure import inputs, main  # noqa: E402
-
-EXPERIMENT = "membrane_equilateral"
 # (column title, case, variant, reference)
-COLUMNS = [
-    ("a) stretch", "stretch", "mss", "fem"),
-    ("b) compression", "compression", "mss", "fem"),
-    ("c) shear", "shear", "mss", "fem"),
-]
-INPUTS = [f"results/lloyd/{EXPERIMENT}/{case}__{m}.nc" for _, case, var, ref in COLUMNS for m in (var, ref)]
+COLUMNS = [(f"{k}) {case}", case, "mss", "fem") for k, case in zip("abc", ("stretch", "compression", "shear"))]
+INPUTS = [f"results/lloyd/membrane_equilateral/{case}__{m}.nc" for _, case, var, ref in COLUMNS for m in (var, ref)]
 
 if __name__ == "__main__":
-    assert INPUTS == inputs(EXPERIMENT, COLUMNS)
-    main(EXPERIMENT, COLUMNS, __doc__.splitlines()[0], plane="xy", panel_width=3.2)
+    main(__doc__, COLUMNS, INPUTS, plane="xy", panel_width=3.2)

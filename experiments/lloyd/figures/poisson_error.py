@@ -3,14 +3,14 @@
 A regular hexagon 1.7 cm high; one panel per load case; the dotted line marks nu = 1/3, where
 Lloyd's eq. 8 is exact.
 
-    python poisson_error.py --out paper/figures/lloyd_poisson_error
+    python -m experiments.lloyd.figures.poisson_error --out paper/figures/lloyd_poisson_error
 """
 
-import argparse
 from pathlib import Path
 
 import xarray as xr
 
+from experiments import script
 from msslib import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -19,9 +19,7 @@ TITLES = {"stretch": "a) stretch, 10 % of E", "shear": "b) shear, 4 % of E", "sm
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="output stem: writes STEM.png and STEM.pdf")
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     ds = xr.load_dataset(ROOT / INPUTS[0])
     cases = list(ds.case.values)
     fig = plotting.figure(figsize=(3.3 * len(cases), 3.4))

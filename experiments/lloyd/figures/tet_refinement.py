@@ -9,15 +9,15 @@ against the radius ratio; e) error against the load factor in shear, circles mar
 inverted (folded) cells; f) the hole cylinder under 1800 Pa compression and g) the cone under 2000 Pa
 shear along the load.
 
-    python tet_refinement.py --out paper/figures/lloyd_tet_refinement
+    python -m experiments.lloyd.figures.tet_refinement --out paper/figures/lloyd_tet_refinement
 """
 
-import argparse
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from experiments import script
 from msslib import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -26,9 +26,7 @@ LEVEL_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:purple"]
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="output stem: writes STEM.png and STEM.pdf")
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     ds = xr.load_dataset(ROOT / INPUTS[0])
     n = ds.n_nodes.values
     fig = plotting.figure(figsize=(17.5, 7.6))

@@ -10,7 +10,7 @@ edges and a traction can be put on exactly the cap's facets (selected by a box z
 The element size is the one (from 6 mm down to 3 mm in steps of 0.1 mm, the coarsest on a tie) whose
 mesh has the number of tetrahedra closest to the paper's 391.
 
-    python experiments/lloyd/meshes/make_myoma.py
+    python -m experiments.lloyd.meshes.make_myoma
 """
 
 from pathlib import Path

@@ -9,7 +9,7 @@ element (plane stress) is stored beside it.  Straight lines fitted to the MSS po
 displacement = slope * F, give the slopes of compression and of stretch (the paper: a factor of
 about two between them).
 
-    python force_displacement.py --out results/lloyd/studies/force_displacement.nc [--quick]
+    python -m experiments.lloyd.studies.force_displacement --out results/lloyd/studies/force_displacement.nc [--quick]
 """
 
 from __future__ import annotations

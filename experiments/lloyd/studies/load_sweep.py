@@ -13,7 +13,7 @@ over the height.  Every MSS variant is compared with the experiment's reference 
 Euclidean distance: max, mean, both also relative to the largest reference displacement, and the
 ratio mean/max, which does not depend on the load where the error is linear or quadratic in it).
 
-    python load_sweep.py --out results/lloyd/studies/load_sweep.nc [--quick]
+    python -m experiments.lloyd.studies.load_sweep --out results/lloyd/studies/load_sweep.nc [--quick]
 
 ``--quick``: the two small membranes (Secs. 5.1, 5.3), 0.1 % and the stated deformation only; the
 other experiments are written as rows of NaN (same labels as the full build).

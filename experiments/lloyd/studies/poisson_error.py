@@ -8,7 +8,7 @@ where the MSS is nearly linear).  Springs from Lloyd's eq. 8
 to 0.49.  The paper does not state the load of Fig. 3; the minimum of the error should sit near
 nu = 1/3, where eq. 8 is exact.
 
-    python poisson_error.py --out results/lloyd/studies/poisson_error.nc [--quick]
+    python -m experiments.lloyd.studies.poisson_error --out results/lloyd/studies/poisson_error.nc [--quick]
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ compression too); Sec. 5.3 stretch and compression, the mean strain of the top e
 the mean top displacement over the height (13 %, the end of the paper's general "ten to thirteen
 percent").
 
-    python ratio_causes.py --out results/lloyd/studies/ratio_causes.nc [--quick]
+    python -m experiments.lloyd.studies.ratio_causes --out results/lloyd/studies/ratio_causes.nc [--quick]
 """
 
 from __future__ import annotations

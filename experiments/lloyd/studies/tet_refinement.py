@@ -18,7 +18,7 @@ Four parts, one NetCDF:
    smallest relative Jacobian, inverted cells (msslib.quality) and the smallest eigenvalue of the
    free tangent stiffness (divided by the mean of its diagonal) at every converged load factor.
 
-    python tet_refinement.py --out results/lloyd/studies/tet_refinement.nc [--quick]
+    python -m experiments.lloyd.studies.tet_refinement --out results/lloyd/studies/tet_refinement.nc [--quick]
 """
 
 from __future__ import annotations

@@ -1,21 +1,18 @@
 """Lloyd et al. Sec. 5: published errors beside ours at a small load and at the stated deformation."""
 
-import argparse
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-from msslib.io import write_text
+from experiments import script
 
 ROOT = Path(__file__).resolve().parents[3]
 INPUTS = ["results/lloyd/studies/load_sweep.nc"]
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     ds = xr.load_dataset(ROOT / INPUTS[0])
     small = 100 * float(ds.attrs["small_deformation"])
 
@@ -43,8 +40,7 @@ def main(argv=None):
              f"ours max at {small:g} % (mm) | ours mean/max at {small:g} % | load at the end (Pa) | ours max at the end (mm) | "
              "ours mean/max at the end | ours / published max |"),
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for i in range(ds.sizes["run"]):
-        r = ds.isel(run=i)
+    for r in script.rows(ds, "run"):
         lo, hi = float(r.stated_low), float(r.stated_high)
         if float(r.end_at_file_load):  # the sweep ends at the file's load (a solver limit), not at a stated value
             stated = f"> {100 * lo:.3g}; sweep to {100 * hi:.3g}" if lo < hi else f"{100 * lo:.3g}; MSS fails beyond {100 * hi:.3g}"
@@ -55,8 +51,7 @@ def main(argv=None):
             f"{mm(float(r.published_max))} | {r2(float(r.published_ratio))} | {sig2(float(r.error_max_small) * 1e3)} | "
             f"{r2(float(r.ratio_small))} | {pa(float(r.load_stated))} | {mm(float(r.error_max_stated))} | "
             f"{r2(float(r.ratio_stated))} | {r2(float(r.max_over_published))} |")
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

@@ -1,11 +1,10 @@
 """Lloyd et al. Secs. 5.1 and 5.3: the ratio mean/max error under one changed factor at a time."""
 
-import argparse
 from pathlib import Path
 
 import xarray as xr
 
-from msslib.io import write_text
+from experiments import script
 
 ROOT = Path(__file__).resolve().parents[3]
 INPUTS = ["results/lloyd/studies/ratio_causes.nc"]
@@ -16,9 +15,7 @@ SHORT = {"baseline": "nothing (the experiment file)", "equal_forces": "equal nod
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     ds = xr.load_dataset(ROOT / INPUTS[0])
     lines = [("**Lloyd Secs. 5.1 and 5.3: what sets the ratio mean/max error** (one factor changed at a time "
              "from the experiment files' set-up; strains along the load at the top corner node and in the middle "
@@ -27,15 +24,13 @@ def main(argv=None):
              ("| Sec. | case | changed | load (Pa) | strain corner / middle, FEM (%) | ours max (mm) | ours mean/max | "
              "published max (mm) | published mean/max | ours - published, mean/max |"),
              "|---|---|---|---|---|---|---|---|---|---|"]
-    for i in range(ds.sizes["run"]):
-        r = ds.isel(run=i)
+    for r in script.rows(ds, "run"):
         lines.append(
             f"| {r.section.values} | {r.case.values} | {SHORT.get(str(r.factor.values), str(r.factor.values))} | {float(r['load']):.0f} | "
             f"{100 * float(r.corner_fem):.1f} / {100 * float(r.middle_fem):.1f} | {1e3 * float(r.error_max):.3g} | "
             f"{float(r.ratio):.2f} | {1e3 * float(r.published_max):.3g} | {float(r.published_ratio):.2f} | "
             f"{float(r.ratio) - float(r.published_ratio):+.2f} |")
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

@@ -1,11 +1,10 @@
 """Lloyd's tetrahedral MSS under refinement (per level) and along the load paths of the hole
 cylinder and the cone."""
 
-import argparse
-
 import numpy as np
 
-from msslib.io import read_result, write_text
+from experiments import script
+from msslib.io import read_result
 
 INPUTS = ["results/lloyd/studies/tet_refinement.nc"]
 
@@ -16,9 +15,7 @@ def _pct(v):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    args = ap.parse_args()
+    args = script.args(__doc__)
     ds = read_result(INPUTS[0])
     h_nl, h_lin = ds.attrs["h_nonlinear_reference_mm"], ds.attrs["h_linear_reference_mm"]
     caption = (
@@ -32,8 +29,7 @@ def main():
               "| linearised shear / stretch, same mesh | linearised shear vs fine | full shear, same mesh | full shear vs reference "
               "| neo-Hookean vs reference |")
     lines = [caption, "", header, "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for j in range(ds.sizes["level"]):
-        r = ds.isel(level=j)
+    for r in script.rows(ds, "level"):
         lines.append(
             f"| {float(r.h):g} | {int(r.n_nodes)} | {int(r.n_cells)} | {float(r.rho_median):.2f} ({float(r.rho_min):.2f}) "
             f"| {float(r.dihedral_min):.1f} | {float(r.fit_lloyd_median):.2f} ({float(r.fit_best6_median):.2f}) "
@@ -62,7 +58,7 @@ def main():
         first = "none" if not np.isfinite(first) else f"{first:g}"
         lines.append(f"| {label} | {int(ds[name + '_nodes'])} | {float(ds[name + '_last_load']):g} | {fails} | {jac} | {eig} "
                      f"| {n_inv} | {first} | {published[name]} |")
-    write_text(args.out, "\n".join(lines) + "\n")
+    script.write_table(args.out, lines)
 
 
 if __name__ == "__main__":

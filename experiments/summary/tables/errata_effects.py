@@ -1,8 +1,7 @@
 """How each erratum changes results: the printed formula against the derived one, in simulation."""
 
-import argparse
-
-from msslib.io import read_result, write_text
+from experiments import script
+from msslib.io import read_result
 
 INPUTS = ["results/golec/studies/isotropy.nc", "results/baudet/studies/tension.nc",
           "results/baudet/studies/bulk.nc", "results/lloyd/studies/poisson_error.nc",
@@ -14,9 +13,7 @@ def pct(v):
 
 
 def main():
-    p = argparse.ArgumentParser()
-    p.add_argument("--out", required=True)
-    a = p.parse_args()
+    a = script.args(__doc__)
     gi, bt, bb, pe, cv = (read_result(f) for f in INPUTS)
     rows = []
     # Golec: printed constants per element / as interior totals vs derived, at A = 1
@@ -52,7 +49,7 @@ def main():
                  "-(kappa/V0)(V - V0) dV/dP: see the volumes of the compression experiment", "results/golec/compression"))
     lines = ["| erratum | with the printed formula | with the derived formula | source |", "|---|---|---|---|"]
     lines += [f"| {a_} | {b_} | {c_} | `{d_}` |" for a_, b_, c_, d_ in rows]
-    write_text(a.out, "\n".join(lines) + "\n")
+    script.write_table(a.out, lines)
 
 
 if __name__ == "__main__":

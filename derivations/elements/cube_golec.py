@@ -25,7 +25,11 @@ from derivations import elasticity as el
 from derivations import fem, lattice, match, mss, show
 from derivations.elasticity import E, nu
 from derivations.fem import _REF
-from derivations.records import Derivation, Erratum, Formula
+from derivations.records import Derivation, Element, Erratum, Formula
+
+# what this module derives and which simulator models the generated code feeds (derivations.registry)
+ELEMENT = Element("cube_golec", cell="hexahedron", models=("golec_cube",),
+                  source="Golec et al. (2017)")
 
 a, A = sp.symbols("a A", positive=True)
 k_e, k_f, k_c, kappa = sp.symbols("k_e k_f k_c kappa", real=True)

@@ -20,7 +20,11 @@ import sympy as sp
 
 from derivations import fem, match, mss, show
 from derivations.elasticity import E, nu
-from derivations.records import Derivation, Erratum, Formula
+from derivations.records import Derivation, Element, Erratum, Formula
+
+# what this module derives and which simulator models the generated code feeds (derivations.registry)
+ELEMENT = Element("tetrahedron", cell="tetra", models=("lloyd_tetrahedron", "lloyd_tetrahedron_volume"),
+                  source="Lloyd et al. (2007), Sec. 4.2, eqs. 12-14")
 
 l = sp.Symbol("l", positive=True)
 V = sp.Symbol("V", positive=True)

@@ -25,7 +25,11 @@ from derivations import elasticity as el
 from derivations import fem, lattice, mss, show
 from derivations.elasticity import E, nu
 from derivations.fem import _REF
-from derivations.records import Derivation, Erratum, Formula
+from derivations.records import Derivation, Element, Erratum, Formula
+
+# what this module derives and which simulator models the generated code feeds (derivations.registry)
+ELEMENT = Element("cube_baudet", cell="hexahedron", models=("baudet_cube",),
+                  source="Baudet et al. (2007), configuration M2")
 
 x0, y0, z0 = sp.symbols("x_0 y_0 z_0", positive=True)
 a = sp.Symbol("a", positive=True)

@@ -28,7 +28,11 @@ import sympy as sp
 
 from derivations import fem, lattice, match, mss, show
 from derivations.elasticity import E, elasticity_matrix, nu, t
-from derivations.records import Derivation, Formula
+from derivations.records import Derivation, Element, Formula
+
+# what this module derives and which simulator models the generated code feeds (derivations.registry)
+ELEMENT = Element("rectangle", cell="quad", models=("lloyd_rectangle",),
+                  source="extends Lloyd et al. (2007), Sec. 4.1, to any aspect ratio", extends="square")
 
 a = sp.Symbol("a", positive=True)
 r = sp.Symbol("r", positive=True)  # aspect ratio b / a
@@ -131,7 +135,7 @@ if __name__ == "__main__":
     show.equations(r"\text{Gröbner basis, last two elements}", groebner_certificate(True).exprs[-2:])
     show.check(r"K_{\text{FEM}} - K_{\text{MSS}} = 0\ \text{at the solution}",
                (stiffness_fem() - stiffness_mss()).subs(s_exact).applyfunc(sp.simplify) == sp.zeros(8, 8))
-    show.math(r"\text{Gröbner basis without prestrain}", r"\{" + ",\ ".join(sp.latex(g) for g in groebner_certificate(False).exprs) + r"\}")
+    show.math(r"\text{Gröbner basis without prestrain}", r"\{" + r",\ ".join(sp.latex(g) for g in groebner_certificate(False).exprs) + r"\}")
     show.equations(r"\text{without prestrain, structural zeros of}\ K_{\text{MSS}}\ \text{demand}", zero_entry_conditions())
 
 

@@ -20,7 +20,11 @@ import sympy as sp
 
 from derivations import fem, lattice, match, mss, show
 from derivations.elasticity import E, elasticity_matrix, nu, t
-from derivations.records import Derivation, Formula
+from derivations.records import Derivation, Element, Formula
+
+# what this module derives and which simulator models the generated code feeds (derivations.registry)
+ELEMENT = Element("square", cell="quad", models=("lloyd_square",),
+                  source="Lloyd et al. (2007), Sec. 4.1, eqs. 10-11")
 
 a = sp.Symbol("a", positive=True)
 nu_c = sp.Symbol("nu_c", real=True)

@@ -1,19 +1,18 @@
-// Generated from derivations/ by `python -m derivations.codegen`. Do not edit.
-// source-sha256: a3482487f48e97bcf813af674b8e238b6a6ed2b563d838dbd97c8c52b2117f24
-// body-sha256: 5ceba7b2a30e6d690d2d5155aca5c1712604068917890b031bb7363351837576
-/* Spring constants, rest-length factors, volume coefficients and the energy, gradient and
- * Hessian kernels of msslib's mass-spring models, in C99.
+// Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
+// source-sha256: 1182560a2f7a13168c90c1c208673628652d84b0c593a1fc54d9a45687e47ccc
+// body-sha256: 7f5d5f733ea9977037af525660c2fc36b8b662c38c8617e6adddab5a10c656b3
+/* Energy, gradient and Hessian kernels, in C99.
  *
- * Printed by SymPy's C99 printer from the expressions that the Python modules of
- * msslib/generated are printed from (the modules of derivations/), with the same common
- * subexpressions; `python -m derivations.codegen` writes both, do not edit.
+ * Printed by SymPy's C99 printer from the expressions that msslib/generated/kernels.py is
+ * printed from (derivations/terms/kernels.py), with the same common subexpressions;
+ * `python -m derivations.codegen` writes both, do not edit. msslib_mss.h includes every module.
  * SI units: E in Pa, lengths in m, spring constants in N/m, energies in J, gradients in N,
  * Hessians in N/m (row-major, node by node: x0, y0(, z0), x1, ...).
  * Functions are `static inline` unless MSSLIB_API is defined before this header is
  * included (define it empty to compile them with external linkage, e.g. into a library).
  * Link with -lm. */
-#ifndef MSSLIB_MSS_H
-#define MSSLIB_MSS_H
+#ifndef MSSLIB_KERNELS_H
+#define MSSLIB_KERNELS_H
 
 #include <math.h>
 
@@ -24,264 +23,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* ---- derivations/triangle.py: Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9) ---- */
-
-/* lloyd_triangle: Spring constant of each edge of an equilateral triangle, per element (sum over the triangles sharing the edge). Exact for nu = 1/3.
- * Returns k. */
-MSSLIB_API double msslib_lloyd_triangle(double E, double t)
-{
-    return (1.0/4.0)*sqrt(3)*E*t;
-}
-
-/* van_gelder_triangle: Van Gelder's spring constant, per element: E t A_e / l^2.
- * Returns k. */
-MSSLIB_API double msslib_van_gelder_triangle(double E, double t, double A_e, double l)
-{
-    return A_e*E*t/pow(l, 2);
-}
-
-/* ---- derivations/square.py: Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11) ---- */
-
-#define MSSLIB_LLOYD_SQUARE_N_OUT 4
-#define MSSLIB_LLOYD_SQUARE_K_EDGE 0
-#define MSSLIB_LLOYD_SQUARE_K_DIAGONAL 1
-#define MSSLIB_LLOYD_SQUARE_REST_FACTOR_EDGE 2
-#define MSSLIB_LLOYD_SQUARE_REST_FACTOR_DIAGONAL 3
-
-/* lloyd_square: Per-element constants of the square: edge springs (sum over the squares sharing the edge) and diagonal springs, with rest length = factor x rest distance. Exact for nu = 1/3.
- * Writes out[0..3] = (k_edge, k_diagonal, rest_factor_edge, rest_factor_diagonal). */
-MSSLIB_API void msslib_lloyd_square(double E, double t, double *out)
-{
-    const double _c0 = E*t;
-    out[0] = (5.0/16.0)*_c0;
-    out[1] = (7.0/16.0)*_c0;
-    out[2] = 6.0/5.0;
-    out[3] = 6.0/7.0;
-}
-
-/* ---- derivations/rectangle.py: Rectangle of aspect ratio r, plane stress, six prestrained springs (generalising Lloyd et al. Sec. 4.1) ---- */
-
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_N_OUT 6
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_K_H 0
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_K_V 1
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_K_D 2
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_C_H 3
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_C_V 4
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_C_D 5
-
-/* rectangle_least_squares: Least-squares springs of an a x b rectangle (r = b/a), plane stress, nu = 1/3, per element: k_h (the 2 edges along x, length a), k_v (the 2 edges along y, length b = r a), k_d (the 2 diagonals) and rest-length factors c_h, c_v, c_d (rest length = c times the rest distance). Edge constants add up over the elements sharing the edge. Exact only for r = 1 (Lloyd's 5/16, 7/16 E t; 6/5, 6/7); k and c are positive only for 0.4920 < r < 2.0324, and for r != 1 the element is NOT in equilibrium at rest (see rectangle_least_squares_equilibrium).
- * Writes out[0..5] = (k_h, k_v, k_d, c_h, c_v, c_d). */
-MSSLIB_API void msslib_rectangle_least_squares(double E, double t, double r, double *out)
-{
-    const double _c0 = pow(r, 2);
-    const double _c1 = pow(r, 4);
-    const double _c2 = pow(r, 6);
-    const double _c3 = -3*_c0 + 28*_c1 + 6*_c2 - 1;
-    const double _c4 = _c1 + 1;
-    const double _c5 = (1.0/16.0)*E*t/(r*(4*_c0 + _c4));
-    const double _c6 = -28*_c0 + 3*_c1 + _c2 - 6;
-    const double _c7 = _c0 + 1;
-    const double _c8 = 19*_c0 + _c4;
-    const double _c9 = 3*r;
-    out[0] = _c3*_c5;
-    out[1] = -_c5*_c6;
-    out[2] = _c5*_c7*_c8;
-    out[3] = 2*(14*_c1 + 2*_c2 + _c7)/_c3;
-    out[4] = -2*(14*_c0 + _c1 + _c2 + 2)/_c6;
-    out[5] = 2*(-_c0 + _c9 + 1)*(_c0 + _c9 - 1)/_c8;
-}
-
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_N_OUT 6
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_K_H 0
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_K_V 1
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_K_D 2
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_C_H 3
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_C_V 4
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_C_D 5
-
-/* rectangle_least_squares_equilibrium: Least-squares springs of an a x b rectangle (r = b/a), plane stress, nu = 1/3, restricted to elements in equilibrium at rest (spring tensions balance at every node), per element: k_h (the 2 edges along x, length a), k_v (the 2 edges along y, length b = r a), k_d (the 2 diagonals) and rest-length factors c_h, c_v, c_d (rest length = c times the rest distance). Edge constants add up over the elements sharing the edge. Equal to rectangle_least_squares at r = 1; k and c are positive for every r.
- * Writes out[0..5] = (k_h, k_v, k_d, c_h, c_v, c_d). */
-MSSLIB_API void msslib_rectangle_least_squares_equilibrium(double E, double t, double r, double *out)
-{
-    const double _c0 = pow(r, 4);
-    const double _c1 = 5*_c0;
-    const double _c2 = pow(r, 2);
-    const double _c3 = 14*_c2;
-    const double _c4 = _c1 + _c3;
-    const double _c5 = _c4 + 1;
-    const double _c6 = E*t/(_c4 + 5);
-    const double _c7 = (3.0/8.0)*_c6;
-    const double _c8 = 1.0/r;
-    const double _c9 = _c0 + _c3 + 5;
-    const double _c10 = _c1 + 5;
-    const double _c11 = _c10 + 32*_c2;
-    const double _c12 = pow(r, 6);
-    out[0] = _c5*_c7*r;
-    out[1] = _c7*_c8*_c9;
-    out[2] = (1.0/8.0)*_c11*_c6*_c8*(_c2 + 1);
-    out[3] = (1.0/6.0)*(91*_c0 + 35*_c12 + 13*_c2 + 5)/(_c2*_c5);
-    out[4] = (1.0/6.0)*(13*_c0 + 5*_c12 + 91*_c2 + 35)/_c9;
-    out[5] = (1.0/2.0)*(_c10 + 62*_c2)/_c11;
-}
-
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_N_OUT 6
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_K_H 0
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_K_V 1
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_K_D 2
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_C_H 3
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_C_V 4
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_C_D 5
-
-/* rectangle_least_squares_nu: Least-squares springs of an a x b rectangle (r = b/a), plane stress, any Poisson's ratio nu, per element: k_h (the 2 edges along x, length a), k_v (the 2 edges along y, length b = r a), k_d (the 2 diagonals) and rest-length factors c_h, c_v, c_d (rest length = c times the rest distance). Edge constants add up over the elements sharing the edge. rectangle_least_squares is its value at nu = 1/3; not in equilibrium at rest.
- * Writes out[0..5] = (k_h, k_v, k_d, c_h, c_v, c_d). */
-MSSLIB_API void msslib_rectangle_least_squares_nu(double E, double nu, double t, double r, double *out)
-{
-    const double _c0 = 2*nu;
-    const double _c1 = pow(r, 2);
-    const double _c2 = pow(r, 4);
-    const double _c3 = pow(r, 6);
-    const double _c4 = 3*nu;
-    const double _c5 = 7*nu;
-    const double _c6 = _c0 + _c1*_c4 - 5*_c1 + _c2*_c5 + 35*_c2 + 8*_c3 - 2;
-    const double _c7 = nu + 1;
-    const double _c8 = (1.0/24.0)*E*t/(_c7*r*(nu - 1)*(4*_c1 + _c2 + 1));
-    const double _c9 = 2*_c3;
-    const double _c10 = _c1*_c5;
-    const double _c11 = _c0*_c3 + 35*_c1 + _c10 + _c2*_c4 - 5*_c2 - _c9 + 8;
-    const double _c12 = _c1 + 1;
-    const double _c13 = -_c0*_c2 - _c0 + 23*_c1 + _c10 + 2*_c2 + 2;
-    const double _c14 = 2*_c7;
-    const double _c15 = 3*r;
-    out[0] = -_c6*_c8;
-    out[1] = -_c11*_c8;
-    out[2] = -_c12*_c13*_c8;
-    out[3] = _c14*(_c12 + 14*_c2 + _c9)/_c6;
-    out[4] = _c14*(14*_c1 + _c2 + _c3 + 2)/_c11;
-    out[5] = _c14*(-_c1 + _c15 + 1)*(_c1 + _c15 - 1)/_c13;
-}
-
-/* ---- derivations/tetrahedron.py: Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14) ---- */
-
-/* lloyd_tetrahedron: Per-element spring constant of a regular tetrahedron of edge l (least squares at nu = 1/4, eq. 12); use the equivalent edge length of eq. 13 for other shapes; sum over the tetrahedra sharing the edge.
- * Returns k. */
-MSSLIB_API double msslib_lloyd_tetrahedron(double E, double l)
-{
-    return (2.0/25.0)*sqrt(2)*E*l;
-}
-
-/* lloyd_tetrahedron_general_nu: Least-squares spring constant for any nu (per element).
- * Returns k. */
-MSSLIB_API double msslib_lloyd_tetrahedron_general_nu(double E, double nu, double l)
-{
-    return (1.0/15.0)*sqrt(2)*E*l*(nu - 1)/((nu + 1)*(2*nu - 1));
-}
-
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_N_OUT 2
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_K 0
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_K_VOLUME 1
-
-/* lloyd_tetrahedron_volume: Per-element spring constant and volume-energy coefficient k_V of E_V = k_V/(2 V0^2)(V - V0)^2, least squares for any nu (eq. 14 is the case nu = 1/4).
- * Writes out[0..1] = (k, k_volume). */
-MSSLIB_API void msslib_lloyd_tetrahedron_volume(double E, double nu, double l, double *out)
-{
-    const double _c0 = sqrt(2)*E/(nu + 1);
-    out[0] = (2.0/21.0)*_c0*l;
-    out[1] = -1.0/84.0*_c0*pow(l, 3)*(13*nu - 3)/(2*nu - 1);
-}
-
-/* equivalent_edge_length: Edge of the regular tetrahedron of volume V (eq. 13).
- * Returns l. */
-MSSLIB_API double msslib_equivalent_edge_length(double V)
-{
-    return sqrt(2)*cbrt(3)*cbrt(V);
-}
-
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_PUBLISHED_N_OUT 2
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_PUBLISHED_K 0
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_PUBLISHED_K_VOLUME 1
-
-/* lloyd_tetrahedron_volume_published: Lloyd et al.'s eq. 14 as printed (the optimum at nu = 1/4).
- * Writes out[0..1] = (k, k_volume). */
-MSSLIB_API void msslib_lloyd_tetrahedron_volume_published(double E, double l, double *out)
-{
-    const double _c0 = sqrt(2)*E;
-    out[0] = (8.0/105.0)*_c0*l;
-    out[1] = (1.0/210.0)*_c0*pow(l, 3);
-}
-
-/* ---- derivations/cube_baudet.py: Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.) ---- */
-
-#define MSSLIB_BAUDET_CUBE_N_OUT 3
-#define MSSLIB_BAUDET_CUBE_K_EDGE 0
-#define MSSLIB_BAUDET_CUBE_K_DIAGONAL 1
-#define MSSLIB_BAUDET_CUBE_CORRECTION_FACTOR 2
-
-/* baudet_cube: Per-element constants of a cube of edge a: edge springs (sum over the cubes sharing the edge), inner diagonals, and the factor c of the correction force F_perp = c F_i applied, as a total per face, on each face orthogonal to the elongation force F_i (Baudet eqs. 7-8).
- * Writes out[0..2] = (k_edge, k_diagonal, correction_factor). */
-MSSLIB_API void msslib_baudet_cube(double E, double nu, double a, double *out)
-{
-    const double _c0 = E*a/(nu + 1);
-    out[0] = (1.0/8.0)*_c0*(4*nu + 1);
-    out[1] = (3.0/8.0)*_c0;
-    out[2] = 1.0/2.0 - 2*nu;
-}
-
-#define MSSLIB_BAUDET_CUBE_PUBLISHED_N_OUT 3
-#define MSSLIB_BAUDET_CUBE_PUBLISHED_K_EDGE 0
-#define MSSLIB_BAUDET_CUBE_PUBLISHED_K_DIAGONAL 1
-#define MSSLIB_BAUDET_CUBE_PUBLISHED_CORRECTION_FACTOR 2
-
-/* baudet_cube_published: Baudet et al.'s eqs. 7-8 as printed (correction factor -(4 nu - 1)/16).
- * Writes out[0..2] = (k_edge, k_diagonal, correction_factor). */
-MSSLIB_API void msslib_baudet_cube_published(double E, double nu, double a, double *out)
-{
-    const double _c0 = 4*nu;
-    const double _c1 = E*a/(nu + 1);
-    out[0] = (1.0/8.0)*_c1*(_c0 + 1);
-    out[1] = (3.0/8.0)*_c1;
-    out[2] = 1.0/16.0 - 1.0/16.0*_c0;
-}
-
-/* ---- derivations/cube_golec.py: Cube with edge, face and inner springs and volume correction (Golec et al.) ---- */
-
-#define MSSLIB_GOLEC_CUBE_N_OUT 4
-#define MSSLIB_GOLEC_CUBE_K_EDGE 0
-#define MSSLIB_GOLEC_CUBE_K_FACE 1
-#define MSSLIB_GOLEC_CUBE_K_INNER 2
-#define MSSLIB_GOLEC_CUBE_KAPPA 3
-
-/* golec_cube: Per-element constants of a cube of edge a (sum the edge springs over the up to 4 cubes sharing an edge, face diagonals over the up to 2 cubes sharing a face) and kappa [Pa] of the volume energy kappa/(2 V0) (V - V0)^2. The lattice reproduces the isotropic (lambda, mu) exactly.
- * Writes out[0..3] = (k_edge, k_face, k_inner, kappa). */
-MSSLIB_API void msslib_golec_cube(double E, double nu, double a, double A, double *out)
-{
-    const double _c0 = 2*A;
-    const double _c1 = E*a/(_c0*nu + _c0 + 3*nu + 3);
-    const double _c2 = (3.0/4.0)*_c1;
-    out[0] = (1.0/8.0)*_c1*(4*A + 3);
-    out[1] = _c2;
-    out[2] = A*_c2;
-    out[3] = -1.0/2.0*E*(4*nu - 1)/(2*pow(nu, 2) + nu - 1);
-}
-
-#define MSSLIB_GOLEC_CUBE_PUBLISHED_N_OUT 4
-#define MSSLIB_GOLEC_CUBE_PUBLISHED_K_EDGE 0
-#define MSSLIB_GOLEC_CUBE_PUBLISHED_K_FACE 1
-#define MSSLIB_GOLEC_CUBE_PUBLISHED_K_INNER 2
-#define MSSLIB_GOLEC_CUBE_PUBLISHED_KAPPA 3
-
-/* golec_cube_published: Golec et al.'s constants as printed (k_edge and k_face are the assembled values of an interior spring).
- * Writes out[0..3] = (k_edge, k_face, k_inner, kappa). */
-MSSLIB_API void msslib_golec_cube_published(double E, double nu, double a, double A, double *out)
-{
-    const double _c0 = (6.0/5.0)*E*a/(4*A + 3);
-    out[0] = _c0*((8.0/3.0)*A + 1);
-    out[1] = _c0;
-    out[2] = A*_c0;
-    out[3] = -1.0/2.0*E*(4*nu - 1)/((nu + 1)*(2*nu - 1));
-}
-
-/* ---- derivations/kernels.py: Energy, gradient and Hessian kernels ---- */
 
 /* spring2d_energy: Spring k/2 (|x1 - x0| - L0)^2 in 2D. Energy [J].
  * Returns energy. */
@@ -1911,4 +1652,4 @@ MSSLIB_API double msslib_hex_averaged_volume(double x0, double y0, double z0, do
 }
 #endif
 
-#endif /* MSSLIB_MSS_H */
+#endif /* MSSLIB_KERNELS_H */

@@ -22,7 +22,11 @@ import sympy as sp
 
 from derivations import fem, lattice, match, mss, show
 from derivations.elasticity import E, elasticity_matrix, nu, t
-from derivations.records import Derivation, Erratum, Formula
+from derivations.records import Derivation, Element, Erratum, Formula
+
+# what this module derives and which simulator models the generated code feeds (derivations.registry)
+ELEMENT = Element("triangle", cell="triangle", models=("lloyd_triangle", "van_gelder"),
+                  source="Lloyd et al. (2007), Sec. 3; van Gelder (1998)")
 
 a = sp.Symbol("a", positive=True)
 x2 = sp.Symbol("x2", real=True)
