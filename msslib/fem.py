@@ -518,28 +518,31 @@ def solve_nonlinear(
 
     ``law``: ``"svk"`` (St Venant-Kirchhoff, Green-Lagrange strain) or ``"neohookean"``
     (``W = mu/2 (I1 - 3) - mu ln J + lam/2 (ln J)^2``). Loads and prescribed displacements are
-    applied in ``steps`` equal load-factor increments; each increment is solved by Newton's method
-    and converged when the residual force norm on the free dofs is at most
-    ``max(tol * max(|load|, |reactions|), floor)`` (load = current external force vector; the
-    criterion of :func:`msslib.solvers.convergence_threshold`), ``floor`` the round-off floor
-    :func:`msslib.solvers.roundoff_floor` of ``|| |K| |u| + sum_e |f_e| + |load| ||`` on the free
-    dofs (the size of what the internal force sums: the displacement gradient differences nodal
-    displacements, each element force sums stresses), so that a problem whose ``tol * F_ref`` lies
-    below the round-off converges at the floor instead of iterating on it (an increment accepted
-    there, above ``tol * F_ref``, is listed in ``stats``). A failed increment
-    (no convergence in ``max_iter`` iterations, or an inverted element) is halved, at most
-    ``max_halvings`` times in a row and never below ``1 / (steps * 2**max_halvings)``; then
-    :class:`RuntimeError` names the step and the residual.
+    applied in ``steps`` equal load-factor increments, solved by the Newton iteration of the
+    mass-spring models (:func:`msslib.solvers.static_solve` through
+    :mod:`msslib.solvers.displacement`; no line search, direct linear solves): converged when the
+    residual force norm on the free dofs is at most ``max(tol * F_ref, floor)``
+    (:func:`msslib.solvers.convergence_threshold`), ``F_ref`` the norm of the external load on the
+    free dofs (for pure displacement control, of the linear reaction of the prescribed motion),
+    ``floor`` the round-off floor :func:`msslib.solvers.roundoff_floor` of
+    ``|| |K| |u| + sum_e |f_e| + |load| ||`` on the free dofs at the current iterate (the size of
+    what the internal force sums: the displacement gradient differences nodal displacements,
+    each element force sums stresses), so that a problem whose ``tol * F_ref`` lies below the
+    round-off converges at the floor instead of iterating on it (an increment accepted there is
+    listed in ``stats``). A failed increment (no convergence in ``max_iter`` iterations, or an
+    inverted element) is halved, at most ``max_halvings`` times in a row and never below
+    ``1 / (steps * 2**max_halvings)``; then :class:`msslib.errors.ConvergenceError` (a
+    RuntimeError) names the step and the residual.
     2D: ``plane="stress"`` (default, as in :func:`solve_linear`; exact plane stress of the 3D law, see
     the module docstring) or ``"strain"`` (``F33 = 1``). ``progress(step, n_steps)`` is called after every converged nominal step.
 
-    ``stats``: ``iterations`` (Newton iterations per converged increment), ``residuals`` (relative
-    residual history per increment), ``load_factors`` (after each converged increment), ``n_halvings``,
+    ``stats``: ``iterations`` (Newton iterations per converged increment), ``residuals`` (residual
+    history per increment, relative to ``F_ref``; ``force_scale`` is ``F_ref``), ``load_factors`` (after each converged increment), ``n_halvings``,
     ``n_dofs``, ``wall_time``, ``solver``, ``tol``, ``roundoff_floor`` and ``threshold`` (of the
     last converged increment, absolute), ``roundoff_steps`` (increments accepted at the floor,
     1-based) and ``messages``.
     """
-    from msslib.solvers import _abs_times, convergence_threshold, roundoff_floor, roundoff_note
+    from msslib.solvers.displacement import SOLVER, DisplacementProblem, solve_displacement
 
     t0 = time.perf_counter()
     d = mesh.dim
@@ -577,95 +580,12 @@ def solve_nonlinear(
         K = geo.assemble_matrix(ke.reshape(m, nb * d, nb * d) * w)
         return fint, K, energy, fabs
 
-    u = np.zeros(geo.n_dofs)
-    lf = 0.0  # converged load factor
-    dlf_nominal = 1.0 / steps
-    dlf = dlf_nominal
-    iterations, residuals, factors = [], [], []
-    halvings = 0
-    n_halvings = 0
-    next_report = 1
-    last_res = np.nan
-    floor = thr = np.nan
-    roundoff_steps, messages = [], []
-    load_abs = np.abs(f_ext)
-    while lf < 1.0 - 1e-12:
-        target = min(1.0, lf + dlf)
-        ut = u.copy()
-        ut[cons] = target * presc[cons]
-        fe_t = target * f_ext
-        hist = []
-        ok = False
-        try:
-            for it in range(max_iter + 1):
-                fint, K, _, fabs = internal(ut, tangent=True)
-                r = fint - fe_t
-                ref = max(np.linalg.norm(fe_t[free]), np.linalg.norm(r[cons]), np.finfo(float).tiny)
-                res = np.linalg.norm(r[free])
-                if not np.isfinite(res):
-                    raise FloatingPointError("non-finite residual")
-                mag = _abs_times(K, np.abs(ut)) + fabs + target * load_abs
-                floor = roundoff_floor(float(np.linalg.norm(mag[free])))
-                thr = convergence_threshold(tol, ref, floor)
-                hist.append(res / ref)
-                last_res = res
-                if res <= thr or not free.any():
-                    ok = True
-                    break
-                if it == max_iter:
-                    break
-                du = _solve_sparse(K[free][:, free], -r[free])
-                if not np.all(np.isfinite(du)):
-                    raise FloatingPointError("non-finite Newton update")
-                ut[free] += du
-        except (FloatingPointError, np.linalg.LinAlgError):
-            ok = False
-        if ok:
-            if free.any() and last_res > tol * ref:  # accepted at the round-off floor
-                roundoff_steps.append(len(factors) + 1)
-                messages.append(f"increment {len(factors) + 1} (load factor {target:.6g}): "
-                                f"{roundoff_note(last_res, floor, tol * ref)}")
-            u, lf = ut, target
-            iterations.append(len(hist) - 1)
-            residuals.append(hist)
-            factors.append(lf)
-            halvings = 0
-            dlf = min(dlf * 2.0, dlf_nominal) if dlf < dlf_nominal else dlf_nominal
-            while progress is not None and next_report <= steps and lf >= next_report * dlf_nominal - 1e-12:
-                progress(next_report, steps)
-                next_report += 1
-            continue
-        halvings += 1
-        n_halvings += 1
-        # also stop when the increment has shrunk below nominal / 2**max_halvings: near a limit
-        # point, alternating successes and halvings would otherwise creep towards it forever
-        if halvings > max_halvings or dlf * 0.5 < dlf_nominal * 0.5**max_halvings * (1.0 - 1e-12):
-            step = int(np.floor(lf / dlf_nominal + 1e-9)) + 1
-            raise RuntimeError(
-                f"Newton did not converge in load step {step} of {steps} (load factor {lf:.6g} -> {target:.6g}, "
-                f"after {max_halvings} step halvings): last residual norm {last_res:.3e} "
-                f"(relative {hist[-1] if hist else float('nan'):.3e}, tol {tol:.1e}; round-off floor {floor:.3e})"
-            )
-        dlf *= 0.5
-
+    problem = DisplacementProblem(internal, f_ext, cons, presc)
+    u, newton = solve_displacement(problem, steps=steps, tol=tol, max_iter=max_iter, max_halvings=max_halvings,
+                                   progress=progress)
     fint, _, energy, _ = internal(u, tangent=False)
     r = fint - f_ext
     reaction = np.where(cons, r, 0.0)
-    stats = {
-        "n_dofs": int(u.size),
-        "n_free_dofs": int(free.sum()),
-        "iterations": iterations,
-        "residuals": residuals,
-        "load_factors": factors,
-        "n_halvings": n_halvings,
-        "law": law,
-        "plane": pl,
-        "wall_time": time.perf_counter() - t0,
-        "solver": "Newton, " + _SOLVER,
-        "tol": float(tol),
-        "roundoff_floor": float(floor),
-        "threshold": float(thr),
-        "roundoff_steps": roundoff_steps,
-        "messages": messages,
-    }
+    stats = {"n_dofs": int(u.size), "n_free_dofs": int(free.sum()), **newton, "law": law, "plane": pl,
+             "wall_time": time.perf_counter() - t0, "solver": SOLVER}
     return FemResult(displacement=u.reshape(-1, d), reaction=reaction.reshape(-1, d), strain_energy=energy, stats=stats)

@@ -297,6 +297,7 @@ def test_repeated_solves_of_a_problem_keep_the_amg_hierarchy(monkeypatch):
     (no new set-up) and gives the same result; another start, another linear solver or a model
     whose values changed still solve correctly; the state goes with the model."""
     import gc
+    import weakref
 
     import msslib.solvers as S
 
@@ -307,16 +308,16 @@ def test_repeated_solves_of_a_problem_keep_the_amg_hierarchy(monkeypatch):
         builds.append(A.shape)
         return original(A, context)
 
-    monkeypatch.setattr(S, "_preconditioner", counting)
+    monkeypatch.setattr(S.linear, "_preconditioner", counting)  # where the linear solve looks it up
     model = _gravity_cube(6)
     direct = static_solve(model, model.x0, linear_solver="direct", tol=1e-10)  # the reference
     first = static_solve(model, model.x0, linear_solver="cg", tol=1e-10)
     assert len(builds) == 1 and first.cg_iterations > 0
-    ctx = S._STATIC_CONTEXTS[model]
+    ctx = S._kept_context(model)
     K = ctx["K"]
     second = static_solve(model, model.x0, linear_solver="cg", tol=1e-10)
     assert len(builds) == 1  # kept: CG converged as fast with it
-    assert S._STATIC_CONTEXTS[model] is ctx and ctx["K"] is K  # the matrix refilled in place
+    assert S._kept_context(model) is ctx and ctx["K"] is K  # the matrix refilled in place
     assert second.cg_iterations == first.cg_iterations
     scale = np.abs(first.x - model.x0).max()
     np.testing.assert_allclose(second.x, first.x, rtol=0, atol=1e-9 * scale)
@@ -329,15 +330,15 @@ def test_repeated_solves_of_a_problem_keep_the_amg_hierarchy(monkeypatch):
     # a state left by a stiffer model's solve: still converges to the right answer
     soft, stiff = _gravity_cube(6, E=1e4), _gravity_cube(6, E=1e6)
     static_solve(stiff, stiff.x0, linear_solver="cg", tol=1e-10)
-    S._STATIC_CONTEXTS[soft] = S._STATIC_CONTEXTS[stiff]  # as if the values had changed
+    setattr(soft, S.context.ATTRIBUTE, S._kept_context(stiff))  # as if the values had changed
     r = static_solve(soft, soft.x0, linear_solver="cg", tol=1e-10)
     np.testing.assert_allclose(r.x, direct.x, rtol=0, atol=1e-7 * scale)
     assert r.residuals[-1][-1] <= 1e-10 * r.force_scale
     # the state goes with the model
-    n = len(S._STATIC_CONTEXTS)
-    del model, soft, stiff
+    kept = [weakref.ref(S._kept_context(m)) for m in (model, stiff)]
+    del model, soft, stiff, ctx
     gc.collect()
-    assert len(S._STATIC_CONTEXTS) <= n - 2
+    assert all(k() is None for k in kept)
 
 
 def test_static_context_in_use_is_not_shared():
@@ -347,7 +348,7 @@ def test_static_context_in_use_is_not_shared():
     free = np.asarray(model.free, dtype=bool)
     a = S._static_context(model, model.x0, free, "cg")
     b = S._static_context(model, model.x0, free, "cg")  # `a` is in use (another thread)
-    assert b is not a and S._STATIC_CONTEXTS[model] is a
+    assert b is not a and S._kept_context(model) is a
     S._release_context(a)
     S._release_context(b)
     c = S._static_context(model, model.x0, free, "cg")

@@ -40,9 +40,10 @@ def lattice_block(nx, ny, nz, *, k3=2.0, g=0.05):
 
 
 def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
-    from msslib.solvers import _submatrix
+    from msslib.solvers import PlanCache, _submatrix
 
     rng = np.random.default_rng(4)
+    plans = PlanCache()
     for t in range(30):
         K = sp.random(40, 40, 0.08, random_state=t, format="csr") + (sp.eye(40) if t % 2 else 0)
         K = sp.csr_matrix(K)
@@ -50,13 +51,14 @@ def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
         free = rng.random(40) < 0.7
         idx = np.flatnonzero(free)
         for _ in range(2):  # the second call goes through the cached plan
-            A = _submatrix(K, free)
+            A = _submatrix(K, free, plans=plans)
             A.check_format(full_check=True)
             assert A.shape == (len(idx), len(idx))
             assert abs(A - K[idx][:, idx]).max() == 0 if A.nnz else K[idx][:, idx].nnz == 0
         K2 = K.copy()
         K2.data = rng.standard_normal(K2.nnz)  # same pattern, new values
-        assert abs(_submatrix(K2, free) - K2[idx][:, idx]).max() == 0 if K2[idx][:, idx].nnz else True
+        assert abs(_submatrix(K2, free, plans=plans) - K2[idx][:, idx]).max() == 0 if K2[idx][:, idx].nnz else True
+        assert plans.entries[0]["free"].tolist() == free.tolist()  # the plan was kept
 
 
 def clamped_golec_block(nx, ny, nz, nu=0.3):
@@ -71,24 +73,27 @@ def clamped_golec_block(nx, ny, nz, nu=0.3):
 
 
 def test_submatrix_refill_in_place_equals_fresh_extraction():
-    from msslib.solvers import _submatrix
+    from msslib.solvers import PlanCache, _submatrix
 
     model = clamped_golec_block(3, 2, 2)
     free = model.free
     idx = np.flatnonzero(free)
     rng = np.random.default_rng(5)
     K = model.stiffness(model.x0)
-    A = _submatrix(K, free)
+    plans = PlanCache()
+    A = _submatrix(K, free, plans=plans)
     for _ in range(2):
         x = model.x0 + 1e-3 * rng.standard_normal(model.n_dof)
         K = model.stiffness(x, out=K)
-        A2 = _submatrix(K, free, out=A)
+        A2 = _submatrix(K, free, out=A, plans=plans)
         assert A2 is A  # values overwritten in place
         ref = K.tocsc()[idx][:, idx]
         assert abs(A2 - ref).max() == 0.0
     # a matrix of another pattern is not reused
     other = sp.csr_matrix(np.eye(len(idx)))
-    assert _submatrix(K, free, out=other) is not other
+    assert _submatrix(K, free, out=other, plans=plans) is not other
+    # without a plan cache the plan is made for the call: the result is not refilled in place
+    assert _submatrix(K, free, out=A) is not A
 
 
 @pytest.mark.parametrize("shift", [0.0, -0.5])  # SPD (banded Cholesky) and indefinite (banded LU)
@@ -172,12 +177,12 @@ def test_free_node_blocks_as_bsr_equal_the_csr_block_and_refill_in_place():
     ctx = _solver_context(model, model.x0, free)
     rng = np.random.default_rng(6)
     K = model.stiffness(model.x0)
-    B = _submatrix_bsr(K, ctx["node_free"], 3)
+    B = _submatrix_bsr(K, ctx["node_free"], 3, plans=ctx)
     assert B.format == "bsr" and B.blocksize == (3, 3)
     B.check_format(full_check=True)
     for _ in range(2):
         K = model.stiffness(model.x0 + 1e-3 * rng.standard_normal(model.n_dof), out=K)
-        B2 = _submatrix_bsr(K, ctx["node_free"], 3, out=B)
+        B2 = _submatrix_bsr(K, ctx["node_free"], 3, out=B, plans=ctx)
         assert B2 is B  # values overwritten in place
         np.testing.assert_array_equal(B2.toarray(), K.toarray()[np.ix_(idx, idx)])
     # patterns that are not whole node blocks are refused (the caller then extracts a CSR block)
@@ -203,7 +208,7 @@ def test_cg_newton_systems_go_through_node_blocks(monkeypatch):
         calls.append(None if out is None else out.format)
         return out
 
-    monkeypatch.setattr(S, "_submatrix_bsr", spy)
+    monkeypatch.setattr(S.statics, "_submatrix_bsr", spy)  # where the Newton iteration looks it up
     iterative = static_solve(prob, x0, linear_solver="cg", tol=1e-10)
     assert calls and set(calls) == {"bsr"}
     direct = static_solve(prob, x0, linear_solver="direct", tol=1e-10)
@@ -237,7 +242,7 @@ def test_band_width_bound_never_exceeds_the_bandwidth_found(shape, monkeypatch):
     A = _submatrix(K, model.free)
     import msslib.solvers as S
 
-    monkeypatch.setattr(S, "BAND_COST_MAX", float("inf"))  # a plan whatever the bandwidth
+    monkeypatch.setattr(S.direct, "BAND_COST_MAX", float("inf"))  # a plan whatever the bandwidth
     plan = _band_plan(sp.csr_matrix(A.toarray()), ctx)
     n = A.shape[0]
     assert plan["bw"] >= (n - 1) / (2.0 * e)
@@ -247,3 +252,42 @@ def test_band_width_bound_never_exceeds_the_bandwidth_found(shape, monkeypatch):
         assert _band_surely_wide(entry, 3)
     if shape in ((16, 4, 4), (30, 2, 2)):
         assert cheap and not _band_surely_wide(entry, 3)
+
+
+def test_linear_solver_policy_decides_every_case_in_one_place():
+    """choose_linear_solver: explicit choices pass through, "auto" is direct up to
+    ITERATIVE_THRESHOLD or for non-symmetric systems, CG above BAND_PLAN_MAX_DOFS, and between
+    the two asks whether the band is cheap (only then)."""
+    from msslib.solvers import BAND_PLAN_MAX_DOFS, ITERATIVE_THRESHOLD, choose_linear_solver
+
+    def never():
+        raise AssertionError("band cost asked for")
+
+    assert choose_linear_solver(lambda A, b: b, 10, True, never) == "user"
+    assert choose_linear_solver("cg", 10, False, never) == "cg"
+    assert choose_linear_solver("direct", 10**6, True, never) == "direct"
+    assert choose_linear_solver("auto", ITERATIVE_THRESHOLD, True, never) == "direct"
+    assert choose_linear_solver("auto", 10**6, False, never) == "direct"
+    assert choose_linear_solver("auto", BAND_PLAN_MAX_DOFS + 1, True, never) == "cg"
+    mid = ITERATIVE_THRESHOLD + 1
+    assert choose_linear_solver("auto", mid, True, lambda: True) == "direct"
+    assert choose_linear_solver("auto", mid, True, lambda: False) == "cg"
+    with pytest.raises(ValueError, match="linear_solver"):
+        choose_linear_solver("lu", 10, True)
+
+
+def test_solver_errors_are_defined_once_and_fem_failures_are_convergence_errors():
+    import msslib.errors as E
+    import msslib.solvers as S
+    from msslib import fem
+    from msslib import mesh as M
+
+    assert S.ConvergenceError is E.ConvergenceError and S.DivergenceError is E.DivergenceError
+    assert E.ConvergenceError.__module__ == "msslib.errors"
+    mesh = M.hex_grid(2.0, 1.0, 1.0, 2, 1, 1)
+    fixed = np.zeros((mesh.n_nodes, 3), bool)
+    fixed[np.isclose(mesh.points[:, 0], 0.0)] = True
+    f = np.zeros((mesh.n_nodes, 3))
+    f[np.isclose(mesh.points[:, 0], 2.0), 0] = 50.0
+    with pytest.raises(E.ConvergenceError, match=r"static_solve did not converge: load step \d+ \(nominal step 1 of 1\)"):
+        fem.solve_nonlinear(mesh, 1.0, 0.3, fixed=fixed, nodal_forces=f, steps=1, max_iter=2, max_halvings=1)

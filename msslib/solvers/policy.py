@@ -1,0 +1,94 @@
+"""The linear-solver policy: which solver takes a Newton system, decided in one place
+(:func:`choose_linear_solver`), for the static Newton systems, their node-block assembly and the
+implicit time steps alike.
+
+``"auto"`` takes the direct solver up to ``ITERATIVE_THRESHOLD`` free dofs, and above it while the
+banded Cholesky is cheap (``n (b + 1)^2 <= BAND_AUTO_COST`` for the bandwidth ``b`` of the best
+ordering found; never above ``BAND_PLAN_MAX_DOFS``, where no ordering is computed), else
+AMG-preconditioned CG for symmetric systems.  The direct solver itself picks the factorisation
+(:func:`msslib.solvers.direct._direct_solve`): banded Cholesky when a band plan exists and the
+matrix is positive definite, banded LU once it is found indefinite, else SuperLU.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import scipy.sparse as sp
+
+from .direct import BAND_PLAN_MAX_DOFS, _band_plan
+from .plans import _bsr_entry, _eccentricity, _submatrix
+
+ITERATIVE_THRESHOLD = 2_000  # free dofs above which "auto" may use preconditioned CG (symmetric)
+BAND_AUTO_COST = 1.5e8  # ... unless the banded Cholesky costs at most this n (b + 1)^2
+# Measured on the gravity-loaded Golec cube lattice (benchmarks/statics.py), single thread, whole
+# static solves: 1944 dofs banded Cholesky 0.033 s vs AMG-CG 0.040 s; 3630 dofs SuperLU 0.44 s
+# (banded too wide) vs AMG-CG 0.083 s; 6084 dofs 1.37 s vs 0.16 s.  SuperLU's fill grows like
+# n^(4/3..2) in 3D; slender bodies keep a narrow band and stay direct.
+
+LINEAR_SOLVERS = ("auto", "direct", "cg")
+
+
+def choose_linear_solver(method, n: int, symmetric: bool, band_is_cheap: Callable[[], bool] | None = None) -> str:
+    """The solver of a Newton system of ``n`` unknowns: ``"user"`` (``method`` is a callable),
+    ``"cg"`` or ``"direct"``.
+
+    ``method``: ``"auto"``, ``"direct"``, ``"cg"`` or a callable.  ``symmetric``: whether the
+    tangent is symmetric (CG is never chosen by ``"auto"`` otherwise).  ``band_is_cheap()``:
+    asked only for ``"auto"`` between ``ITERATIVE_THRESHOLD`` and ``BAND_PLAN_MAX_DOFS`` free
+    dofs, whether the banded Cholesky is cheap (None: it is not)."""
+    if callable(method):
+        return "user"
+    if method not in LINEAR_SOLVERS:
+        raise ValueError(f"linear_solver must be 'auto', 'direct', 'cg' or a callable, got {method!r}")
+    if method != "auto":
+        return method
+    if not symmetric or n <= ITERATIVE_THRESHOLD:
+        return "direct"
+    if n > BAND_PLAN_MAX_DOFS or band_is_cheap is None:
+        return "cg"
+    return "direct" if band_is_cheap() else "cg"
+
+
+def _band_surely_wide(entry, dim) -> bool:
+    """True when no ordering can make the banded Cholesky cheap, from a bound that costs one
+    breadth-first search: a graph of ``n`` vertices and diameter ``D`` has bandwidth at least
+    ``(n - 1) / D``, and ``D <= 2 e`` for the eccentricity ``e`` of any vertex (the dofs of a
+    node are neighbours, so the dof graph has the diameter of the node graph).  Spares compact
+    bodies the bandwidth-reducing orderings, which cost more than the whole solve there."""
+    e = int(_eccentricity(entry["bptr"], entry["bind"]))
+    if e <= 0:
+        return False
+    n = dim * (len(entry["bptr"]) - 1)
+    b = (n - 1) / (2.0 * e)
+    return n * (b + 1.0) ** 2 > BAND_AUTO_COST
+
+
+def _band_is_cheap(A, context):
+    """Whether the banded Cholesky of the free-dof matrix ``A`` (canonical CSR) is cheap."""
+    if A.shape[0] > BAND_PLAN_MAX_DOFS or not (sp.issparse(A) and A.format == "csr" and A.has_canonical_format):
+        return False
+    plan = _band_plan(A, context)
+    return plan is not None and A.shape[0] * (plan["bw"] + 1.0) ** 2 <= BAND_AUTO_COST
+
+
+def _wants_blocks(full_tangent, free, method, symmetric, context, block_tangent=None):
+    """Whether the Newton systems go to AMG-CG as BSR node blocks: symmetric, whole free nodes,
+    and CG chosen by :func:`choose_linear_solver`.  ``full_tangent()`` gives the full stiffness
+    when the decision needs its pattern (mid sizes only); ``block_tangent()`` (optional) the free
+    node blocks or None: when their graph alone shows the band too wide, the full tangent is not
+    formed."""
+    if not (symmetric and method in ("auto", "cg") and context.get("dim") and "node_free" in context):
+        return False
+
+    def band_is_cheap():
+        Kb = block_tangent() if block_tangent is not None else None
+        if Kb is not None and _band_surely_wide({"bptr": Kb.indptr, "bind": Kb.indices}, context["dim"]):
+            return False
+        K_full = full_tangent()
+        entry = _bsr_entry(K_full, context["node_free"], context["dim"], context)
+        if entry is not None and _band_surely_wide(entry, context["dim"]):
+            return False
+        return _band_is_cheap(_submatrix(K_full, free, plans=context), context)
+
+    return choose_linear_solver(method, int(free.sum()), symmetric, band_is_cheap) == "cg"

@@ -1,0 +1,209 @@
+"""The stability limit of the explicit schemes and its check before a run."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .plans import _submatrix
+from .protocol import _free_mask
+
+
+def _mass_vector(problem):
+    m = np.asarray(getattr(problem, "mass"), dtype=float).reshape(-1)
+    if m.shape != (int(problem.n_dof),):
+        raise ValueError(f"problem.mass must have shape ({problem.n_dof},), got {m.shape}")
+    return m
+
+
+EXPLICIT_METHODS = ("symplectic_euler", "velocity_verlet")
+_EIG_TOL = 1e-4  # ARPACK's tolerance for omega_max^2: the Ritz residual is added (see below)
+
+
+def _omega_max_squared(problem, x, load: float = 1.0) -> float:
+    """Largest eigenvalue of ``M^-1 K`` on the free dofs at ``x`` (an estimate from above; see
+    :func:`explicit_stability_limit`).  0.0 when no eigenvalue is positive."""
+    free = _free_mask(problem)
+    m = _mass_vector(problem)[free]
+    if np.any(m <= 0):
+        raise ValueError("masses of free dofs must be positive")
+    K = _submatrix(problem.stiffness(np.asarray(x, dtype=float), load), free)
+    d = sp.diags(1.0 / np.sqrt(m))
+    A = sp.csr_matrix(d @ K @ d)
+    symmetric = bool(getattr(problem, "symmetric", True))
+    n = A.shape[0]
+    if n == 0:
+        return 0.0
+    if n <= 400:
+        dense = A.toarray()
+        lam = np.linalg.eigvalsh(0.5 * (dense + dense.T)).max() if symmetric else np.abs(np.linalg.eigvals(dense)).max()
+        return max(float(lam), 0.0)
+    v0 = np.random.default_rng(0).standard_normal(n)
+    try:
+        if symmetric:
+            w, V = spla.eigsh(A, k=1, which="LA", tol=_EIG_TOL, v0=v0)
+        else:
+            w, V = spla.eigs(A, k=1, which="LM", tol=_EIG_TOL, v0=v0)
+        v = V[:, 0] / np.linalg.norm(V[:, 0])
+        theta = w[0]
+        # the Ritz value is at most the top eigenvalue; with the norm of its residual added it is
+        # an upper bound when the Ritz pair approximates the top eigenpair (Lanczos from a random
+        # start: in practice always); the residual is at most _EIG_TOL * theta
+        res = float(np.linalg.norm(A @ v - theta * v))
+        lam = (float(theta.real) if symmetric else float(abs(theta))) + res
+    except (spla.ArpackNoConvergence, spla.ArpackError):
+        v = v0 / np.linalg.norm(v0)
+        lam = 0.0
+        for _ in range(500):
+            w = A @ v
+            lam_new = float(np.linalg.norm(w))
+            if lam_new == 0.0:
+                break
+            v = w / lam_new
+            if abs(lam_new - lam) <= 1e-8 * lam_new:
+                lam = lam_new
+                break
+            lam = lam_new
+        if symmetric:  # Rayleigh quotient plus residual
+            Av = A @ v
+            theta = float(v @ Av)
+            lam = max(lam, theta + float(np.linalg.norm(Av - theta * v)))
+    return max(float(lam), 0.0)
+
+
+def explicit_stability_limit(problem, x, load: float = 1.0) -> float:
+    """Critical time step ``2 / omega_max`` of the explicit schemes at state ``x`` (undamped).
+
+    ``omega_max^2`` is the largest eigenvalue of ``M^-1 K`` on the free dofs, computed as the
+    largest eigenvalue of ``M^-1/2 K M^-1/2``: dense for up to 400 free dofs (exact), else
+    Lanczos (ARPACK ``eigsh``, largest algebraic, relative tolerance 1e-4; ``eigs`` and the
+    largest modulus for a non-symmetric ``K``) with the residual norm of the Ritz pair added to
+    the Ritz value.  The Ritz value never exceeds the top eigenvalue, and with its residual
+    added it bounds it from above whenever the pair approximates the top eigenpair, which Lanczos
+    from a random start does in practice: the limit is then accurate to about 1e-4 and errs on
+    the safe (small) side (measured on Golec lattices of 3.6e3 to 1e5 dofs: 1e-7 to 2e-4 below the
+    exact value, 0.005 to 0.3 s).  Power iteration is the fallback.  Returns ``inf`` when no
+    eigenvalue is positive.  See :func:`critical_time_step` for the effect of damping.
+    """
+    lam = _omega_max_squared(problem, x, load)
+    return 2.0 / np.sqrt(lam) if lam > 0 else float("inf")
+
+
+def _spectral_radius(method, h, omega, alpha, beta):
+    """Spectral radius of the one-step map of the scheme ``method`` (as :func:`integrate` runs it)
+    on the mode ``u'' = -omega^2 u - (alpha + beta omega^2) u'`` (arrays broadcast)."""
+    h, w = np.broadcast_arrays(np.asarray(h, dtype=float), np.asarray(omega, dtype=float))
+    w2 = w * w
+    c = alpha + beta * w2
+    if method == "symplectic_euler":  # v+ = (1 - h c) v - h w2 x; x+ = x + h v+
+        a11, a12 = 1.0 - h * h * w2, h * (1.0 - h * c)
+        a21, a22 = -h * w2, 1.0 - h * c
+    else:  # velocity Verlet: explicit half-kick, drift, half-kick with beta at v_half, alpha implicit
+        hx, hv = -0.5 * h * w2, 1.0 - 0.5 * h * c  # v_half = hx x + hv v
+        a11, a12 = 1.0 + h * hx, h * hv  # x+ = x + h v_half
+        g = 1.0 / (1.0 + 0.5 * h * alpha)
+        a21 = g * (hx - 0.5 * h * w2 * a11 - 0.5 * h * beta * w2 * hx)
+        a22 = g * (hv - 0.5 * h * w2 * a12 - 0.5 * h * beta * w2 * hv)
+    tr, det = a11 + a22, a11 * a22 - a12 * a21
+    disc = np.sqrt((tr * tr - 4.0 * det).astype(complex))
+    return np.maximum(np.abs(0.5 * (tr + disc)), np.abs(0.5 * (tr - disc)))
+
+
+def critical_time_step(omega_max: float, method: str = "symplectic_euler", alpha: float = 0.0,
+                       beta: float = 0.0) -> float:
+    """Largest stable step of the explicit ``method`` (as :func:`integrate` runs it) for modal
+    frequencies up to ``omega_max`` with damping ``C = alpha M + beta K`` (modal damping
+    ``c = alpha + beta omega^2``).
+
+    * undamped, both schemes: ``2 / omega_max``;
+    * symplectic Euler (damping explicit): ``(sqrt(c^2 + 4 omega^2) - c) / omega^2`` at
+      ``omega_max``, below ``2 / omega_max`` for any damping (the top mode binds: the bound
+      decreases with omega);
+    * velocity Verlet: mass-proportional damping (implicit in the second half-kick) leaves
+      ``2 / omega_max`` unchanged; with ``beta > 0`` the limit is the first step at which any
+      mode up to ``omega_max`` (200 sampled) becomes unstable, found by a scan and bisection on
+      the modal amplification matrices, at most ``2 / omega_max`` (heavily overdamped top modes
+      can be stable beyond it, for a stable set that is not an interval; such steps are refused).
+    """
+    if method not in EXPLICIT_METHODS:
+        raise ValueError(f"method must be one of {EXPLICIT_METHODS}, got {method!r}")
+    omega = float(omega_max)
+    if not (omega > 0) or not np.isfinite(omega):
+        if omega == float("inf"):
+            return 0.0
+        # no stiffness: only the damping limits the step (symplectic Euler: h alpha < 2)
+        return 2.0 / alpha if method == "symplectic_euler" and alpha > 0 else float("inf")
+    undamped = 2.0 / omega
+    if alpha == 0.0 and beta == 0.0:
+        return undamped
+    if method == "symplectic_euler":
+        c = alpha + beta * omega * omega
+        # (sqrt(c^2 + 4 w^2) - c) / w^2, written without cancellation for large c
+        return 4.0 / (np.sqrt(c * c + 4.0 * omega * omega) + c)
+    if beta == 0.0:
+        return undamped
+    modes = omega * np.concatenate([np.geomspace(1e-3, 0.9, 100, endpoint=False), np.linspace(0.9, 1.0, 100)])
+
+    def stable(h):
+        return float(_spectral_radius(method, h, modes, alpha, beta).max()) <= 1.0 + 1e-12
+
+    hs = undamped * np.arange(1, 2001) / 2000.0
+    radius = _spectral_radius(method, hs[:, None], modes[None, :], alpha, beta).max(axis=1)
+    bad = np.flatnonzero(radius > 1.0 + 1e-12)
+    if len(bad) == 0:
+        return undamped
+    if bad[0] == 0:
+        lo, hi = 0.0, hs[0]
+    else:
+        lo, hi = hs[bad[0] - 1], hs[bad[0]]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+    return float(lo)
+
+
+def check_time_step(problem, x, dt: float, *, method: str = "symplectic_euler", damping=None,
+                    load: float = 1.0, allow_unstable: bool = False, omega_max: float | None = None) -> dict:
+    """The stability limit of an explicit run from state ``x`` (the model at rest, prescribed
+    displacements applied) and its check: raises :class:`msslib.errors.StabilityError` when
+    ``dt`` exceeds it, unless ``allow_unstable``.
+
+    Returns ``{"stability_limit", "stability_limit_undamped", "omega_max", "dt_over_limit"}``:
+    :func:`critical_time_step` of the damping (``None``: ``problem.damping``) at ``omega_max``
+    from :func:`explicit_stability_limit` (or ``omega_max`` if given: a value computed earlier
+    for the same state)."""
+    alpha, beta = _resolve_damping(problem, damping)
+    omega = float(np.sqrt(_omega_max_squared(problem, x, load))) if omega_max is None else float(omega_max)
+    limit = critical_time_step(omega, method, alpha, beta)
+    undamped = 2.0 / omega if omega > 0 else float("inf")
+    ratio = dt / limit if limit > 0 else float("inf")
+    info = {"stability_limit": float(limit), "stability_limit_undamped": float(undamped), "omega_max": omega,
+            "dt_over_limit": float(ratio)}
+    if ratio > 1.0 and not allow_unstable:
+        from msslib.errors import StabilityError
+
+        raise StabilityError(
+            f"{method}: time step dt = {dt:.7g} s is {ratio:.3g} x the explicit stability limit {limit:.7g} s "
+            f"of the model at rest ({_limit_origin(limit, undamped, omega)}): the run would diverge; "
+            f"use dt <= {limit:.7g} s or method implicit_euler (allow_unstable runs it anyway: "
+            f"solver.allow_unstable in a scene)")
+    return info
+
+
+def _limit_origin(limit, undamped, omega):
+    text = f"2/omega_max, omega_max = {omega:.6g} rad/s"
+    if limit < undamped * (1.0 - 1e-12):
+        text += f", lowered from {undamped:.6g} s by the damping"
+    return text
+
+
+def _resolve_damping(problem, damping):
+    if damping is None:
+        damping = getattr(problem, "damping", None)
+    if damping is None:
+        return 0.0, 0.0
+    if np.ndim(damping) == 0:
+        return float(damping), 0.0
+    alpha, beta = damping
+    return float(alpha), float(beta)
