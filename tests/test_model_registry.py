@@ -5,6 +5,7 @@ scene round trip; and the rectangle of any aspect ratio against the bilinear ele
 from __future__ import annotations
 
 import importlib
+import re
 
 import numpy as np
 import pytest
@@ -102,7 +103,10 @@ def test_baudet_readings_match_the_correction_module():
 @pytest.mark.parametrize("name", MSS)
 def test_spec_names_its_paper_and_generated_element(name):
     spec = SPECS[name]
-    assert spec.reference and (spec.doi or spec.hal)
+    # the citation: authors, title, venue and year; an identifier only where one is known for sure
+    assert spec.reference and re.search(r"(19|20)\d\d", spec.reference), spec.reference
+    assert spec.doi is None or re.fullmatch(r"10\.\d{4,}/\S+", spec.doi), spec.doi
+    assert spec.hal is None or re.fullmatch(r"(hal|inria)-\d{8}", spec.hal), spec.hal
     gen = importlib.import_module(f"msslib.generated.{spec.element}")
     assert callable(spec.parameters) and callable(spec.build)
     assert gen.__doc__

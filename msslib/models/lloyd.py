@@ -55,7 +55,8 @@ VALID_NU = {"lloyd_triangle": 1 / 3, "van_gelder_triangle": 1 / 3, "lloyd_square
 
 REFERENCE = ("B. A. Lloyd, G. Szekely, M. Harders, Identification of Spring Parameters for Deformable Object "
              "Simulation, IEEE TVCG 13(5), 2007")
-DOI = "10.1109/TVCG.2007.1055"
+# no DOI: none is printed in the available text, and an identifier is not written from memory
+DOI = None
 
 
 # --------------------------------------------------------------------------------------------
