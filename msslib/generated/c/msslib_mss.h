@@ -7,6 +7,7 @@
 #define MSSLIB_MSS_H
 
 #include "msslib_triangle.h"
+#include "msslib_triangle_angular.h"
 #include "msslib_square.h"
 #include "msslib_rectangle.h"
 #include "msslib_tetrahedron.h"
