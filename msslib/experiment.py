@@ -39,7 +39,7 @@ import numpy as np
 import yaml
 
 KEYS = {"name", "paper", "title", "section", "description", "scene", "cases", "models", "reference", "quick", "published"}
-PAPERS = ("lloyd", "baudet", "golec")
+PAPERS = ("lloyd", "baudet", "golec", "performance")  # performance: experiments of this project beyond the papers
 UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "%": 1e-2, "1": 1.0, "Pa": 1.0, "kPa": 1e3, "s": 1.0, "m^3": 1.0, "cm^3": 1e-6}
 METRICS = ("mean", "std", "max")
 

@@ -42,15 +42,15 @@ HERE = Path(__file__).resolve().parent
 LONG = 2.0  # s: runs longer than this are timed once
 BUDGET = 75.0  # s of CPU time after which a run is stopped (and recorded as such)
 
-MSS = {"triangle": ["lloyd_triangle", "van_gelder"], "tetra": ["lloyd_tetrahedron", "lloyd_tetrahedron_volume"],
-       "hexahedron": ["baudet_cube", "golec_cube"], "quad": ["lloyd_square"]}
 LAW = {"triangle": "fem_svk", "quad": "fem_svk", "tetra": "fem_neohookean", "hexahedron": "fem_neohookean"}
 
 
 def variants(cell_type):
     """(name, model, linear) of every variant of a cell type."""
+    from msslib.models import for_cells
+
     out = []
-    for m in MSS[cell_type]:
+    for m in for_cells(cell_type, kind="mss"):  # every registered mass-spring model of these cells
         out += [(m, m, False), (f"{m}_linear", m, True)]
     return out + [("fem_linear", "fem_linear", False), (LAW[cell_type], LAW[cell_type], False)]
 
