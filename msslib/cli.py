@@ -455,12 +455,12 @@ def _add_export(subparsers) -> None:
 def _cmd_export(args) -> int:
     import warnings
 
-    from msslib import export
+    from msslib import export, export_files
     from msslib.errors import MsslibWarning
     from msslib.io import StagedOutputs
 
     try:
-        formats = export.parse_formats(args.formats)
+        formats = export_files.parse_formats(args.formats)
     except ValueError as exc:
         raise CommandError(_one_line(exc)) from None
     scene_path = Path(args.scene)
@@ -473,9 +473,9 @@ def _cmd_export(args) -> int:
     if directory and out.exists() and not out.is_dir():
         raise CommandError(f"--out {str(args.out)!r} is not a directory")
     exp = export.build(scene)
-    chosen = formats if formats is not None else export.default_formats(exp)
-    stem = export.stem_for(out, scene.name, directory)
-    planned = export.output_paths(exp, stem, chosen)
+    chosen = formats if formats is not None else export_files.default_formats(exp)
+    stem = export_files.stem_for(out, scene.name, directory)
+    planned = export_files.output_paths(exp, stem, chosen)
     inputs = [("scene file", scene_path), *_mesh_input(scene)]
     if "c" in chosen:
         inputs.append(("generated C header", export.C_HEADER_PATH))
@@ -499,7 +499,7 @@ def _cmd_export(args) -> int:
         out.mkdir(parents=True, exist_ok=True)
     with StagedOutputs() as staged:  # every file, or none
         for fmt, what, path, table in planned:
-            staged.write(path, export.file_writer(exp, fmt, table), what=what)
+            staged.write(path, export_files.file_writer(exp, fmt, table), what=what)
     if not args.quiet:
         extra = f", {'; '.join(exp.volume_terms)}" if exp.volume_terms else ""
         print(f"{scene.name}: {scene.model}, {exp.n_nodes} nodes, {len(exp.pairs)} springs{extra} -> "

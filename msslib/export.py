@@ -12,16 +12,16 @@ displacements, the loads and gravity. The writers turn it into
     loads at load factor 1), ``gravity``, and when the model has them ``tet_volume`` (Lloyd),
     ``hex_volume`` (Golec), ``baudet_correction`` (factor and face forces per cell) and
     ``baudet_correction_forces`` (the nodal forces it adds at load factor 1). Node indices are
-    0-based. Floats are written with ``repr`` (they read back bit for bit): :func:`read_csv`.
+    0-based. Floats are written with ``repr`` (they read back bit for bit): :func:`msslib.export_text.read_csv`.
 ``json``
     One document with the same tables, a schema name and version (:data:`SCHEMA`,
-    :data:`SCHEMA_VERSION`), the units, the energy of every term, the scene text: :func:`read_json`.
+    :data:`SCHEMA_VERSION`), the units, the energy of every term, the scene text: :func:`msslib.export_text.read_json`.
 ``vtu``
     The springs as line cells (cell data ``stiffness``, ``rest_length``) on the rest positions,
     with the point data ``mass``, ``fixed``, ``prescribed_displacement``, ``load`` (and
     ``baudet_correction``): for ParaView. The volume terms are in the tables only.
 ``mjcf``
-    A MuJoCo model (:func:`mjcf_text`): one body per node with a slide joint per free axis (a node
+    A MuJoCo model (:func:`msslib.export_simulators.mjcf_text`): one body per node with a slide joint per free axis (a node
     fixed on every axis has none: it is welded to the world; prescribed displacements move the
     body), its mass as a point mass, a site at the node; one spatial tendon per spring between the
     two sites with ``stiffness`` = k and ``springlength`` = the rest length, i.e. the force
@@ -30,7 +30,7 @@ displacements, the loads and gravity. The writers turn it into
     with a constant affine bias on the joints; mass-proportional damping ``alpha`` as joint damping
     ``alpha m``. Volume terms cannot be expressed: an XML comment and the command say so.
 ``sofa``
-    A SOFA scene (:func:`sofa_text`, ``.scn`` XML) made only of the components and attributes of
+    A SOFA scene (:func:`msslib.export_simulators.sofa_text`, ``.scn`` XML) made only of the components and attributes of
     :data:`SOFA_COMPONENTS`: MechanicalObject, DiagonalMass (``vertexMass``), SpringForceField
     (``spring``: ``i j ks kd L`` per spring), Fixed/PartialFixedProjectiveConstraint,
     ConstantForceField, StaticSolver (static scenes) or EulerImplicitSolver (dynamic scenes,
@@ -40,25 +40,21 @@ displacements, the loads and gravity. The writers turn it into
     header per derivation module (``msslib_<module>.h``: its spring-constant formulas, or the energy,
     gradient and Hessian kernels), all copied beside the outputs (:func:`c_header_paths`).
 
-Units are SI throughout.
+Units are SI throughout. The writers are in :mod:`msslib.export_text` (CSV, JSON, VTU) and
+:mod:`msslib.export_simulators` (MuJoCo, SOFA); :mod:`msslib.export_files` chooses formats and
+file names and hands each output its writer.
 """
 
 from __future__ import annotations
 
-import csv
-import io
-import json
-import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["FORMATS", "SPRINGS_ONLY_FORMATS", "SCHEMA", "SCHEMA_VERSION",
-           "C_HEADER_PATH", "c_header_paths", "Column", "Table", "MssExport", "build", "from_setup", "parse_formats", "default_formats",
-           "not_carried", "output_paths", "stem_for", "file_writer", "csv_text", "read_csv", "json_document",
-           "json_text", "read_json", "write_vtu"]
+__all__ = ["FORMATS", "SPRINGS_ONLY_FORMATS", "SCHEMA", "SCHEMA_VERSION", "C_HEADER_PATH", "c_header_paths", "Column",
+           "Table", "MssExport", "build", "from_setup", "not_carried"]
 
 #: every format, in the order outputs are written
 FORMATS = ("csv", "json", "vtu", "mjcf", "sofa", "c")
@@ -338,30 +334,8 @@ def _tables(exp: MssExport) -> dict[str, Table]:
 
 
 # --------------------------------------------------------------------------------------------
-# formats and file names
+# shared by the writers
 # --------------------------------------------------------------------------------------------
-
-
-def parse_formats(text: str | None) -> tuple[str, ...] | None:
-    """``"csv,mjcf"`` -> ``("csv", "mjcf")`` in :data:`FORMATS` order; None for None (the default).
-    ValueError naming an unknown or repeated format."""
-    if text is None:
-        return None
-    items = [s.strip() for s in text.split(",")]
-    if not text.strip() or any(not s for s in items):
-        raise ValueError(f"--format {text!r}: give formats separated by commas, from {','.join(FORMATS)}")
-    for s in items:
-        if s not in FORMATS:
-            raise ValueError(f"--format {text!r}: {s!r} is not a format; expected some of {','.join(FORMATS)}")
-        if items.count(s) > 1:
-            raise ValueError(f"--format {text!r}: {s!r} is given twice")
-    return tuple(f for f in FORMATS if f in items)
-
-
-def default_formats(exp: MssExport) -> tuple[str, ...]:
-    """Every format that carries the whole model: MuJoCo and SOFA only without volume terms."""
-    return tuple(f for f in FORMATS if not (f in SPRINGS_ONLY_FORMATS and exp.volume_terms))
-
 
 def not_carried(exp: MssExport, fmt: str) -> list[str]:
     """What of the model ``fmt`` leaves out (an empty list: all of it)."""
@@ -382,188 +356,10 @@ def _safe_name(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "scene"
 
 
-def output_paths(exp: MssExport, stem: Path, formats) -> list[tuple[str, str, Path, str | None]]:
-    """``(format, what, path, table)`` of every file the formats write (``table``: the table of a
-    CSV file, else None), ``stem`` the path prefix: CSV ``STEM_TABLE.csv``, JSON ``STEM.json``, VTU
-    ``STEM.vtu``, MuJoCo ``STEM_mujoco.xml``, SOFA ``STEM.scn``, C ``msslib_mss.h`` and the headers it
-    includes in the stem's directory (``table``: the header's file name)."""
-    stem = Path(stem)
-    out = []
-    for fmt in formats:
-        if fmt == "csv":
-            out += [("csv", f"CSV table {name}", stem.with_name(f"{stem.name}_{name}.csv"), name)
-                    for name in exp.tables()]
-        elif fmt == "json":
-            out.append(("json", "JSON document", stem.with_name(f"{stem.name}.json"), None))
-        elif fmt == "vtu":
-            out.append(("vtu", "VTU file", stem.with_name(f"{stem.name}.vtu"), None))
-        elif fmt == "mjcf":
-            out.append(("mjcf", "MuJoCo model", stem.with_name(f"{stem.name}_mujoco.xml"), None))
-        elif fmt == "sofa":
-            out.append(("sofa", "SOFA scene", stem.with_name(f"{stem.name}.scn"), None))
-        elif fmt == "c":
-            out += [("c", f"C header {p.name}", stem.with_name(p.name), p.name) for p in c_header_paths()]
-        else:
-            raise ValueError(f"unknown format {fmt!r}")
-    return out
-
-
-def file_writer(exp: MssExport, fmt: str, table: str | None = None):
-    """``writer(path)`` that writes one output of ``fmt`` (for :class:`msslib.io.StagedOutputs`,
-    which then names the destination in any error)."""
-    def text(make):
-        def write(path):
-            Path(path).write_text(make(), encoding="utf-8")
-        return write
-
-    if fmt == "csv":
-        return text(lambda: csv_text(exp.tables()[table]))
-    if fmt == "json":
-        return text(lambda: json_text(exp))
-    if fmt == "vtu":
-        return lambda path: write_vtu(path, exp)
-    if fmt in ("mjcf", "sofa"):
-        from . import export_simulators
-
-        make = export_simulators.mjcf_text if fmt == "mjcf" else export_simulators.sofa_text
-        return text(lambda: make(exp))
-    if fmt == "c":
-        return text(lambda: (C_HEADER_PATH.parent / (table or C_HEADER_PATH.name)).read_text(encoding="utf-8"))
-    raise ValueError(f"unknown format {fmt!r}")
-
-
-def stem_for(out: Path, scene_name: str, directory: bool) -> Path:
-    """The path prefix of the outputs: ``out / NAME`` in a directory, else ``out`` itself."""
-    return Path(out) / _safe_name(scene_name) if directory else Path(out)
-
-
-# --------------------------------------------------------------------------------------------
-# CSV and JSON
-# --------------------------------------------------------------------------------------------
-
-
-def _cell(v) -> str:
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    v = float(v)
-    if not math.isfinite(v):
-        raise ValueError(f"cannot export the non-finite value {v!r}")
-    return repr(v)
-
-
-def csv_text(table: Table) -> str:
-    """A table as CSV: a header row ``name [unit]``, one row per entry, floats by ``repr``."""
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow([c.header for c in table.columns])
-    cols = [c.values.tolist() for c in table.columns]
-    for row in zip(*cols):
-        w.writerow([_cell(v) for v in row])
-    return buf.getvalue()
-
-
-_HEADER = re.compile(r"^(?P<name>[^\[\]]+?)(?: \[(?P<unit>[^\[\]]+)\])?$")
-
-
-def read_csv(path, name: str | None = None) -> Table:
-    """Read a table written by :func:`csv_text` (integer columns as ints, the rest as floats)."""
-    path = Path(path)
-    with open(path, newline="", encoding="utf-8") as f:
-        rows = list(csv.reader(f))
-    if not rows:
-        raise ValueError(f"{path}: empty CSV file, expected a header row")
-    columns = []
-    for j, head in enumerate(rows[0]):
-        m = _HEADER.match(head)
-        if m is None:
-            raise ValueError(f"{path}: column header {head!r} is not 'name [unit]'")
-        raw = [r[j] for r in rows[1:]]
-        is_int = all(re.fullmatch(r"-?\d+", s) for s in raw) and (m["unit"] is None)
-        values = np.array([int(s) for s in raw], dtype=np.int64) if is_int else np.array([float(s) for s in raw])
-        columns.append(Column(m["name"], m["unit"], values))
-    return Table(name or path.stem, "", columns)
-
-
-def json_document(exp: MssExport) -> dict:
-    """The export as one JSON-able document (see the module docstring)."""
-    scene = exp.scene
-    terms = [{"kind": "springs", "count": int(len(exp.pairs)), "table": "springs",
-              "energy": "k/2 (|x_j - x_i| - L)^2", "conservative": True, "scales_with_load": False}]
-    if exp.tet_volume is not None:
-        terms.append({"kind": "tet_volume", "count": len(exp.tet_volume), "table": "tet_volume",
-                      "energy": "k_v/(2 V0^2) (V - V0)^2, V signed tetrahedron volume", "conservative": True,
-                      "scales_with_load": False})
-    if exp.hex_volume is not None:
-        terms.append({"kind": "hex_volume", "count": len(exp.hex_volume), "table": "hex_volume",
-                      "energy": "kappa/(2 V0) (V - V0)^2, V averaged-edge-vector hexahedron volume",
-                      "conservative": True, "scales_with_load": False})
-    if exp.correction is not None:
-        terms.append({"kind": "baudet_correction", "count": int(len(exp.correction.factor)),
-                      "table": "baudet_correction", "forces_table": "baudet_correction_forces",
-                      "energy": None, "conservative": False, "scales_with_load": True})
-    tables = {}
-    for name, t in exp.tables().items():
-        tables[name] = {"description": t.description,
-                        "columns": [{"name": c.name, "unit": c.unit, "description": c.description,
-                                     "values": c.values.tolist()} for c in t.columns]}
-    opts = {k: (list(v) if isinstance(v, tuple) else v) for k, v in scene.model_options.items()}
-    return {
-        "schema": SCHEMA, "schema_version": SCHEMA_VERSION,
-        "generator": f"msslib {_version()}",
-        "scene": {"name": scene.name, "description": scene.description, "model": scene.model,
-                  "model_options": opts, "solver": _plain(scene.solver), "text": scene.text},
-        "dim": exp.dim, "index_base": 0, "units": UNITS,
-        "n_nodes": exp.n_nodes, "mass_source": exp.mass_source,
-        "gravity": None if exp.gravity is None else exp.gravity.tolist(),
-        "load_factor": 1.0,
-        "damping": {"alpha": exp.damping[0], "beta": exp.damping[1],
-                    "meaning": "Rayleigh damping C = alpha M + beta K of a dynamic scene (0 for static scenes)"},
-        "terms": terms, "tables": tables,
-    }
-
-
-def _plain(value):
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
-
 def _version() -> str:
     from msslib import __version__
 
     return __version__
-
-
-def json_text(exp: MssExport) -> str:
-    return json.dumps(json_document(exp), indent=1, allow_nan=False) + "\n"
-
-
-def read_json(path) -> tuple[dict, dict[str, Table]]:
-    """``(document, tables)`` of a JSON export; ValueError if it is not one of this schema."""
-    doc = json.loads(Path(path).read_text(encoding="utf-8"))
-    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
-        raise ValueError(f"{path}: not an {SCHEMA} document")
-    if doc.get("schema_version") != SCHEMA_VERSION:
-        raise ValueError(f"{path}: schema version {doc.get('schema_version')!r}, this msslib reads {SCHEMA_VERSION}")
-    tables = {}
-    for name, t in doc["tables"].items():
-        cols = []
-        for c in t["columns"]:
-            v = c["values"]
-            arr = np.array(v, dtype=np.int64) if all(isinstance(x, int) for x in v) and c["unit"] is None \
-                else np.array(v, dtype=float)
-            cols.append(Column(c["name"], c["unit"], arr, c.get("description", "")))
-        tables[name] = Table(name, t.get("description", ""), cols)
-    return doc, tables
-
-
-# --------------------------------------------------------------------------------------------
-# VTU
-# --------------------------------------------------------------------------------------------
 
 
 def _pad3(a):
@@ -571,31 +367,3 @@ def _pad3(a):
     if a.ndim == 2 and a.shape[1] < 3:
         a = np.hstack([a, np.zeros((len(a), 3 - a.shape[1]), dtype=a.dtype)])
     return a
-
-
-def write_vtu(path, exp: MssExport) -> Path:
-    """The springs as VTK line cells with cell data ``stiffness`` (N/m) and ``rest_length`` (m), on
-    the rest positions, with point data ``mass`` (kg), ``fixed`` (0/1 per axis),
-    ``prescribed_displacement`` (m), ``load`` (N) and ``baudet_correction`` (N, when present)."""
-    import meshio
-
-    point_data = {"mass": exp.masses, "fixed": _pad3(exp.fixed.astype(np.int8)),
-                  "prescribed_displacement": _pad3(exp.prescribed), "load": _pad3(exp.loads)}
-    if exp.correction is not None:
-        point_data["baudet_correction"] = _pad3(exp.correction.nodal)
-    mesh = meshio.Mesh(_pad3(exp.points), [("line", exp.pairs.astype(np.int64))], point_data=point_data,
-                       cell_data={"stiffness": [exp.stiffness], "rest_length": [exp.rest_length]})
-    meshio.write(path, mesh, file_format="vtu")
-    return Path(path)
-
-
-# the simulator formats (MuJoCo, SOFA) live in msslib.export_simulators; their names are kept here
-_SIMULATOR_NAMES = ("SOFA_COMPONENTS", "SOFA_TARGET", "time_step", "mjcf_text", "sofa_text")
-
-
-def __getattr__(name):
-    if name in _SIMULATOR_NAMES:
-        from . import export_simulators
-
-        return getattr(export_simulators, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

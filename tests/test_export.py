@@ -28,7 +28,7 @@ import pytest
 import yaml
 
 from derivations import codegen, registry
-from msslib import cli, export, export_simulators
+from msslib import cli, export, export_files, export_simulators, export_text
 from msslib.solvers import static_solve
 from msslib.terms import BaudetCorrection, HexVolume, Springs, TetVolume
 
@@ -114,11 +114,11 @@ def test_csv_and_json_round_trip_equal_the_model(tmp_path, capsys):
     springs = _springs(model)
     (hexv,) = [t for t in model.terms if isinstance(t, HexVolume)]
     out = tmp_path / "out"
-    csv_tables = {name: export.read_csv(out / f"golec_beam_{name}.csv", name)
+    csv_tables = {name: export_text.read_csv(out / f"golec_beam_{name}.csv", name)
                   for name in ("nodes", "springs", "fixed", "loads", "gravity", "hex_volume")}
     assert sorted(p.name for p in out.iterdir()) == sorted(
         [f"golec_beam_{n}.csv" for n in csv_tables] + ["golec_beam.json"])
-    doc, json_tables = export.read_json(out / "golec_beam.json")
+    doc, json_tables = export_text.read_json(out / "golec_beam.json")
     assert doc["schema"] == export.SCHEMA and doc["schema_version"] == export.SCHEMA_VERSION
     assert doc["units"]["stiffness"] == "N/m" and doc["index_base"] == 0 and doc["dim"] == 3
     assert doc["gravity"] == [0.0, 0.0, -9.81]
@@ -150,7 +150,7 @@ def test_csv_and_json_round_trip_equal_the_model(tmp_path, capsys):
 @pytest.mark.parametrize("scene", [SQUARE, BAUDET, LLOYD_TET], ids=lambda s: s["name"])
 def test_tables_carry_every_term(scene, tmp_path):
     exp = export.build(_scene_file(tmp_path, scene))
-    tables = {name: export.read_csv(_write(tmp_path / f"{name}.csv", export.csv_text(t)), name)
+    tables = {name: export_text.read_csv(_write(tmp_path / f"{name}.csv", export_text.csv_text(t)), name)
               for name, t in exp.tables().items()}
     springs = _springs(exp.model)
     np.testing.assert_array_equal(tables["springs"]["stiffness"], springs.k)
@@ -508,7 +508,7 @@ def test_all_outputs_or_none(tmp_path, capsys, monkeypatch):
         raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(export_simulators, "sofa_text", fail)
-    monkeypatch.setattr(export, "json_text", lambda e: '{"changed": true}\n')
+    monkeypatch.setattr(export_text, "json_text", lambda e: '{"changed": true}\n')
     code, err = _cli(capsys, "export", scene, "--out", f"{out}/", "--format", "csv,json,sofa")
     _assert_one_error_line(code, err, "baudet_bar.scn")
     assert _snapshot(out) == before  # the JSON written before the failure was not put in place
@@ -537,10 +537,10 @@ def test_python_api_without_files():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         exp = export.build(LLOYD_TET)
-    assert export.default_formats(exp) == ("csv", "json", "vtu", "c")
+    assert export_files.default_formats(exp) == ("csv", "json", "vtu", "c")
     assert export.not_carried(exp, "mjcf") and not export.not_carried(exp, "json")
-    assert export.parse_formats("c,csv") == ("csv", "c")
-    assert os.path.basename(export.output_paths(exp, Path("a/b"), ("mjcf",))[0][2]) == "b_mujoco.xml"
+    assert export_files.parse_formats("c,csv") == ("csv", "c")
+    assert os.path.basename(export_files.output_paths(exp, Path("a/b"), ("mjcf",))[0][2]) == "b_mujoco.xml"
 
 
 def test_dynamic_scene_damping_and_time_step(tmp_path, capsys):

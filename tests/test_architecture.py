@@ -1,0 +1,97 @@
+"""The shape of the code: imports go one way (derivations -> generated -> msslib -> experiments ->
+paper), no module imports one that imports it back (function-level imports included), and no
+hand-written source file is over 600 lines."""
+
+from __future__ import annotations
+
+import ast
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("derivations", "msslib", "experiments", "benchmarks")
+#: what each package may import (besides itself); msslib.paper renders the paper and its notebooks
+ALLOWED = {"derivations": set(), "msslib": {"derivations"}, "experiments": {"msslib", "derivations"},
+           "benchmarks": {"msslib", "derivations", "experiments"}}
+
+
+def _modules():
+    mods = {}
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            if "generated" in path.parts and package == "msslib":
+                continue
+            name = ".".join(path.relative_to(ROOT).with_suffix("").parts).removesuffix(".__init__")
+            mods[name] = path
+    return mods
+
+
+def _imports(name, path, mods):
+    package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            base = package
+            for _ in range(max(node.level - 1, 0)):
+                base = base.rsplit(".", 1)[0]
+            full = (base + ("." + node.module if node.module else "")) if node.level else (node.module or "")
+            candidates = [full] + [f"{full}.{a.name}" for a in node.names]
+        elif isinstance(node, ast.Import):
+            candidates = [a.name for a in node.names]
+        else:
+            continue
+        for c in candidates:
+            while c and c not in mods:
+                c = c.rsplit(".", 1)[0] if "." in c else ""
+            if c and c != name and not name.startswith(c + "."):
+                out.add(c)
+    return out
+
+
+def test_imports_go_one_way():
+    mods = _modules()
+    bad = [(m, d) for m, p in mods.items() for d in _imports(m, p, mods)
+           if d.split(".")[0] != m.split(".")[0] and d.split(".")[0] not in ALLOWED[m.split(".")[0]]]
+    assert not bad, bad
+
+
+def test_no_import_cycles():
+    mods = _modules()
+    graph = {m: _imports(m, p, mods) for m, p in mods.items()}
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 10000))
+    index, low, stack, on, cycles = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                cycles.append(sorted(component))
+
+    for v in graph:
+        if v not in index:
+            visit(v)
+    assert not cycles, cycles
+
+
+@pytest.mark.parametrize("package", PACKAGES + ("tests",))
+def test_no_hand_written_file_over_600_lines(package):
+    long = [(str(p.relative_to(ROOT)), n) for p in (ROOT / package).rglob("*.py")
+            if "generated" not in p.parts and (n := len(p.read_text(encoding="utf-8").splitlines())) > 600]
+    assert not long, long
