@@ -55,6 +55,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import re
 import subprocess
@@ -67,6 +68,8 @@ PLACEHOLDER = re.compile(r"\{\{\s*(include|figure|value)\s+(.*?)\s*\}\}", re.S)
 #: a claim, matched after the other placeholders (including those in its text) are filled
 CLAIM = re.compile(r"\{\{\s*claim\s+(.*?)\s*\}\}", re.S)
 #: {{expr EXPRESSION | FMT}}: a number computed from result values (expanded before the claims)
+#: what a {{value}} shows for a number that the reduced quick build does not compute
+QUICK_NA = "n/a (quick build)"
 EXPR = re.compile(r"\{\{\s*expr\s+(.*?)\s*\}\}", re.S)
 #: a result value in a claim's condition: ``[FILE VAR DIM=LABEL ...]``
 CLAIM_VALUE = re.compile(r"\[([^\[\]]+)\]")
@@ -134,6 +137,10 @@ def _value(root: Path, spec: str) -> str:
             val = float(ds.attrs[var])
         else:
             raise KeyError(f"{{{{value {spec}}}}}: {var!r} is neither a variable nor an attribute of {parts[0]}")
+    if not math.isfinite(val):
+        if _is_quick(path):  # a quantity the reduced quick build does not compute
+            return QUICK_NA
+        raise ValueError(f"{{{{value {spec}}}}}: the result is {val} (a number the paper needs is missing)")
     return format(val * scale, fmt)
 
 
@@ -201,7 +208,8 @@ def _compute(root: Path, expression: str, kind: str):
             raise ValueError(f"{{{{{kind} {expression}}}}}: [{spec}]: expected [FILE VAR DIM=LABEL ...]")
         files.append(root / parts[0])
         key = f"_v{len(values)}"
-        values[key] = float(_value(root, spec + " fmt=.17g"))
+        text = _value(root, spec + " fmt=.17g")
+        values[key] = math.nan if text == QUICK_NA else float(text)
         return key
 
     try:
@@ -217,9 +225,13 @@ def _compute(root: Path, expression: str, kind: str):
 def _expr(root: Path, arg: str) -> str:
     """The value of an arithmetic expression of result values, formatted (default ``.3g``)."""
     expression, _, fmt = (s.strip() for s in arg.partition("|"))
-    value, _, _ = _compute(root, expression, "expr")
+    value, _, files = _compute(root, expression, "expr")
     if isinstance(value, bool):
         raise ValueError(f"{{{{expr {expression}}}}}: a comparison, not a number (write it as a claim)")
+    if not math.isfinite(value):
+        if any(_is_quick(f) for f in files):
+            return QUICK_NA
+        raise ValueError(f"{{{{expr {expression}}}}}: the result is {value}")
     return format(value, fmt or ".3g")
 
 

@@ -7,6 +7,7 @@ import importlib.util
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from derivations import report
@@ -276,6 +277,24 @@ def test_expr_is_a_number_or_an_error(tmp_path, expression):
     source = make_paper(tmp_path, f"{{{{expr {expression}}}}}\n")
     with pytest.raises(ValueError):
         paper.fill(source, tmp_path / "paper" / "build" / "paper.md")
+
+
+def test_a_missing_number_fails_the_build_but_not_the_quick_build(tmp_path):
+    import xarray as xr
+
+    source = make_paper(tmp_path, "x = {{value results/demo.nc E_error level=eps10}}, "
+                                  "d = {{expr [results/demo.nc E_error level=eps10] * 2}}\n")
+    path = tmp_path / "results" / "demo.nc"
+    with xr.open_dataset(path) as ds:
+        ds = ds.load()
+    ds["E_error"][:] = np.nan
+    ds.to_netcdf(path)
+    with pytest.raises(ValueError, match="missing"):
+        paper.fill(source, tmp_path / "paper" / "build" / "paper.md")
+    ds.attrs["quick"] = 1
+    ds.to_netcdf(path)
+    text = paper.fill(source, tmp_path / "paper" / "build" / "paper.md").read_text(encoding="utf-8")
+    assert f"x = {paper.QUICK_NA}, d = {paper.QUICK_NA}" in text
 
 
 def test_false_claim_on_quick_results_is_marked(tmp_path):
