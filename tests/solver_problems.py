@@ -137,3 +137,21 @@ class Circulatory:
 def hardening_stretch(k, k3, force):
     roots = np.roots([k3, 0.0, k, -force]) if k3 else np.array([force / k])
     return float(np.real(roots[np.argmin(np.abs(roots.imag))]))
+
+
+def lattice_system(n=8):
+    """The free-dof block matrix of a clamped Golec lattice of n^3 cubes at a perturbed state, its
+    rigid-body modes and the solver context (the AMG and speed-path tests' system)."""
+    from msslib import mesh as M
+    from msslib.model import Model, golec_cube_springs
+    from msslib.solvers import _rigid_body_modes, _solver_context, _submatrix_bsr
+
+    mesh = M.hex_grid(0.01 * n, 0.01 * n, 0.01 * n, n, n, n)
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    fixed[mesh.points[:, 2] < 1e-12] = True
+    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
+    x = model.x0 + 2e-4 * np.random.default_rng(7).standard_normal(model.n_dof)
+    ctx = _solver_context(model, x, model.free)
+    A = _submatrix_bsr(model.stiffness(x), ctx["node_free"], 3)
+    A.sort_indices()
+    return A, _rigid_body_modes(ctx["coords"], 3), ctx

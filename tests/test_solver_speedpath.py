@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from solver_problems import lattice_system
 
 
 def _pools_or_skip():
@@ -96,20 +97,7 @@ def _spd_update(A, factor=1.5):
     return sp.bsr_matrix(A + sp.block_diag(list((factor - 1.0) * D)).tobsr(blocksize=A.blocksize))
 
 
-def _lattice(n=8):
-    from msslib import mesh as M
-    from msslib.model import Model, golec_cube_springs
-    from msslib.solvers import _rigid_body_modes, _solver_context, _submatrix_bsr
-
-    mesh = M.hex_grid(0.01 * n, 0.01 * n, 0.01 * n, n, n, n)
-    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
-    fixed[mesh.points[:, 2] < 1e-12] = True
-    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
-    x = model.x0 + 2e-4 * np.random.default_rng(7).standard_normal(model.n_dof)
-    ctx = _solver_context(model, x, model.free)
-    A = _submatrix_bsr(model.stiffness(x), ctx["node_free"], 3)
-    A.sort_indices()
-    return A, _rigid_body_modes(ctx["coords"], 3), ctx
+_lattice = lattice_system
 
 
 @pytest.mark.parametrize("single", [False, True])

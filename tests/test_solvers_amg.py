@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from solver_problems import lattice_system
 
 from msslib.solvers import (
     static_solve,
@@ -16,19 +17,7 @@ from msslib.solvers import (
 # ---------------------------------------------------------------------------------------------
 
 
-def _lattice_system(n=8):
-    from msslib import mesh as M
-    from msslib.model import Model, golec_cube_springs
-    from msslib.solvers import _rigid_body_modes, _solver_context, _submatrix_bsr
-
-    mesh = M.hex_grid(0.01 * n, 0.01 * n, 0.01 * n, n, n, n)
-    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
-    fixed[mesh.points[:, 2] < 1e-12] = True
-    model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
-    x = model.x0 + 2e-4 * np.random.default_rng(7).standard_normal(model.n_dof)
-    ctx = _solver_context(model, x, model.free)
-    A = _submatrix_bsr(model.stiffness(x), ctx["node_free"], 3)
-    return A, _rigid_body_modes(ctx["coords"], 3), ctx
+_lattice_system = lattice_system
 
 
 def test_block_jacobi_radius_is_the_largest_eigenvalue():
