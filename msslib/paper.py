@@ -137,7 +137,7 @@ def _value(root: Path, spec: str) -> str:
             val = float(ds.attrs[var])
         else:
             raise KeyError(f"{{{{value {spec}}}}}: {var!r} is neither a variable nor an attribute of {parts[0]}")
-    if not math.isfinite(val):
+    if math.isnan(val):  # (infinity is a value: e.g. a budget with no upper end)
         if _is_quick(path):  # a quantity the reduced quick build does not compute
             return QUICK_NA
         raise ValueError(f"{{{{value {spec}}}}}: the result is {val} (a number the paper needs is missing)")
@@ -228,7 +228,7 @@ def _expr(root: Path, arg: str) -> str:
     value, _, files = _compute(root, expression, "expr")
     if isinstance(value, bool):
         raise ValueError(f"{{{{expr {expression}}}}}: a comparison, not a number (write it as a claim)")
-    if not math.isfinite(value):
+    if math.isnan(value):
         if any(_is_quick(f) for f in files):
             return QUICK_NA
         raise ValueError(f"{{{{expr {expression}}}}}: the result is {value}")
