@@ -10,6 +10,8 @@ Placeholders (in ``paper/*.md.in`` and the files they include):
 ``{{value FILE VAR [DIM=LABEL ...] [scale=S] [fmt=F]}}``
     a number read from the NetCDF result ``FILE`` (relative to the project root): variable or
     attribute ``VAR``, selected by labels, multiplied by ``S``, formatted with ``F`` (default .3g);
+``{{notebooks}}``
+    links to the executed notebook page of every derivation module (from the derivation registry);
 ``{{expr EXPRESSION [| FMT]}}``
     a number computed from result values, e.g. a difference or a ratio: ``EXPRESSION`` is
     arithmetic as in a claim's condition (below), formatted with ``FMT`` (default .3g);
@@ -68,6 +70,8 @@ PLACEHOLDER = re.compile(r"\{\{\s*(include|figure|value)\s+(.*?)\s*\}\}", re.S)
 #: a claim, matched after the other placeholders (including those in its text) are filled
 CLAIM = re.compile(r"\{\{\s*claim\s+(.*?)\s*\}\}", re.S)
 #: {{expr EXPRESSION | FMT}}: a number computed from result values (expanded before the claims)
+#: {{notebooks}}: links to the notebook page of every derivation module that generates code
+NOTEBOOKS = re.compile(r"\{\{\s*notebooks\s*\}\}")
 #: what a {{value}} shows for a number that the reduced quick build does not compute
 QUICK_NA = "n/a (quick build)"
 EXPR = re.compile(r"\{\{\s*expr\s+(.*?)\s*\}\}", re.S)
@@ -251,6 +255,18 @@ def _claim(root: Path, arg: str) -> str:
                      + (f"; text: {text!r}" if text else ""))
 
 
+def _notebook_links(root: Path) -> str:
+    """``[title](derivations/<name>.html)`` for every module the derivation registry generates code
+    from, titled as in ``paper/derivations.json``; the pages are built beside the paper."""
+    import json
+
+    from derivations import registry
+
+    titles = json.loads((root / "paper" / "derivations.json").read_text(encoding="utf-8"))
+    links = [f"[{titles.get(name, {}).get('title', name)}](derivations/{name}.html)" for name in registry.generated()]
+    return "; ".join(links)
+
+
 def _figure(paper_dir: Path, arg: str) -> str:
     name, _, caption = (s.strip() for s in arg.partition("|"))
     if not (paper_dir / "figures" / f"{name}.png").is_file():
@@ -278,6 +294,7 @@ def expand(text: str, paper_dir: Path, root: Path, depth: int = 0) -> str:
         return _value(root, arg)
 
     text = PLACEHOLDER.sub(repl, text)
+    text = NOTEBOOKS.sub(lambda m: _notebook_links(root), text)
     text = EXPR.sub(lambda m: _expr(root, m.group(1)), text)
     return CLAIM.sub(lambda m: _claim(root, m.group(1)), text)
 
