@@ -8,9 +8,11 @@
 
 #include "msslib_triangle.h"
 #include "msslib_triangle_angular.h"
+#include "msslib_triangle_lsq.h"
 #include "msslib_square.h"
 #include "msslib_rectangle.h"
 #include "msslib_tetrahedron.h"
+#include "msslib_tetrahedron_lsq.h"
 #include "msslib_cube_baudet.h"
 #include "msslib_cube_golec.h"
 #include "msslib_kernels.h"

@@ -1,0 +1,214 @@
+# Generated from derivations/elements/tetrahedron_lsq.py by `python -m derivations.codegen`. Do not edit.
+# source-sha256: d67b3a9715216804402c411cb4858e75eb46a1dbfe00a15c37cdcdcb7a428cb9
+# body-sha256: 89b8e0e5c48bc84d2b7e4594b8c4d97310a136cbd5701cbff09017ff4d8c8eb8
+"""Tetrahedron of any shape, six springs fitted to its own linear element by least squares (Natsupakpong and Cavusoglu 2010, normal equations).
+
+Generated from derivations/elements/tetrahedron_lsq.py by `python -m derivations.codegen`; do not edit.
+"""
+
+from numpy import sqrt  # noqa: F401
+
+
+# the simulator models whose parameters come from this module (its ELEMENT declaration)
+MODELS = ('lsq_tetrahedron',)
+
+
+OUTPUTS = {'lsq_tetrahedron_gram': ('G_00', 'G_01', 'G_02', 'G_03', 'G_04', 'G_05', 'G_11', 'G_12', 'G_13', 'G_14', 'G_15', 'G_22', 'G_23', 'G_24', 'G_25', 'G_33', 'G_34', 'G_35', 'G_44', 'G_45', 'G_55'), 'lsq_tetrahedron_rhs': ('b_0', 'b_1', 'b_2', 'b_3', 'b_4', 'b_5')}
+
+
+def lsq_tetrahedron_gram(a, x2, y2, x3, y3, z3):
+    """Gram matrix G_pq = <K_p, K_q> (upper triangle, dimensionless) of the unit springs of one tetrahedron with nodes (0, 0, 0), (a, 0, 0), (x2, y2, 0), (x3, y3, z3), y2 > 0, z3 > 0 (positively oriented); edges 0-1, 0-2, 0-3, 1-2, 1-3, 2-3. The per-element spring constants (N/m, summed over the tetrahedra sharing an edge) solve G k = b.
+
+    Returns (G_00, G_01, G_02, G_03, G_04, G_05, G_11, G_12, G_13, G_14, G_15, G_22, G_23, G_24, G_25, G_33, G_34, G_35, G_44, G_45, G_55).
+    """
+    _c0 = x2**2
+    _c1 = y2**2
+    _c2 = _c0 + _c1
+    _c3 = _c2**(-1.0)
+    _c4 = x3**2
+    _c5 = _c4 + y3**2 + z3**2
+    _c6 = _c5**(-1.0)
+    _c7 = a**2
+    _c8 = a*x2
+    _c9 = (_c2 + _c7 - 2*_c8)**(-1.0)
+    _c10 = a*x3
+    _c11 = (-2*_c10 + _c5 + _c7)**(-1.0)
+    _c12 = x2*x3
+    _c13 = y2*y3
+    _c14 = _c12 + _c13
+    _c15 = -_c8
+    _c16 = -_c12 - _c13
+    _c17 = (-2*_c12 - 2*_c13 + _c2 + _c5)**(-1.0)
+    _c18 = -_c10
+    _c19 = _c18 + _c5
+    _c20 = _c14 + _c18
+    return (
+        4,
+        _c0*_c3,
+        _c4*_c6,
+        _c9*(a - x2)**2,
+        _c11*(a - x3)**2,
+        0,
+        4,
+        _c14**2*_c3*_c6,
+        _c3*_c9*(_c15 + _c2)**2,
+        0,
+        _c17*_c3*(_c16 + _c2)**2,
+        4,
+        0,
+        _c11*_c19**2*_c6,
+        _c17*_c6*(_c16 + _c5)**2,
+        4,
+        _c11*_c9*(_c15 + _c20 + _c7)**2,
+        _c17*_c9*(-_c0 - _c1 + _c20 + _c8)**2,
+        4,
+        _c11*_c17*(_c16 + _c19 + _c8)**2,
+        4,
+    )
+
+
+def lsq_tetrahedron_rhs(E, nu, a, x2, y2, x3, y3, z3):
+    """Right-hand side b_p = <K_p, K_FEM> (N/m) of one tetrahedron with nodes (0, 0, 0), (a, 0, 0), (x2, y2, 0), (x3, y3, z3), y2 > 0, z3 > 0 (positively oriented); edges 0-1, 0-2, 0-3, 1-2, 1-3, 2-3. The per-element spring constants (N/m, summed over the tetrahedra sharing an edge) solve G k = b.
+
+    Returns (b_0, b_1, b_2, b_3, b_4, b_5).
+    """
+    _c0 = y2*y3
+    _c1 = 4*a
+    _c2 = _c1*x2
+    _c3 = _c0*_c2
+    _c4 = _c1*x3
+    _c5 = _c0*_c4
+    _c6 = x2*x3
+    _c7 = _c0*_c6
+    _c8 = y3**2
+    _c9 = _c2*_c8
+    _c10 = z3**2
+    _c11 = _c10*_c2
+    _c12 = y2**2
+    _c13 = _c1*_c12
+    _c14 = _c13*x3
+    _c15 = a**2
+    _c16 = 2*_c0
+    _c17 = 8*nu
+    _c18 = _c17*a
+    _c19 = _c18*x2
+    _c20 = _c0*_c19
+    _c21 = _c18*x3
+    _c22 = _c0*_c21
+    _c23 = _c12*_c15
+    _c24 = _c15*_c8
+    _c25 = _c10*_c15
+    _c26 = x2**2
+    _c27 = _c26*_c8
+    _c28 = 4*_c27
+    _c29 = _c10*_c26
+    _c30 = 4*_c29
+    _c31 = x3**2
+    _c32 = _c12*_c31
+    _c33 = 4*_c32
+    _c34 = _c10*_c12
+    _c35 = 8*_c34
+    _c36 = _c19*_c8
+    _c37 = _c10*_c19
+    _c38 = _c12*_c18
+    _c39 = 4*_c15
+    _c40 = _c0*_c39
+    _c41 = _c40*nu
+    _c42 = 2*nu
+    _c43 = _c35*nu
+    _c44 = (1/12)*E/(y2*z3*(_c42 - 1)*(nu + 1))
+    _c45 = _c44/a
+    _c46 = _c12 + _c26
+    _c47 = y2**4
+    _c48 = _c15*_c47
+    _c49 = _c23*_c26
+    _c50 = _c24*_c26
+    _c51 = 4*_c50
+    _c52 = _c25*_c26
+    _c53 = 4*_c52
+    _c54 = 2*a
+    _c55 = _c54*x3
+    _c56 = y2**3*y3
+    _c57 = x2**3
+    _c58 = _c1*_c57
+    _c59 = _c15*_c17
+    _c60 = _c18*_c57
+    _c61 = _c4*_c56
+    _c62 = _c4*nu
+    _c63 = _c54*x2
+    _c64 = _c0*_c54
+    _c65 = _c12*_c26
+    _c66 = _c12*_c9
+    _c67 = _c12*_c8
+    _c68 = _c43*a
+    _c69 = _c0*_c59
+    _c70 = _c26*_c5
+    _c71 = _c2*nu
+    _c72 = _c0*nu
+    _c73 = x2**4
+    _c74 = _c73*_c8
+    _c75 = _c10*_c73
+    _c76 = _c31*_c47
+    _c77 = _c10*_c47
+    _c78 = _c31*_c65
+    _c79 = _c12*_c27
+    _c80 = 2*_c10
+    _c81 = 2*_c6
+    _c82 = _c16*x3
+    _c83 = 4*nu
+    _c84 = _c10*_c83
+    _c85 = _c6*_c83
+    _c86 = _c0*_c83
+    _c87 = _c86*x3
+    _c88 = _c42*_c74 + _c42*_c75 + _c42*_c76 + _c42*_c77 + _c42*_c78 + _c42*_c79 + _c56*_c81 - _c56*_c85 + _c57*_c82 - _c57*_c87 - _c65*_c80 + _c65*_c84 - _c74 - _c75 - _c76 - _c77 - _c78 - _c79
+    _c89 = _c10*_c23
+    _c90 = _c12*_c24
+    _c91 = _c17*_c89 + _c17*_c90 - 8*_c89 - 4*_c90
+    _c92 = _c10 + _c31 + _c8
+    _c93 = y3**4
+    _c94 = _c15*_c93
+    _c95 = z3**4
+    _c96 = _c15*_c95
+    _c97 = _c24*_c31
+    _c98 = _c25*_c31
+    _c99 = _c23*_c31
+    _c100 = 4*_c99
+    _c101 = x3**3
+    _c102 = y2*y3**3
+    _c103 = _c31*_c8
+    _c104 = _c10*_c31
+    _c105 = _c14*_c8
+    _c106 = _c0*_c25
+    _c107 = _c3*_c31
+    _c108 = _c0*_c55
+    _c109 = _c10*nu
+    _c110 = _c26*_c93
+    _c111 = _c26*_c95
+    _c112 = _c12*x3**4
+    _c113 = _c12*_c95
+    _c114 = _c27*_c31
+    _c115 = _c29*_c31
+    _c116 = _c103*_c12
+    _c117 = _c34*_c8
+    _c118 = _c16*x2
+    _c119 = _c86*x2
+    _c120 = _c10*_c81
+    _c121 = _c0*_c120 + _c101*_c118 - _c101*_c119 + _c102*_c81 - _c102*_c85 + _c109*_c28 + _c109*_c33 + _c110*_c42 - _c110 + _c111*_c42 - _c111 + _c112*_c42 - _c112 + _c113*_c42 - _c113 + _c114*_c42 - _c114 + _c115*_c42 - _c115 + _c116*_c42 - _c116 + _c117*_c42 - _c117 - _c27*_c80 - _c32*_c80 - _c7*_c84
+    _c122 = a**4
+    _c123 = _c122*_c8
+    _c124 = _c10*_c122
+    _c125 = a**3
+    _c126 = a*nu
+    _c127 = -_c0*_c15*_c81 + _c41*_c6 + _c42*_c90 + _c83*_c89 - 6*_c89 - _c90
+    _c128 = _c12*_c122
+    _c129 = _c126*x3
+    _c130 = _c0*_c63
+    _c131 = 2*_c8
+    return (
+        _c45*(_c11 + _c14 + _c15*_c16 + _c17*_c27 + _c17*_c29 + _c17*_c32 + _c20 + _c22 + _c23*_c42 - _c23 + _c24*_c42 - _c24 + _c25*_c42 - _c25 - _c28 - _c3 - _c30 - _c33 - _c35 - _c36 - _c37 - _c38*x3 - _c41 + _c43 - _c5 - 16*_c7*nu + 8*_c7 + _c9),
+        _c45*(_c10*_c58 - _c10*_c60 + _c17*_c50 + _c17*_c52 - _c19*_c67 + _c2*_c34 + _c21*_c56 + _c22*_c26 + _c26*_c40 - _c26*_c69 + _c39*_c56 + _c42*_c48 + _c42*_c49 + _c47*_c55 - _c47*_c62 - _c48 - _c49 - _c51 - _c53 + _c55*_c65 - _c56*_c59 - _c56*_c63 + _c56*_c71 - _c57*_c64 + _c58*_c72 + _c58*_c8 - _c60*_c8 - _c61 - _c62*_c65 + _c66 - _c68*x2 - _c70 + _c88 + _c91)/_c46,
+        _c45*(-_c0*_c11 + _c0*_c37 + _c1*_c101*_c72 - _c10*_c108 - _c10*_c36 + _c10*_c9 - _c100 + _c101*_c13 - _c101*_c38 - _c101*_c64 + _c102*_c19 - _c102*_c2 + _c102*_c39 - _c102*_c55 - _c102*_c59 + _c102*_c62 + _c103*_c63 - _c103*_c71 + _c104*_c63 - _c104*_c71 + _c105 - _c106*_c17 + 4*_c106 - _c107 + _c109*_c5 + _c121 + _c17*_c99 + _c20*_c31 - _c21*_c67 - _c24*_c80 + _c24*_c84 + _c31*_c40 - _c31*_c69 + _c34*_c4 + _c42*_c94 + _c42*_c96 + _c42*_c97 + _c42*_c98 + _c63*_c93 + _c63*_c95 - _c68*x3 - _c71*_c93 - _c71*_c95 + _c91 - _c94 - _c96 - _c97 - _c98)/_c92,
+        _c45*(-_c108*_c26 + _c123*_c42 - _c123 + _c124*_c42 - _c124 + _c125*_c82 - _c125*_c87 - _c126*_c33*x2 + _c127 + _c32*_c63 + _c42*_c99 + 2*_c50 - _c51*nu + 2*_c52 - _c53*nu + _c55*_c56 - _c61*nu - _c63*_c67 + _c66*nu + _c70*nu + _c88 - _c99)/(_c15 + _c46 - _c63),
+        _c45*(_c10*_c130 - _c100*nu + _c102*_c63 - _c102*_c71 + _c105*nu + _c107*nu - _c11*_c72 + _c118*_c125 - _c119*_c125 + _c121 + _c127 + _c128*_c42 - _c128 - _c129*_c28 - _c129*_c30 - _c130*_c31 + _c27*_c55 + _c29*_c55 + _c42*_c50 + _c42*_c52 - _c50 - _c52 - _c55*_c67 + 2*_c99)/(_c15 - _c55 + _c92),
+        _c44*a*(-_c10*_c131 + _c103*_c42 - _c103 + _c104*_c42 - _c104 + _c12*_c131 + _c12*_c81 - _c12*_c85 + _c120 - _c16*_c26 - _c16*_c31 - _c17*_c7 + _c26*_c86 + _c27*_c42 - _c27 + _c29*_c42 - _c29 + _c31*_c86 + _c32*_c42 - _c32 + _c34*_c83 - 6*_c34 + _c42*_c47 + _c42*_c65 + _c42*_c93 + _c42*_c95 - _c47 - _c6*_c84 - _c65 - _c67*_c83 + 4*_c7 + _c8*_c81 + _c8*_c84 - _c8*_c85 - _c93 - _c95)/(-_c16 + _c46 - _c81 + _c92),
+    )

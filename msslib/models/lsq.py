@@ -1,0 +1,186 @@
+"""Springs fitted per element by least squares, for triangles and tetrahedra of any shape.
+
+Each element gets the spring constants (one per edge) that minimise the Frobenius distance between
+the linearised stiffness of springs on its edges and its own linear FEM stiffness (the plane-stress
+CST of thickness ``t``, the linear tetrahedron), with its own material: irregular meshes no longer
+use constants derived for the equilateral triangle or the regular tetrahedron. Per edge, the
+constants of the elements sharing it are summed; rest lengths are the mesh distances.
+
+The triangle's constants are a closed form (:mod:`msslib.generated.triangle_lsq`); for the
+tetrahedron the generated code gives the 6x6 normal equations ``G k = b``
+(:mod:`msslib.generated.tetrahedron_lsq`) and they are solved here, element by element. Both are
+derived in ``derivations/elements/triangle_lsq.py`` and ``tetrahedron_lsq.py``. The method is the
+per-element fit of S. Natsupakpong and M. C. Cavusoglu, Determination of elasticity parameters in
+lumped element (mass-spring) models of deformable objects, Graphical Models 72(6), 2010.
+
+Negative constants: the fit is kept as it is, so an element with a very obtuse angle (triangle)
+or a flat shape (tetrahedron) can get a negative constant on one edge. The builders warn once
+(:class:`~msslib.models.checks.FormulaValidityWarning`) with how many element constants are
+negative; a spring whose summed constant is not positive is refused by
+:class:`msslib.terms.Springs` (ValueError naming the springs).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from msslib.generated import tetrahedron_lsq as _tet
+from msslib.generated import triangle_lsq as _tri
+from msslib.models.checks import (
+    FormulaValidityWarning,
+    evaluate,
+    poisson,
+    positive,
+    same_shape,
+)
+from msslib.models.common import _require, assemble_springs, material_arrays
+from msslib.models.delingette import local_coordinates
+from msslib.models.spec import Exactness, ModelSpec, split_terms
+
+__all__ = ["TriangleLsqSprings", "TetrahedronLsqSprings", "lsq_triangle", "lsq_tetrahedron"]
+
+#: place in the registry's order (after the founding papers and Delingette's triangle)
+RANK = 11
+
+#: the fit is the optimum for every nu: no Poisson's ratio to warn about
+VALID_NU: dict = {}
+
+REFERENCE = ("S. Natsupakpong, M. C. Cavusoglu, Determination of elasticity parameters in lumped element "
+             "(mass-spring) models of deformable objects, Graphical Models 72(6), 2010")
+
+#: local edges of the cells, in the order of the generated constants
+TRIANGLE_EDGES = np.array([(0, 1), (1, 2), (0, 2)])
+TETRA_EDGES = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)])
+
+
+@dataclass(frozen=True)
+class TriangleLsqSprings:
+    k_01: float  # N/m, per element, edge 0-1
+    k_12: float
+    k_02: float
+
+
+@dataclass(frozen=True)
+class TetrahedronLsqSprings:
+    k: np.ndarray  # (..., 6) N/m, per element, edges 0-1, 0-2, 0-3, 1-2, 1-3, 2-3
+
+
+def lsq_triangle(E, nu, t, a, x2, y2) -> TriangleLsqSprings:
+    """Least-squares constants of one triangle with nodes ``(0, 0)``, ``(a, 0)``, ``(x2, y2)``
+    (``a > 0``, ``y2 > 0``), Young's modulus ``E``, Poisson's ratio ``nu``, thickness ``t``."""
+    positive("E", E), positive("thickness t", t), positive("a", a), positive("y2", y2)
+    poisson(nu)
+    same_shape("lsq_triangle", E=E, nu=nu, t=t, a=a, x2=x2, y2=y2)
+    return evaluate("lsq_triangle", _tri.lsq_triangle, TriangleLsqSprings, E=E, nu=nu, t=t, a=a, x2=x2, y2=y2)
+
+
+def tetra_frame(points):
+    """``(a, x2, y2, x3, y3, z3)`` of tetrahedra ``points`` (..., 4, 3) in their own frame: node 0
+    at the origin, node 1 on the x axis, node 2 in the xy plane with y2 > 0 (``z3 > 0`` for a
+    positively oriented tetrahedron)."""
+    p = np.asarray(points, dtype=float)
+    e1, e2, e3 = (p[..., i, :] - p[..., 0, :] for i in (1, 2, 3))
+    a = np.linalg.norm(e1, axis=-1)
+    u = e1 / a[..., None]
+    x2 = np.einsum("...i,...i->...", e2, u)
+    w = e2 - x2[..., None] * u
+    y2 = np.linalg.norm(w, axis=-1)
+    v = w / y2[..., None]
+    n = np.cross(u, v)
+    return a, x2, y2, np.einsum("...i,...i->...", e3, u), np.einsum("...i,...i->...", e3, v), \
+        np.einsum("...i,...i->...", e3, n)
+
+
+def lsq_tetrahedron(E, nu, points) -> TetrahedronLsqSprings:
+    """Least-squares constants of tetrahedra with node coordinates ``points`` (4, 3) or (m, 4, 3)
+    (positively oriented, VTK order), Young's modulus ``E`` and Poisson's ratio ``nu`` (scalars or
+    (m,) arrays): the solution of the generated normal equations ``G k = b`` of each element."""
+    positive("E", E), poisson(nu)
+    p = np.asarray(points, dtype=float)
+    if p.shape[-2:] != (4, 3) or p.ndim not in (2, 3) or not np.isfinite(p).all():
+        raise ValueError(f"lsq_tetrahedron: points must be finite, of shape (4, 3) or (m, 4, 3), got {p.shape}")
+    frame = tetra_frame(p)
+    if np.any(~(frame[2] > 0)) or np.any(~(frame[5] > 0)):
+        raise ValueError("lsq_tetrahedron: a tetrahedron is degenerate or inverted (negative orientation)")
+    shape = frame[0].shape
+    E, nu = np.broadcast_to(np.asarray(E, dtype=float), shape), np.broadcast_to(np.asarray(nu, dtype=float), shape)
+    upper = [np.broadcast_to(np.asarray(g, dtype=float), shape) for g in _tet.lsq_tetrahedron_gram(*frame)]
+    G = np.empty(shape + (6, 6))
+    iu = np.triu_indices(6)
+    for value, i, j in zip(upper, *iu):
+        G[..., i, j] = G[..., j, i] = value
+    b = np.stack(np.broadcast_arrays(*_tet.lsq_tetrahedron_rhs(E, nu, *frame)), axis=-1)
+    k = np.linalg.solve(G, b[..., None])[..., 0]
+    if not np.isfinite(k).all():
+        raise ValueError("lsq_tetrahedron: the constants are not finite (a degenerate tetrahedron?)")
+    return TetrahedronLsqSprings(k)
+
+
+def _local_index(mesh, cells, node_pairs, edges):
+    """The local edge (row of ``edges``) of each (cell, node pair) incidence."""
+    local = mesh.cells[cells]
+    i = np.argmax(local == node_pairs[:, :1], axis=1)
+    j = np.argmax(local == node_pairs[:, 1:], axis=1)
+    n = local.shape[1]
+    table = np.full((n, n), -1)
+    for e, (p, q) in enumerate(edges):
+        table[p, q] = table[q, p] = e
+    out = table[i, j]
+    assert (out >= 0).all()
+    return out
+
+
+def _warn_negative(k, model):
+    neg = int(np.count_nonzero(k < 0))
+    if neg:
+        warnings.warn(f"{model}: {neg} of {k.size} per-element spring constants are negative (least-squares fit on "
+                      f"badly shaped elements); kept as fitted, summed per edge", FormulaValidityWarning, stacklevel=3)
+
+
+def lsq_triangle_springs(mesh, materials, t: float):
+    """Springs on the edges of a triangle mesh (plane stress, thickness ``t`` m), each triangle
+    contributing the least-squares constants of its own shape and material."""
+    _require(mesh, "triangle")
+    E, nu = material_arrays(mesh, materials)
+    a, x2, y2 = local_coordinates(mesh.points, mesh.cells)
+    p = lsq_triangle(E, nu, t, a, x2, y2)
+    k = np.stack([np.broadcast_to(np.asarray(getattr(p, f), dtype=float), a.shape) for f in ("k_01", "k_12", "k_02")],
+                 axis=1)
+    _warn_negative(k, "lsq_triangle")
+    return [assemble_springs(mesh, "edges", lambda c, pairs: k[c, _local_index(mesh, c, pairs, TRIANGLE_EDGES)])]
+
+
+def lsq_tetrahedron_springs(mesh, materials):
+    """Springs on the edges of a tetrahedral mesh, each tetrahedron contributing the least-squares
+    constants of its own shape and material."""
+    _require(mesh, "tetra")
+    E, nu = material_arrays(mesh, materials)
+    k = lsq_tetrahedron(E, nu, mesh.points[mesh.cells]).k
+    _warn_negative(k, "lsq_tetrahedron")
+    return [assemble_springs(mesh, "edges", lambda c, pairs: k[c, _local_index(mesh, c, pairs, TETRA_EDGES)])]
+
+
+def _build_triangle(ctx):
+    return split_terms(lsq_triangle_springs(ctx.mesh, ctx.materials, ctx.thickness), ctx.options["terms"])
+
+
+def _build_tetrahedron(ctx):
+    return split_terms(lsq_tetrahedron_springs(ctx.mesh, ctx.materials), ctx.options["terms"])
+
+
+SPECS = (
+    ModelSpec("lsq_triangle", "lsq", "mss", ("triangle",), 2,
+              "springs fitted per triangle to its own CST by least squares (any shape)",
+              REFERENCE + "; closed form derived here", element="triangle_lsq", terms=("springs",),
+              parameters=lsq_triangle, build=_build_triangle,
+              exact=(Exactness("element", "equilateral", nu=1 / 3,
+                               source="on the equilateral triangle at nu = 1/3 the fit is Lloyd's eq. 8, which "
+                                      "reproduces the CST (derivations/elements/triangle_lsq.py, triangle.py)"),)),
+    ModelSpec("lsq_tetrahedron", "lsq", "mss", ("tetra",), 3,
+              "springs fitted per tetrahedron to its own linear element by least squares (any shape)",
+              REFERENCE + "; normal equations derived here", element="tetrahedron_lsq", terms=("springs",),
+              parameters=lsq_tetrahedron, build=_build_tetrahedron),
+)
