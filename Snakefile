@@ -27,8 +27,10 @@ PAPERS = ["lloyd", "baudet", "golec", "performance", "summary"]
 DERIVATIONS = {p.stem: str(p) for kind in ("elements", "terms")
                for p in sorted(Path("derivations", kind).glob("*.py")) if not p.stem.startswith("_")}
 ENGINE = sorted(str(p) for p in Path("derivations").glob("*.py"))
-# the derivation modules as notebooks: one HTML page each, beside the paper (linked as derivations/<name>.html)
-NOTEBOOKS = [f"paper/build/derivations/{m}.html" for m in DERIVATIONS]
+# the derivation modules as notebooks: one HTML page each, beside the paper (linked as derivations/<name>.html).
+# Each page re-runs its derivation (seconds to a minute of SymPy), so the quick build renders one of
+# them, the first, as its reduced version of the set; the full build renders every page.
+NOTEBOOKS = [f"paper/build/derivations/{m}.html" for m in (list(DERIVATIONS)[:1] if QUICK else DERIVATIONS)]
 SCENES = sorted(glob_wildcards("experiments/scenes/{name}.yaml").name)
 # every result depends on the library that computed it: a change in msslib reruns what it touches
 # (msslib/paper.py computes no result: only the paper rules depend on it)
