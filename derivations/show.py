@@ -149,3 +149,12 @@ def check(statement: str, holds: bool) -> None:
         return
     note(f"Check ({mark}):")
     _emit(statement, "")
+
+
+def summary(derivation):
+    """Print what a module's ``derive()`` hands on (its title and findings, one line each) and
+    return it: the closing cell of every derivation module."""
+    print(derivation.title)
+    for label, text in derivation.findings:
+        print(f"  {label}: {text}")
+    return derivation

@@ -312,10 +312,7 @@ def derive() -> Derivation:
 
 # %%
 if __name__ == "__main__":
-    d = derive()
-    print(d.title)
-    for label, text in d.findings:
-        print(f"  {label}: {text}")
+    d = show.summary(derive())
     s = d.data["solution"]
     print("  eq. 7 reproduced:", sp.simplify(d.data["k_d"] - PUBLISHED["k_d"]) == 0)
     print("  eq. 8 k_x reproduced:", sp.simplify(s[k_x] - PUBLISHED["k_x"]) == 0)

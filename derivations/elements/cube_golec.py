@@ -279,7 +279,4 @@ if __name__ == "__main__":
 
 # %%
 if __name__ == "__main__":
-    d = derive()
-    print(d.title)
-    for label, text in d.findings:
-        print(f"  {label}: {text}")
+    d = show.summary(derive())

@@ -421,10 +421,7 @@ def derive() -> Derivation:
 
 # %%
 if __name__ == "__main__":
-    d = derive()
-    print(d.title)
-    for label, text in d.findings:
-        print(f"  {label}: {text}")
+    d = show.summary(derive())
     s = d.data["exact"]
     lloyd = {K_SYM[0]: 5 * E * t / 16, K_SYM[1]: 5 * E * t / 16, K_SYM[2]: 7 * E * t / 16,
              C_SYM[0]: sp.Rational(6, 5), C_SYM[1]: sp.Rational(6, 5), C_SYM[2]: sp.Rational(6, 7)}

@@ -139,10 +139,7 @@ if __name__ == "__main__":
 
 # %%
 if __name__ == "__main__":
-    d = derive()
-    print(d.title)
-    for label, text in d.findings:
-        print(f"  {label}: {text}")
+    d = show.summary(derive())
     s = d.data["solution"]
     pub = {k_e: 5 * E * t / 16, k_d: 7 * E * t / 16, c_e: sp.Rational(6, 5), c_d: sp.Rational(6, 7)}
     print("  eqs. 10-11 reproduced:", all(sp.simplify(s[key] - v) == 0 for key, v in pub.items()))

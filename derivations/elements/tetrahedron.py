@@ -187,10 +187,7 @@ if __name__ == "__main__":
 
 # %%
 if __name__ == "__main__":
-    d = derive()
-    print(d.title)
-    for label, text in d.findings:
-        print(f"  {label}: {text}")
+    d = show.summary(derive())
     print("  eq. 12 reproduced:", sp.simplify(d.formulas[0].outputs["k"] - 2 * sp.sqrt(2) / 25 * l * E) == 0)
     ek, ekv = d.data["eq14"]
     f = d.formulas[2].outputs

@@ -131,7 +131,4 @@ def derive() -> Derivation:
 
 # %%
 if __name__ == "__main__":
-    d = derive()
-    print(d.title)
-    for label, text in d.findings:
-        print(f"  {label}: {text}")
+    d = show.summary(derive())

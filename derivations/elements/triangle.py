@@ -143,10 +143,7 @@ def derive() -> Derivation:
 
 # %%
 if __name__ == "__main__":
-    d = derive()
-    print(d.title)
-    for label, text in d.findings:
-        print(f"  {label}: {text}")
+    d = show.summary(derive())
     print("  published eq. 8: k = sqrt(3)/4 E t ->", "agrees" if sp.simplify(d.formulas[0].outputs["k"] - sp.sqrt(3) / 4 * E * t) == 0 else "DIFFERS")
     print("  van Gelder = eq. 9:", sp.simplify(VAN_GELDER - LLOYD_EQ9) == 0)
     print("  lattice = plane stress at nu = 1/3:", sp.simplify(d.data["lattice"] - elasticity_matrix("plane_stress", E, sp.Rational(1, 3))) == sp.zeros(3, 3))

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 592b8f8add175381c28a61ac8bf37715a4ced0b94611ed0dc1d12d5a90ac5260
+# source-sha256: a8168c2ba54679e6402a4e966c218a01ad537a3264fab6bd8e4b3f7f596578f3
 # body-sha256: ead38ff0979f342e371691d41eaa2c1fcc80bd8a3ec45ce6848072726eb1950e
 """Cube with edge, face and inner springs and volume correction (Golec et al.).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 1182560a2f7a13168c90c1c208673628652d84b0c593a1fc54d9a45687e47ccc
+# source-sha256: 478777193ef1671c154567ac098ef85920d96179492c70be985863302fe88a86
 # body-sha256: 3d373773da99006a61be809dfa382060e5f3e52fab7de0235f0cb4b483a8f761
 """Energy, gradient and Hessian kernels.
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: ac06af23d91b87d622122cd8e616a69b2b29ff6d459be4058aff212b70958e23
+# source-sha256: d3e9b7a12a70eebb3b75f7b0d21c74951422103b5fe4baf76f8c65382883ab7b
 # body-sha256: 1dd982c2337e75087dee499cd350e6dc2d1ddc93b1216533dccefec5767742ed
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle_lsq.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 4f8a65c63706bbacdd9c32425ae3d6d4861f4cfefa371c121013e3c180a4c8b5
+# source-sha256: 43523c175342e96901e7484d34f5ddc7a8066559a1fc4fe9deeb5c10e5c75e4e
 # body-sha256: 57450fa1afc4ade7ef6a3d860ad9bb3d9c204b40b131686eafec79f025b5913c
 """Triangle of any shape, three springs fitted to its own CST by least squares (Natsupakpong and Cavusoglu 2010, closed form).
 

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 592b8f8add175381c28a61ac8bf37715a4ced0b94611ed0dc1d12d5a90ac5260
+// source-sha256: a8168c2ba54679e6402a4e966c218a01ad537a3264fab6bd8e4b3f7f596578f3
 // body-sha256: 0d238d4fdc2f5bdb6dcaa28eebe4aa10cb54605177300b8e9a011a8f52bf3db9
 /* Cube with edge, face and inner springs and volume correction (Golec et al.), in C99.
  *

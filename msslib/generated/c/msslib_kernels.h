@@ -1,5 +1,5 @@
 // Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 1182560a2f7a13168c90c1c208673628652d84b0c593a1fc54d9a45687e47ccc
+// source-sha256: 478777193ef1671c154567ac098ef85920d96179492c70be985863302fe88a86
 // body-sha256: 7f5d5f733ea9977037af525660c2fc36b8b662c38c8617e6adddab5a10c656b3
 /* Energy, gradient and Hessian kernels, in C99.
  *

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/square.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: ac06af23d91b87d622122cd8e616a69b2b29ff6d459be4058aff212b70958e23
+// source-sha256: d3e9b7a12a70eebb3b75f7b0d21c74951422103b5fe4baf76f8c65382883ab7b
 // body-sha256: 13b5965d96604f6d2aac3e0b15b3fde5c77ce864e6397a964dba8cab8b65bb35
 /* Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11), in C99.
  *

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: bd4656877f02f102e15d177d8680b220787ecaa0361e012b9f4bbc782d853741
+// source-sha256: 0d0bf17a5dedd15988d2fb7803022fbcfe60cfc94439390d158472ccb5d53756
 // body-sha256: f939343cb2baf0fb848f36b70ff7f3b1f31ba015f97cabe173307781e3e06e1c
 /* Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14), in C99.
  *

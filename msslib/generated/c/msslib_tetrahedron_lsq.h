@@ -1,5 +1,5 @@
 // Generated from derivations/elements/tetrahedron_lsq.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: d67b3a9715216804402c411cb4858e75eb46a1dbfe00a15c37cdcdcb7a428cb9
+// source-sha256: ff416bdd045175906b1c478acea9b4b64b01edd498ff141e41da658e8a6d155b
 // body-sha256: cdd295929070b1914d0045f23012c41281748fae771a1b80dd2b0474e6910964
 /* Tetrahedron of any shape, six springs fitted to its own linear element by least squares (Natsupakpong and Cavusoglu 2010, normal equations), in C99.
  *
