@@ -137,7 +137,7 @@ def derive() -> Derivation:
         "(D = l^2 - L^2, squared lengths). Exact against the CST for every triangle and nu."))
     eq = equilateral()
     d.findings += [
-        ("exact", "unique exact match for every triangle and every \\nu"),
+        ("exact", "one exact match with the CST for every triangle and every Poisson ratio"),
         ("equilateral", ", ".join(f"{sp.latex(key)} = {sp.latex(v)}" for key, v in eq.items())),
     ]
     d.data.update(solution=s, equilateral=eq)
