@@ -186,25 +186,34 @@ class RunTimeout(BaseException):  # not an Exception: solvers must not swallow i
     """A run exceeded its wall-time budget."""
 
 
-def _run(raw, base_dir, budget=None):
+def run_with_budget(scene, budget=None, *, cpu=False):
+    """``run_scene(scene)`` stopped by :class:`RunTimeout` after ``budget`` seconds of wall time
+    (``cpu=True``: of CPU time); no limit where the platform has no interval timers."""
     import signal
 
-    from msslib.scene import load_scene, run_scene
+    from msslib.scene import run_scene
 
-    scene = load_scene(raw, base_dir=base_dir)
     if not budget or not hasattr(signal, "SIGALRM"):
         return run_scene(scene, progress=False)
+    sig, timer, what = ((signal.SIGPROF, signal.ITIMER_PROF, "s of CPU time") if cpu
+                        else (signal.SIGALRM, signal.ITIMER_REAL, "s"))
 
     def _alarm(_sig, _frame):
-        raise RunTimeout(f"exceeded the budget of {budget:g} s")
+        raise RunTimeout(f"exceeded the budget of {budget:g} {what}")
 
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.setitimer(signal.ITIMER_REAL, budget)
+    old = signal.signal(sig, _alarm)
+    signal.setitimer(timer, budget)
     try:
         return run_scene(scene, progress=False)
     finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
+        signal.setitimer(timer, 0)
+        signal.signal(sig, old)
+
+
+def _run(raw, base_dir, budget=None):
+    from msslib.scene import load_scene
+
+    return run_with_budget(load_scene(raw, base_dir=base_dir), budget)
 
 
 def check_scene(scene, *, levels=(1, 2, 3), models=None):

@@ -66,21 +66,9 @@ def scene_at(raw, level, model, linear=False):
 
 def _run(scene, budget):
     """run_scene, stopped by :class:`msslib.planning.RunTimeout` after ``budget`` seconds of CPU time."""
-    import signal
+    from msslib.planning import run_with_budget
 
-    from msslib.planning import RunTimeout
-    from msslib.scene import run_scene
-
-    def _alarm(_sig, _frame):
-        raise RunTimeout(f"stopped after {budget:g} s of CPU time")
-
-    old = signal.signal(signal.SIGPROF, _alarm)
-    signal.setitimer(signal.ITIMER_PROF, budget)
-    try:
-        return run_scene(scene, progress=False)
-    finally:
-        signal.setitimer(signal.ITIMER_PROF, 0)
-        signal.signal(signal.SIGPROF, old)
+    return run_with_budget(scene, budget, cpu=True)
 
 
 def timed(raw, base_dir, repeats, budget=BUDGET):
