@@ -308,7 +308,6 @@ def test_derivation_module_runs_as_script_and_is_a_notebook():
 
 def test_errata_file_lists_every_erratum_with_an_existing_proof():
     text = (codegen.ROOT / "paper" / "errata.md").read_text()
-    names = set(dir(sys.modules[__name__]))
     n = 0
     for m in registry.generated():
         for e in registry.module(m).derive().errata:

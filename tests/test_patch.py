@@ -38,7 +38,7 @@ def test_symbolic_element_stiffness_equals_scikit_fem(cell_type, coords, kind):
 
 def _fem_global(mesh, nu, t=T0):
     """Global linear-FEM stiffness assembled from the element matrices (dofs interleaved)."""
-    dim, nv = mesh.dim, mesh.cells.shape[1]
+    dim = mesh.dim
     K = np.zeros((mesh.n_nodes * dim,) * 2)
     for cell in mesh.cells:
         Ke = fem.element_stiffness(mesh.cell_type, mesh.points[cell], E0, nu, thickness=t)

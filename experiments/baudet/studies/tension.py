@@ -38,7 +38,6 @@ def run(n, nu, published, strains, reading="boundary"):
     eps = H[:, 2, 2]
     E = loads / eps
     nu_m = -(H[:, 0, 0] + H[:, 1, 1]) / 2 / eps
-    e0 = np.concatenate([[0.0], eps])
     # small-strain limit by the first level (linear extrapolation of the secant values)
     E_i = np.interp(strains, eps, E)
     nu_i = np.interp(strains, eps, nu_m)
