@@ -14,10 +14,12 @@ per-element fit of S. Natsupakpong and M. C. Cavusoglu, Determination of elastic
 lumped element (mass-spring) models of deformable objects, Graphical Models 72(6), 2010.
 
 Negative constants: the fit is kept as it is, so an element with a very obtuse angle (triangle)
-or a flat shape (tetrahedron) can get a negative constant on one edge. The builders warn once
+or a flat shape (tetrahedron) can get a negative constant on one edge, and an edge that only such
+elements share gets a negative summed constant. The builders warn once
 (:class:`~msslib.models.checks.FormulaValidityWarning`) with how many element constants are
-negative; a spring whose summed constant is not positive is refused by
-:class:`msslib.terms.Springs` (ValueError naming the springs).
+negative. Where a summed constant is not positive, the lattice is simulated only if it is stable
+at rest: :func:`check_stable_at_rest` factors its stiffness with the rigid-body modes pinned and
+raises ValueError (naming the springs and the smallest pivot) when it is not positive definite.
 """
 
 from __future__ import annotations
@@ -36,11 +38,12 @@ from msslib.models.checks import (
     positive,
     same_shape,
 )
-from msslib.models.common import _require, assemble_springs, material_arrays
+from msslib.models.common import _combine, _pairs_of, _require, material_arrays
 from msslib.models.delingette import local_coordinates
 from msslib.models.spec import Exactness, ModelSpec, split_terms
+from msslib.terms import Springs
 
-__all__ = ["TriangleLsqSprings", "TetrahedronLsqSprings", "lsq_triangle", "lsq_tetrahedron"]
+__all__ = ["TriangleLsqSprings", "TetrahedronLsqSprings", "lsq_triangle", "lsq_tetrahedron", "check_stable_at_rest"]
 
 #: place in the registry's order (after the founding papers and Delingette's triangle)
 RANK = 11
@@ -137,7 +140,81 @@ def _warn_negative(k, model):
     neg = int(np.count_nonzero(k < 0))
     if neg:
         warnings.warn(f"{model}: {neg} of {k.size} per-element spring constants are negative (least-squares fit on "
-                      f"badly shaped elements); kept as fitted, summed per edge", FormulaValidityWarning, stacklevel=3)
+                      f"badly shaped elements); kept as fitted, summed per edge", FormulaValidityWarning, stacklevel=4)
+
+
+def rigid_modes(points) -> np.ndarray:
+    """The infinitesimal rigid-body motions of nodes ``points`` (n, dim), columns of a
+    (dim n, 3) matrix in 2D (two translations, one rotation) or (dim n, 6) in 3D."""
+    p = np.asarray(points, dtype=float)
+    n, dim = p.shape
+    c = p - p.mean(axis=0)
+    modes = [np.tile(np.eye(dim)[i], n) for i in range(dim)]
+    if dim == 2:
+        modes.append(np.column_stack([-c[:, 1], c[:, 0]]).ravel())
+    else:
+        for i, j in ((0, 1), (1, 2), (2, 0)):
+            r = np.zeros_like(c)
+            r[:, i], r[:, j] = -c[:, j], c[:, i]
+            modes.append(r.ravel())
+    return np.column_stack(modes)
+
+
+def check_stable_at_rest(springs, points, label: str) -> None:
+    """Raise ValueError unless the springs' stiffness at rest ``K`` (``points`` stress free) is
+    positive definite apart from the rigid-body motions.
+
+    ``K`` is positive semi-definite with exactly the rigid-body null space if and only if ``K``
+    with the dofs of a rigid-body-pinning set removed (chosen by pivoted QR of the rigid modes)
+    is positive definite: a rigid motion is in ``K``'s null space at a stress-free state, and it
+    is the only displacement that matches an arbitrary motion on the pinned dofs. That reduced
+    matrix is factored by a banded Cholesky in reverse Cuthill-McKee order."""
+    import scipy.linalg as la
+    import scipy.sparse as sps
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    p = np.asarray(points, dtype=float)
+    n = p.size
+    rows, cols, vals = springs.hessian_coo(p.ravel())
+    K = sps.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    R = rigid_modes(p)
+    pinned = la.qr(R.T, pivoting=True, mode="r")[1][: R.shape[1]]
+    keep = np.setdiff1d(np.arange(n), pinned)
+    Kr = K[keep][:, keep].tocsr()
+    order = reverse_cuthill_mckee(Kr, symmetric_mode=True)
+    Kr = Kr[order][:, order].tocoo()
+    bw = int(np.max(np.abs(Kr.row - Kr.col))) if Kr.nnz else 0
+    if Kr.shape[0] * (bw + 1) > 2e8:
+        raise ValueError(f"{label}: cannot check the stability of this lattice at rest (bandwidth {bw} of "
+                         f"{Kr.shape[0]} dofs is too large)")
+    ab = np.zeros((bw + 1, Kr.shape[0]))
+    low = Kr.row >= Kr.col
+    np.add.at(ab, (Kr.row[low] - Kr.col[low], Kr.col[low]), Kr.data[low])
+    _, info = la.lapack.dpbtrf(ab, lower=1)
+    if info != 0:
+        neg = np.flatnonzero(springs.k <= 0)
+        raise ValueError(
+            f"{label}: the fitted lattice is not stable at rest (its stiffness, rigid-body motions "
+            f"removed, is not positive definite: leading minor {info} of {Kr.shape[0]}); "
+            f"{len(neg)} spring(s) have a non-positive summed constant, e.g. nodes "
+            f"{tuple(int(v) for v in springs.conn[neg[0]])} with k = {springs.k[neg[0]]:.4g} N/m. "
+            f"Use a mesh without very obtuse (triangle) or flat (tetrahedron) elements, or another model")
+
+
+def _lsq_springs(mesh, k, edges, label):
+    """Springs on the edges of ``mesh`` with the per-element constants ``k`` (m, edges) summed per
+    edge, rest lengths the mesh distances; non-positive sums only if the lattice is stable."""
+    _warn_negative(k, label)
+    pairs = _pairs_of(mesh, "edges")
+    cells = pairs.cells
+    node_pairs = np.repeat(pairs.pairs, pairs.counts, axis=0)
+    k_sum, _ = _combine(pairs, k[cells, _local_index(mesh, cells, node_pairs, edges)], None)
+    length = np.linalg.norm(mesh.points[pairs.pairs[:, 1]] - mesh.points[pairs.pairs[:, 0]], axis=1)
+    signed = bool(np.any(k_sum <= 0))
+    springs = Springs(pairs.pairs, k_sum, length, mesh.dim, signed=signed)
+    if signed:
+        check_stable_at_rest(springs, mesh.points, label)
+    return [springs]
 
 
 def lsq_triangle_springs(mesh, materials, t: float):
@@ -149,8 +226,7 @@ def lsq_triangle_springs(mesh, materials, t: float):
     p = lsq_triangle(E, nu, t, a, x2, y2)
     k = np.stack([np.broadcast_to(np.asarray(getattr(p, f), dtype=float), a.shape) for f in ("k_01", "k_12", "k_02")],
                  axis=1)
-    _warn_negative(k, "lsq_triangle")
-    return [assemble_springs(mesh, "edges", lambda c, pairs: k[c, _local_index(mesh, c, pairs, TRIANGLE_EDGES)])]
+    return _lsq_springs(mesh, k, TRIANGLE_EDGES, "lsq_triangle")
 
 
 def lsq_tetrahedron_springs(mesh, materials):
@@ -158,9 +234,7 @@ def lsq_tetrahedron_springs(mesh, materials):
     constants of its own shape and material."""
     _require(mesh, "tetra")
     E, nu = material_arrays(mesh, materials)
-    k = lsq_tetrahedron(E, nu, mesh.points[mesh.cells]).k
-    _warn_negative(k, "lsq_tetrahedron")
-    return [assemble_springs(mesh, "edges", lambda c, pairs: k[c, _local_index(mesh, c, pairs, TETRA_EDGES)])]
+    return _lsq_springs(mesh, lsq_tetrahedron(E, nu, mesh.points[mesh.cells]).k, TETRA_EDGES, "lsq_tetrahedron")
 
 
 def _build_triangle(ctx):

@@ -32,13 +32,15 @@ class Springs(_ElementTerm):
     pairs : (s, 2) int node ids.
     k : (s,) spring constants (N/m), finite and > 0.  A zero or negative constant (typically from
         a sliver or inverted element) raises ValueError naming the offending springs; it is never
-        used silently.
+        used silently.  ``signed=True`` accepts any finite constant: for models whose fit can give
+        negative constants and which check the stability of the assembled lattice themselves
+        (:mod:`msslib.models.lsq`).
     rest_length : (s,) rest lengths (m), finite and > 0.  A rest length that differs from the
         distance of the nodes in the mesh prestrains the spring (e.g. Lloyd's squares).
     dim : 2 or 3.
     """
 
-    def __init__(self, pairs, k, rest_length, dim: int):
+    def __init__(self, pairs, k, rest_length, dim: int, *, signed: bool = False):
         if dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
         self.dim = dim
@@ -46,7 +48,7 @@ class Springs(_ElementTerm):
         s = len(self.conn)
         self.k = _per_element("k", k, s)
         self.rest_length = _per_element("rest_length", rest_length, s)
-        bad = np.flatnonzero(~(np.isfinite(self.k) & (self.k > 0)))
+        bad = np.flatnonzero(~(np.isfinite(self.k) & ((self.k > 0) | signed)))
         if len(bad):
             raise ValueError(
                 f"{len(bad)} spring(s) with a non-positive or non-finite spring constant k (N/m), "
