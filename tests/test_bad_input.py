@@ -14,6 +14,7 @@ from msslib import model as MD
 from msslib import parameters as P
 from msslib.io import write_result
 from msslib.scene import load_scene, run_scene
+from scene_helpers import pressed_cube
 
 E, T = 1.0e6, 0.01
 BAD_E = [-1.0, 0.0, float("nan")]
@@ -173,16 +174,7 @@ def test_inverted_cell_named_by_fem():
 # ---- scenes and the command line ---------------------------------------------------------
 
 def _scene(**changes):
-    scene = {
-        "name": "bad_input",
-        "geometry": {"generator": "hex_grid", "args": {"lx": 0.1, "ly": 0.1, "lz": 0.1, "nx": 1, "ny": 1, "nz": 1}},
-        "materials": [{"E": 1.0e6, "nu": 0.3}],
-        "model": "golec_cube",
-        "boundary": [{"select": {"plane": ["z", 0.0]}, "fix": "all"},
-                     {"select": {"plane": ["z", 0.1]}, "fix": ["z"], "displacement": [None, None, -0.001]}],
-    }
-    scene.update(changes)
-    return scene
+    return pressed_cube("bad_input", cells=1, **changes)
 
 
 def _run_cli(tmp_path, capsys, scene, out_name="out.nc"):

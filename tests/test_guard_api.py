@@ -18,6 +18,7 @@ from msslib import planning
 from msslib import parameters as P
 from msslib.io import write_result
 from msslib.scene import load_scene, run_scene
+from scene_helpers import pressed_cube
 
 # ---- parameters: types -------------------------------------------------------------------
 
@@ -113,14 +114,7 @@ def test_results_out_of_double_range_are_refused(call, names):
 
 # ---- the scene loader --------------------------------------------------------------------
 
-SCENE = {
-    "name": "guard_api",
-    "geometry": {"generator": "hex_grid", "args": {"lx": 0.1, "ly": 0.1, "lz": 0.1, "nx": 2, "ny": 2, "nz": 2}},
-    "materials": [{"E": 1.0e6, "nu": 0.3}],
-    "model": "golec_cube",
-    "boundary": [{"select": {"plane": ["z", 0.0]}, "fix": "all"},
-                 {"select": {"plane": ["z", 0.1]}, "fix": ["z"], "displacement": [None, None, -0.001]}],
-}
+SCENE = pressed_cube("guard_api")
 
 
 def _with(path, value):

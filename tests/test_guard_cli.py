@@ -25,15 +25,9 @@ from msslib import experiment as EXP
 from msslib import mesh as M
 from msslib.io import StagedOutputs, read_result, remove_stale_temporaries, write_result, write_text
 from msslib.scene import run_scene
+from scene_helpers import pressed_cube
 
-SCENE = {
-    "name": "guard",
-    "geometry": {"generator": "hex_grid", "args": {"lx": 0.1, "ly": 0.1, "lz": 0.1, "nx": 2, "ny": 2, "nz": 2}},
-    "materials": [{"E": 1.0e6, "nu": 0.3}],
-    "model": "golec_cube",
-    "boundary": [{"select": {"plane": ["z", 0.0]}, "fix": "all"},
-                 {"select": {"plane": ["z", 0.1]}, "fix": ["z"], "displacement": [None, None, -0.001]}],
-}
+SCENE = pressed_cube("guard")
 EXPERIMENT = {"paper": "golec", "scene": SCENE, "cases": {"press": {}},
               "models": {"mss": {"model": "golec_cube"}, "fem": {"model": "fem_linear"}}, "reference": "fem"}
 
@@ -211,47 +205,31 @@ def test_compare_failing_table_keeps_old_comparison(work, capsys, monkeypatch):
     assert _temporaries(work) == []
 
 
-def test_commit_puts_replaced_files_back_when_a_rename_fails(tmp_path, monkeypatch):
-    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
-    a.write_text("old a\n")
-    b.write_text("old b\n")
+@pytest.mark.parametrize("before, error", [
+    # a.txt is replaced first, then put back
+    pytest.param({"a.txt": "old a\n", "b.txt": "old b\n"}, PermissionError(errno.EACCES, "Permission denied"),
+                 id="replaced_files_put_back"),
+    # a.txt did not exist before: the new one is removed
+    pytest.param({"b.txt": "old b\n"}, OSError(errno.EIO, "I/O error"), id="new_file_removed"),
+])
+def test_commit_restores_the_directory_when_a_later_rename_fails(tmp_path, monkeypatch, before, error):
+    for name, text in before.items():
+        (tmp_path / name).write_text(text)
     real_replace = os.replace
 
     def replace(src, dst, *args, **kwargs):
         if os.path.basename(dst) == "b.txt":
-            raise PermissionError(errno.EACCES, "Permission denied", str(dst))
+            raise type(error)(error.errno, error.strerror, str(dst))
         return real_replace(src, dst, *args, **kwargs)
 
     monkeypatch.setattr(os, "replace", replace)
-    with pytest.raises(PermissionError, match="b.txt") as info:
+    with pytest.raises(type(error), match="b.txt") as info:
         with StagedOutputs() as out:
-            out.write_text(a, "new a\n")
-            out.write_text(b, "new b\n")
+            out.write_text(tmp_path / "a.txt", "new a\n")
+            out.write_text(tmp_path / "b.txt", "new b\n")
     assert "msslib-tmp" not in str(info.value)
     monkeypatch.undo()
-    assert a.read_text() == "old a\n"  # replaced first, then put back
-    assert b.read_text() == "old b\n"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt", "b.txt"]
-
-
-def test_commit_removes_new_file_when_a_later_rename_fails(tmp_path, monkeypatch):
-    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
-    b.write_text("old b\n")
-    real_replace = os.replace
-
-    def replace(src, dst, *args, **kwargs):
-        if os.path.basename(dst) == "b.txt":
-            raise OSError(errno.EIO, "I/O error", str(dst))
-        return real_replace(src, dst, *args, **kwargs)
-
-    monkeypatch.setattr(os, "replace", replace)
-    with pytest.raises(OSError, match="b.txt"):
-        with StagedOutputs() as out:
-            out.write_text(a, "new a\n")
-            out.write_text(b, "new b\n")
-    monkeypatch.undo()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["b.txt"]  # a.txt did not exist before
-    assert b.read_text() == "old b\n"
+    assert {p.name: p.read_text() for p in tmp_path.iterdir()} == before
 
 
 def test_error_inside_the_block_touches_nothing(tmp_path):

@@ -17,7 +17,7 @@ from derivations import match, mss
 from derivations.elasticity import E, nu, t
 from derivations.elements import tetrahedron_lsq as DT
 from derivations.elements import triangle_lsq as D
-from msslib import fem
+from fem_helpers import fem_stiffness, jittered
 from msslib import mesh as M
 from msslib.model import Model
 from msslib.models.checks import FormulaValidityWarning
@@ -108,15 +108,6 @@ def test_regular_tetrahedron_fit_is_lloyds_least_squares(n):
 # ---- optimality of the simulated constants ---------------------------------------------------------
 
 
-def _fem_stiffness(mesh, young, poisson):
-    n = mesh.dim * mesh.n_nodes
-    K = np.zeros((n, n))
-    for cell in mesh.cells:
-        dofs = (cell[:, None] * mesh.dim + np.arange(mesh.dim)).ravel()
-        K[np.ix_(dofs, dofs)] += fem.element_stiffness(mesh.cell_type, mesh.points[cell], young, poisson, thickness=T)
-    return K
-
-
 @pytest.mark.parametrize("cell", ["triangle", "tetra"])
 def test_each_constant_sits_at_the_optimum(cell):
     """One irregular element: scaling any one spring by 0.99 or 1.01 increases ||K - K_FEM||_F."""
@@ -127,7 +118,7 @@ def test_each_constant_sits_at_the_optimum(cell):
         mesh = M.Mesh(np.array([[0.0, 0, 0], [2, 0, 0], [0.5, 1, 0], [1 / 3, 0.25, 1.5]]), np.array([[0, 1, 2, 3]]),
                       "tetra")
         model = Model(mesh, lsq_tetrahedron_springs(mesh, [(5.0, 0.3)]))
-    K_fem = _fem_stiffness(mesh, 5.0, 0.3)
+    K_fem = fem_stiffness(mesh, 5.0, 0.3, T)
 
     springs = model.terms[0]
 
@@ -147,15 +138,6 @@ def test_each_constant_sits_at_the_optimum(cell):
 # ---- irregular meshes: closer to the FEM than Lloyd's constants --------------------------------------
 
 
-def _jittered(base, amount, seed=0):
-    """``base`` with its interior nodes moved by up to ``amount`` (m) along each axis."""
-    rng = np.random.default_rng(seed)
-    p = base.points.copy()
-    inner = np.all((p > p.min(0) + 1e-9) & (p < p.max(0) - 1e-9), axis=1)
-    p[inner] += amount * rng.uniform(-1, 1, (inner.sum(), p.shape[1]))
-    return M.Mesh(p, base.cells, base.cell_type)
-
-
 def _relative(terms, mesh, K_fem):
     model = Model(mesh, terms)
     return np.linalg.norm(model.stiffness(model.x0).toarray() - K_fem) / np.linalg.norm(K_fem)
@@ -167,9 +149,9 @@ def _relative(terms, mesh, K_fem):
 ])
 def test_triangle_mesh_closer_to_the_cst_than_lloyd(base, amount, lsq, lloyd):
     """||K - K_CST||_F / ||K_CST||_F at nu = 1/3 on a jittered unit square (66 or 50 triangles)."""
-    mesh = _jittered(M.triangle_grid_equilateral(1.0, 1.0, 6) if base == "equilateral"
+    mesh = jittered(M.triangle_grid_equilateral(1.0, 1.0, 6) if base == "equilateral"
                      else M.triangle_grid_right(1.0, 1.0, 5, 5), amount)
-    K_fem = _fem_stiffness(mesh, 1.0, 1 / 3)
+    K_fem = fem_stiffness(mesh, 1.0, 1 / 3, T)
     ours = _relative(lsq_triangle_springs(mesh, [(1.0, 1 / 3)], T), mesh, K_fem)
     theirs = _relative(lloyd_triangle_springs(mesh, [(1.0, 1 / 3)], T), mesh, K_fem)
     assert (ours, theirs) == pytest.approx((lsq, lloyd), abs=1e-4)
@@ -179,8 +161,8 @@ def test_triangle_mesh_closer_to_the_cst_than_lloyd(base, amount, lsq, lloyd):
 def test_tetrahedron_mesh_closer_to_the_fem_than_lloyd(n, lsq, lloyd):
     """Unit cube, 3 x 3 x 3 x 6 = 162 tetrahedra, interior nodes moved by up to 0.05 (0.15 x the
     spacing): some per-element constants are negative (warned), every summed one positive."""
-    mesh = _jittered(M.tet_grid(1.0, 1.0, 1.0, 3, 3, 3), 0.05)
-    K_fem = _fem_stiffness(mesh, 1.0, n)
+    mesh = jittered(M.tet_grid(1.0, 1.0, 1.0, 3, 3, 3), 0.05)
+    K_fem = fem_stiffness(mesh, 1.0, n, T)
     with pytest.warns(FormulaValidityWarning, match=r"lsq_tetrahedron: \d+ of 972 per-element spring constants"):
         ours = _relative(lsq_tetrahedron_springs(mesh, [(1.0, n)]), mesh, K_fem)
     with warnings.catch_warnings():

@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 import pytest
 
+from fem_helpers import jittered
 from msslib import mesh as M
 from msslib.model import Model
 from msslib.models.checks import FormulaValidityWarning
@@ -22,14 +23,6 @@ from msslib.models.lsq import (
 from msslib.terms import Springs
 
 T = 0.01  # thickness (m)
-
-
-def _jittered(base, amount, seed=0):
-    rng = np.random.default_rng(seed)
-    p = base.points.copy()
-    inner = np.all((p > p.min(0) + 1e-9) & (p < p.max(0) - 1e-9), axis=1)
-    p[inner] += amount * rng.uniform(-1, 1, (inner.sum(), p.shape[1]))
-    return M.Mesh(p, base.cells, base.cell_type)
 
 
 def _spectrum(springs, mesh):
@@ -46,12 +39,12 @@ def _obtuse_triangle(apex_deg=130.0):
 
 
 def _grid_with_negative_boundary_spring():
-    return _jittered(M.triangle_grid_right(1.0, 1.0, 5, 5), 0.04)
+    return jittered(M.triangle_grid_right(1.0, 1.0, 5, 5), 0.04)
 
 
 def test_rigid_modes_span_the_null_space_of_a_stress_free_lattice():
     for mesh, springs in ((_grid_with_negative_boundary_spring(), None),
-                          (_jittered(M.tet_grid(1.0, 1.0, 1.0, 2, 2, 2), 0.05), None)):
+                          (jittered(M.tet_grid(1.0, 1.0, 1.0, 2, 2, 2), 0.05), None)):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", FormulaValidityWarning)
             springs = (lsq_triangle_springs(mesh, [(1.0, 0.3)], T) if mesh.cell_type == "triangle"
@@ -104,7 +97,7 @@ def test_an_unstable_fit_is_refused_in_one_line(apex):
 def test_the_check_agrees_with_the_dense_spectrum_on_random_signed_lattices():
     """Random constants of either sign on a jittered tetrahedral grid: the check raises exactly
     when the dense stiffness has an eigenvalue below zero beyond the six rigid-body modes."""
-    mesh = _jittered(M.tet_grid(1.0, 1.0, 1.0, 2, 2, 2), 0.05, seed=3)
+    mesh = jittered(M.tet_grid(1.0, 1.0, 1.0, 2, 2, 2), 0.05, seed=3)
     pairs = M.unique_edges(mesh).pairs
     rest = np.linalg.norm(mesh.points[pairs[:, 1]] - mesh.points[pairs[:, 0]], axis=1)
     rng = np.random.default_rng(7)

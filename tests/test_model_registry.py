@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
-from msslib import fem
+from fem_helpers import fem_stiffness
 from msslib import mesh as M
 from msslib import models
 from msslib.model import Model
@@ -170,15 +170,6 @@ def test_equilibrium_at_rest(name, opts):
 # ---- patch tests where the derivation claims exactness -----------------------------------------
 
 
-def _fem_stiffness(mesh, E, nu):
-    n = mesh.n_nodes * mesh.dim
-    K = np.zeros((n, n))
-    for cell in mesh.cells:
-        dofs = (cell[:, None] * mesh.dim + np.arange(mesh.dim)).ravel()
-        K[np.ix_(dofs, dofs)] += fem.element_stiffness(mesh.cell_type, mesh.points[cell], E, nu, thickness=T)
-    return K
-
-
 def _exact_cases():
     for name in MSS:
         for i, ex in enumerate(SPECS[name].exact):
@@ -203,7 +194,7 @@ def test_patch_where_exact(name, ex, nu_free):
     model = _model(name, mesh=mesh, nu=nu, E=E, terms=ex.options.get("terms"), **opts)
     K = model.stiffness(model.x0).toarray()
     if ex.level == "element":  # the assembled matrices are equal
-        K_fem = _fem_stiffness(mesh, E, nu)
+        K_fem = fem_stiffness(mesh, E, nu, T)
         assert np.abs(K - K_fem).max() <= 1e-10 * np.abs(K_fem).max()
         return
     # lattice: a homogeneous strain; the virial of the forces is V times the continuum stress
@@ -224,7 +215,7 @@ def test_patch_claims_are_not_vacuous():
     """Off the claimed Poisson's ratio the same checks fail: the exact cases mean something."""
     mesh = _mesh("quad")
     K = _model("lloyd_square", mesh=mesh, nu=0.25).stiffness(mesh.points.ravel()).toarray()
-    K_fem = _fem_stiffness(mesh, 1.0, 0.25)
+    K_fem = fem_stiffness(mesh, 1.0, 0.25, T)
     assert np.abs(K - K_fem).max() > 1e-3 * np.abs(K_fem).max()
 
 
@@ -300,7 +291,7 @@ def test_rectangle_element_residual_is_the_derived_optimum(a, b):
     element turned), nu = 1/3; the fit in equilibrium at rest is further away. No set of springs
     matches the bilinear rectangle for r != 1 (derivations/elements/rectangle.py)."""
     mesh = _one_quad(a, b)
-    K_fem = _fem_stiffness(mesh, 1.0, 1 / 3)
+    K_fem = fem_stiffness(mesh, 1.0, 1 / 3, T)
 
     def rel(fit):
         K = _model("lloyd_rectangle", mesh=mesh, nu=1 / 3, fit=fit).stiffness(mesh.points.ravel()).toarray()

@@ -34,6 +34,17 @@ def _error_line(capsys) -> str:
     return err[-1]
 
 
+def _refused_run(tmp_path: Path, capsys, data: dict, *options: str) -> tuple[Path, str]:
+    """Write ``data`` as a scene and ``msslib run`` it: exit code 1 and no output file. Returns the
+    scene's path and the error line."""
+    scene = _write(tmp_path, data)
+    out = tmp_path / "out.nc"
+    assert main(["run", str(scene), "--out", str(out), *options]) == 1
+    line = _error_line(capsys)
+    assert not out.exists()
+    return scene, line
+
+
 def _small_cube(**overrides) -> dict:
     scene = {
         "name": "cube",
@@ -186,12 +197,8 @@ def test_unknown_key_names_the_path(tmp_path, capsys):
     data = _example("baudet_beam_tension")
     data["loads"].insert(0, {"type": "gravity", "g": [0.0, 0.0, -9.81]})
     data["loads"][1]["tractoin"] = data["loads"][1].pop("traction")
-    scene = _write(tmp_path, data)
-    out = tmp_path / "out.nc"
-    assert main(["run", str(scene), "--out", str(out)]) == 1
-    line = _error_line(capsys)
+    _, line = _refused_run(tmp_path, capsys, data)
     assert "scene.loads[1].tractoin: unknown key" in line and "traction" in line
-    assert not out.exists()
 
 
 @pytest.mark.parametrize("key_path, bad, expected", [
@@ -212,26 +219,18 @@ def test_bad_values_exit_1(key_path, bad, expected, tmp_path, capsys):
     for key in key_path[:-1]:
         target = target[key]
     target[key_path[-1]] = bad
-    scene = _write(tmp_path, data)
-    out = tmp_path / "out.nc"
-    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 1
-    line = _error_line(capsys)
+    scene, line = _refused_run(tmp_path, capsys, data, "--quiet")
     assert line.startswith("msslib: error: ") and expected in line
     if "unknown" not in expected:
         assert str(bad) in line  # the message names the value
-    assert not out.exists()
     assert main(["validate", str(scene)]) == 1
 
 
 def test_missing_mesh_file(tmp_path, capsys):
     data = _example("membrane_fem_stretch")
     data["geometry"] = {"file": "meshes/absent.msh"}
-    scene = _write(tmp_path, data)
-    out = tmp_path / "out.nc"
-    assert main(["run", str(scene), "--out", str(out)]) == 1
-    line = _error_line(capsys)
+    scene, line = _refused_run(tmp_path, capsys, data)
     assert "scene.geometry.file" in line and "meshes/absent.msh" in line
-    assert not out.exists()
     with pytest.raises(FileNotFoundError, match="absent.msh"):
         load_scene(scene)
 
@@ -252,10 +251,8 @@ def test_unwritable_output(where, tmp_path, capsys):
 def test_divergence_is_one_line_and_leaves_no_file(tmp_path, capsys):
     data = _example("cantilever_gravity_dynamic")
     data["solver"].update(dt=1.0e-2, t_end=0.2, allow_unstable=True)  # else refused before the run
-    scene = _write(tmp_path, data)
-    out = tmp_path / "out.nc"
-    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 1
-    assert "diverged" in _error_line(capsys)
+    scene, line = _refused_run(tmp_path, capsys, data, "--quiet")
+    assert "diverged" in line
     assert list(tmp_path.iterdir()) == [scene]
 
 
