@@ -37,26 +37,36 @@ class StabilityError(ValueError):
     """An explicit time step above the stability limit of the model at rest was refused."""
 
 
-class ConvergenceError(RuntimeError):
+class _SolverFailure(RuntimeError):
+    """A solver failure with the circumstances it happened in as attributes: ``FIELDS`` names
+    them (each None unless given as a keyword), ``REQUIRED`` those that must be given."""
+
+    FIELDS: tuple[str, ...] = ()
+    REQUIRED: tuple[str, ...] = ()
+
+    def __init__(self, message, **details):
+        unknown = [name for name in details if name not in self.FIELDS]
+        if unknown:
+            raise TypeError(f"{type(self).__name__}() got an unexpected keyword argument {unknown[0]!r}")
+        missing = [name for name in self.REQUIRED if name not in details]
+        if missing:
+            raise TypeError(f"{type(self).__name__}() missing required keyword argument(s): {', '.join(missing)}")
+        super().__init__(message)
+        for name in self.FIELDS:
+            setattr(self, name, details.get(name))
+
+
+class ConvergenceError(_SolverFailure):
     """Newton's method failed (static load step or implicit time step).
 
     Attributes ``load_step``, ``load``, ``iteration``, ``residual`` (absolute free-dof residual
     norm), ``x_last`` (the last converged state, finite) and, for dynamics, ``step`` and ``time``.
     """
 
-    def __init__(self, message, *, load_step=None, load=None, iteration=None, residual=None,
-                 x_last=None, step=None, time=None):
-        super().__init__(message)
-        self.load_step = load_step
-        self.load = load
-        self.iteration = iteration
-        self.residual = residual
-        self.x_last = x_last
-        self.step = step
-        self.time = time
+    FIELDS = ("load_step", "load", "iteration", "residual", "x_last", "step", "time")
 
 
-class DivergenceError(RuntimeError):
+class DivergenceError(_SolverFailure):
     """A time integration blew up.
 
     Attributes ``step`` (index of the offending step, 1-based), ``time``, ``quantity``
@@ -64,19 +74,9 @@ class DivergenceError(RuntimeError):
     instability, ``value`` then the growth factor), ``dof``, ``value``, the last finite state
     ``x_last``, ``v_last`` (the state before the offending step), ``dt``, ``stability_limit`` (the
     limit of the model at rest computed before an explicit run; None for implicit Euler) and
-    ``max_displacement`` (``max |x - x0|`` when it was stopped).
+    ``max_displacement`` (``max |x - x0|`` when it was stopped); the first five are required.
     """
 
-    def __init__(self, message, *, step, time, quantity, dof, value, x_last=None, v_last=None, dt=None,
-                 stability_limit=None, max_displacement=None):
-        super().__init__(message)
-        self.step = step
-        self.time = time
-        self.quantity = quantity
-        self.dof = dof
-        self.value = value
-        self.x_last = x_last
-        self.v_last = v_last
-        self.dt = dt
-        self.stability_limit = stability_limit
-        self.max_displacement = max_displacement
+    FIELDS = ("step", "time", "quantity", "dof", "value", "x_last", "v_last", "dt", "stability_limit",
+              "max_displacement")
+    REQUIRED = FIELDS[:5]

@@ -122,6 +122,13 @@ def _col(name, unit, values, description="", dtype=float):
     return Column(name, unit, np.ascontiguousarray(values, dtype=dtype), description)
 
 
+def _cell_columns(conn, solid: str) -> list[Column]:
+    """The columns that name each cell of a per-cell table: its index and its nodes ``conn`` (m, k),
+    ``solid`` the kind of cell (``"tetrahedron"``, ``"hexahedron"``)."""
+    return [_col("cell", None, np.arange(len(conn)), "cell index", int),
+            *[_col(f"node_{a}", None, conn[:, a], f"node {a} of the {solid}", int) for a in range(conn.shape[1])]]
+
+
 # --------------------------------------------------------------------------------------------
 # the model
 # --------------------------------------------------------------------------------------------
@@ -294,8 +301,7 @@ def _tables(exp: MssExport) -> dict[str, Table]:
         t = exp.tet_volume
         out["tet_volume"] = Table("tet_volume", "Lloyd's tetrahedron volume energy k_v/(2 V0^2) (V - V0)^2, V the "
                                                 "signed volume of (node_0, ..., node_3) (C: msslib_tet_signed_volume)", [
-            _col("cell", None, np.arange(len(t)), "cell index", int),
-            *[_col(f"node_{a}", None, t.conn[:, a], f"node {a} of the tetrahedron", int) for a in range(4)],
+            *_cell_columns(t.conn, "tetrahedron"),
             _col("k_v", "J", t.k_v, "volume coefficient k_v (may be negative)"),
             _col("V0", "m^3", t.V0, "rest volume of the cell"),
         ])
@@ -304,8 +310,7 @@ def _tables(exp: MssExport) -> dict[str, Table]:
         out["hex_volume"] = Table("hex_volume", "Golec's volume energy kappa/(2 V0) (V - V0)^2, V the averaged-edge-"
                                                 "vector volume of the hexahedron (node_0, ..., node_7) in VTK order "
                                                 "(C: msslib_hex_averaged_volume)", [
-            _col("cell", None, np.arange(len(h)), "cell index", int),
-            *[_col(f"node_{a}", None, h.conn[:, a], f"node {a} of the hexahedron", int) for a in range(8)],
+            *_cell_columns(h.conn, "hexahedron"),
             _col("kappa", "Pa", h.kappa, "volume coefficient kappa (may be negative)"),
             _col("V0", "m^3", h.V0, "rest (averaged) volume of the cell"),
         ])
@@ -316,8 +321,7 @@ def _tables(exp: MssExport) -> dict[str, Table]:
         out["baudet_correction"] = Table("baudet_correction", "Baudet's orthogonal correction per cube: factor c "
                                          "(F_perp = c F_i) and the elongation force of each face at load factor 1 "
                                          f"({faces}; msslib.terms.BaudetCorrection)", [
-            _col("cell", None, np.arange(len(cells)), "cell index", int),
-            *[_col(f"node_{a}", None, cells[:, a], f"node {a} of the hexahedron", int) for a in range(8)],
+            *_cell_columns(cells, "hexahedron"),
             _col("factor", "1", c.factor, "correction factor c"),
             *[_col(f"face_force_{f}", "N", c.face_force[:, f], f"elongation force of face {f} (> 0 tension)")
               for f in range(6)],

@@ -180,8 +180,23 @@ def _fmt_point(p) -> str:
     return "(" + ", ".join(f"{v:.4g}" for v in p) + ")"
 
 
+class _Verdict:
+    """What the verdicts on one state and on a run share: the counts ``n_inverted`` and
+    ``n_collapsed`` (numbers for one state, arrays per state for a run) and what makes them ok."""
+
+    @property
+    def _unphysical(self):
+        """True where an inverted or a collapsed cell is present (per state for a run)."""
+        return (np.asarray(self.n_inverted) > 0) | (np.asarray(self.n_collapsed) > 0)
+
+    @property
+    def ok(self) -> bool:
+        """No inverted and no collapsed cell (in any state)."""
+        return not np.any(self._unphysical)
+
+
 @dataclass(frozen=True)
-class StateQuality:
+class StateQuality(_Verdict):
     """The verdict on one state (see :func:`check_state`).
 
     ``ratio`` and ``state`` are per cell (relative Jacobian, flag); ``worst_cell`` is the cell with
@@ -209,11 +224,6 @@ class StateQuality:
     @property
     def n_cells(self) -> int:
         return len(self.ratio)
-
-    @property
-    def ok(self) -> bool:
-        """No inverted and no collapsed cell."""
-        return self.n_inverted == 0 and self.n_collapsed == 0
 
     def summary(self) -> str:
         """One line: the counts, the worst cell and where it lies at rest."""
@@ -255,7 +265,7 @@ def check_state(mesh: Mesh, positions, *, threshold: float = COLLAPSE_THRESHOLD,
 
 
 @dataclass(frozen=True)
-class HistoryQuality:
+class HistoryQuality(_Verdict):
     """The verdict on every saved state of a run (see :func:`check_history`).
 
     Per state: ``n_inverted``, ``n_collapsed`` (int64) and ``min_ratio`` (the smallest relative
@@ -273,15 +283,19 @@ class HistoryQuality:
     def n_states(self) -> int:
         return len(self.n_inverted)
 
+    @staticmethod
+    def _first(hit: np.ndarray) -> int:
+        """Index of the first True state of ``hit``, -1 if none."""
+        where = np.flatnonzero(hit)
+        return int(where[0]) if len(where) else -1
+
     @property
     def first_inverted(self) -> int:
-        hit = np.flatnonzero(self.n_inverted > 0)
-        return int(hit[0]) if len(hit) else -1
+        return self._first(self.n_inverted > 0)
 
     @property
     def first_unphysical(self) -> int:
-        hit = np.flatnonzero((self.n_inverted > 0) | (self.n_collapsed > 0))
-        return int(hit[0]) if len(hit) else -1
+        return self._first(self._unphysical)
 
     def _time(self, index: int) -> float:
         return float(self.times[index]) if index >= 0 and self.times is not None else float("nan")
@@ -296,11 +310,7 @@ class HistoryQuality:
 
     @property
     def n_unphysical_states(self) -> int:
-        return int(np.count_nonzero((self.n_inverted > 0) | (self.n_collapsed > 0)))
-
-    @property
-    def ok(self) -> bool:
-        return self.n_unphysical_states == 0
+        return int(np.count_nonzero(self._unphysical))
 
 
 def check_history(mesh: Mesh, positions, times=None, *, threshold: float = COLLAPSE_THRESHOLD) -> HistoryQuality:

@@ -5,21 +5,13 @@ and its correction force for the Poisson effect, in two readings (:mod:`msslib.b
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 
 from msslib.baudet_correction import READINGS, ElementBaudetCorrection
 from msslib.generated import cube_baudet as _baudet
 from msslib.models.checks import evaluate, flag, poisson, positive, same_shape
-from msslib.models.common import (
-    _cube_edges,
-    _merge_springs,
-    _per_cell,
-    _require,
-    assemble_springs,
-    material_arrays,
-)
+from msslib.models.common import cube_constants, cube_springs
 from msslib.models.spec import Exactness, ModelSpec, Option, choice, split_terms
 from msslib.terms import BaudetCorrection, Term, sum_external_forces
 
@@ -62,13 +54,8 @@ def baudet_cube_springs(mesh, materials, published: bool = False) -> list[Term]:
     (``parameters.baudet_cube(E, nu, a)``, ``a`` the cube's edge).  Add :func:`baudet_correction`
     for the Poisson effect under load. (The printed and derived spring constants agree;
     ``published`` is accepted for symmetry with the other builders.)"""
-    _require(mesh, "hexahedron")
-    a = _cube_edges(mesh)
-    E, nu = material_arrays(mesh, materials)
-    k_e, k_d = _per_cell(partial(baudet_cube, published=published), ("k_edge", "k_diagonal"), E, nu, a)
-    edges = assemble_springs(mesh, "edges", lambda c, _p: k_e[c])
-    inner = assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_d[c])
-    return [_merge_springs([edges, inner])]
+    k_e, k_d = cube_constants(mesh, materials, baudet_cube, ("k_edge", "k_diagonal"), published=published)
+    return [cube_springs(mesh, [("edges", k_e), ("inner_diagonals", k_d)])]
 
 
 def baudet_correction(mesh, materials, loads, published: bool = False) -> BaudetCorrection:
@@ -76,10 +63,7 @@ def baudet_correction(mesh, materials, loads, published: bool = False) -> Baudet
     ``parameters.baudet_cube(E, nu, a).correction_factor``; ``loads`` (n, 3) nodal surface forces
     at unit load, or a list of terms whose external forces are summed (leave gravity out).
     ``published=True`` uses the printed factor -(4 nu - 1)/16 (see the errata)."""
-    _require(mesh, "hexahedron")
-    a = _cube_edges(mesh)
-    E, nu = material_arrays(mesh, materials)
-    (c,) = _per_cell(partial(baudet_cube, published=published), ("correction_factor",), E, nu, a)
+    (c,) = cube_constants(mesh, materials, baudet_cube, ("correction_factor",), published=published)
     if not isinstance(loads, np.ndarray):
         try:
             loads = np.asarray(loads, dtype=float)
@@ -92,11 +76,8 @@ def element_correction(mesh, materials, published: bool = False) -> ElementBaude
     """:class:`ElementBaudetCorrection` for a mesh of cubes with each cube's ``k_edge``,
     ``k_diagonal`` and ``correction_factor`` from ``parameters.baudet_cube(E, nu, a)``
     (``published=True``: the printed factor -(4 nu - 1)/16)."""
-    _require(mesh, "hexahedron")
-    a = _cube_edges(mesh)
-    E, nu = material_arrays(mesh, materials)
-    k_e, k_d, c = _per_cell(partial(baudet_cube, published=published),
-                            ("k_edge", "k_diagonal", "correction_factor"), E, nu, a)
+    k_e, k_d, c = cube_constants(mesh, materials, baudet_cube, ("k_edge", "k_diagonal", "correction_factor"),
+                                 published=published)
     return ElementBaudetCorrection(mesh, k_e, k_d, c)
 
 

@@ -3,6 +3,8 @@ constants summed over the cells sharing a node pair, and the checks of the mesh.
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 
 from msslib import mesh as _mesh
@@ -140,6 +142,26 @@ def _cube_edges(mesh, rtol=1e-6):
         shown = ", ".join(f"cell {i} (edges {lengths[i].min():.4g}..{lengths[i].max():.4g} m)" for i in bad[:5])
         raise ValueError(f"{len(bad)} hexahedra are not cubes (rtol {rtol}): {shown}")
     return a
+
+
+def cube_constants(mesh, materials, parameters, fields, *args, published: bool = False) -> list[np.ndarray]:
+    """Per-cube constants on a mesh of cubes: ``fields`` of ``parameters(E, nu, a, *args,
+    published=published)``, ``E`` and ``nu`` from ``materials``, ``a`` each cube's edge; one float
+    array per field (see :func:`_per_cell`).  ValueError unless the cells are cubes."""
+    _require(mesh, "hexahedron")
+    a = _cube_edges(mesh)
+    E, nu = material_arrays(mesh, materials)
+    return _per_cell(partial(parameters, published=published), fields, E, nu, a, *args)
+
+
+def cube_springs(mesh, constants) -> Springs:
+    """One Springs term from per-cube spring constants: ``constants`` is a sequence of
+    ``(pair_kind, k)``, ``k`` one value per cell, summed over the cubes sharing a pair
+    (:func:`assemble_springs`); the pairs of the kinds in the order given."""
+    def per_cell(k):
+        return lambda cells, _pairs: k[cells]
+
+    return _merge_springs([assemble_springs(mesh, kind, per_cell(k)) for kind, k in constants])
 
 
 def check_material(E, nu, model, valid_nu):

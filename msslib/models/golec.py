@@ -4,21 +4,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 
 from msslib.generated import cube_golec as _golec
 from msslib.generated import kernels as _K
 from msslib.models.checks import evaluate, flag, poisson, positive, same_shape
-from msslib.models.common import (
-    _cube_edges,
-    _merge_springs,
-    _per_cell,
-    _require,
-    assemble_springs,
-    material_arrays,
-)
+from msslib.models.common import cube_constants, cube_springs
 from msslib.models.spec import (
     Exactness,
     ModelSpec,
@@ -72,16 +64,9 @@ def golec_cube_springs(mesh, materials, A, published: bool = False) -> list[Term
     the averaged-edge volume at rest.  ``A`` (a scalar or one value per cell) is passed through to
     ``golec_cube``. ``published=True`` uses the printed constants, per element (see the errata);
     the volume term keeps the dimensionally consistent energy kappa/(2 V0) (V - V0)^2."""
-    _require(mesh, "hexahedron")
-    a = _cube_edges(mesh)
-    E, nu = material_arrays(mesh, materials)
-    k_e, k_f, k_i, kappa = _per_cell(partial(golec_cube, published=published), ("k_edge", "k_face", "k_inner", "kappa"),
-                                     E, nu, a, A)
-    springs = _merge_springs([
-        assemble_springs(mesh, "edges", lambda c, _p: k_e[c]),
-        assemble_springs(mesh, "face_diagonals", lambda c, _p: k_f[c]),
-        assemble_springs(mesh, "inner_diagonals", lambda c, _p: k_i[c]),
-    ])
+    k_e, k_f, k_i, kappa = cube_constants(mesh, materials, golec_cube, ("k_edge", "k_face", "k_inner", "kappa"), A,
+                                          published=published)
+    springs = cube_springs(mesh, [("edges", k_e), ("face_diagonals", k_f), ("inner_diagonals", k_i)])
     return [springs, HexVolume(mesh.cells, kappa, _hex_rest_volumes(mesh))]
 
 

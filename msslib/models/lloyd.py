@@ -103,32 +103,34 @@ def _nu_optional(nu):
         poisson(nu)
 
 
+def _plate(function, formula, cls, E, t, nu, **sizes):
+    """The parameters ``cls`` of the plate element ``function`` from ``formula(E, t, *sizes)``:
+    ``E``, the thickness ``t`` and the ``sizes`` must be positive; ``nu`` (optional) is only checked
+    and warned about where it differs from the one at which the element is exact
+    (``VALID_NU[function]``)."""
+    positive("E", E), positive("thickness t", t)
+    for name, value in sizes.items():
+        positive(name, value)
+    _nu_optional(nu)
+    same_shape(function, E=E, t=t, **sizes, nu=nu)
+    warn_nu(nu, VALID_NU[function], function)
+    return evaluate(function, formula, cls, E=E, t=t, **sizes)
+
+
 def lloyd_triangle(E, t, *, nu=None) -> TriangleSprings:
     """Lloyd et al. eq. 8: k = sqrt(3)/4 E t per equilateral triangle (exact for nu = 1/3)."""
-    positive("E", E), positive("thickness t", t)
-    _nu_optional(nu)
-    same_shape("lloyd_triangle", E=E, t=t, nu=nu)
-    warn_nu(nu, 1 / 3, "lloyd_triangle")
-    return evaluate("lloyd_triangle", _tri.lloyd_triangle, TriangleSprings, E=E, t=t)
+    return _plate("lloyd_triangle", _tri.lloyd_triangle, TriangleSprings, E, t, nu)
 
 
 def van_gelder_triangle(E, t, area, length, *, nu=None) -> TriangleSprings:
     """Van Gelder: k = E t A_e / l^2 per triangle of area A_e, for its edge of length l (Lloyd eq. 9)."""
-    positive("E", E), positive("thickness t", t), positive("area", area), positive("length", length)
-    _nu_optional(nu)
-    same_shape("van_gelder_triangle", E=E, t=t, area=area, length=length, nu=nu)
-    warn_nu(nu, 1 / 3, "van_gelder_triangle")
-    return evaluate("van_gelder_triangle", _tri.van_gelder_triangle, TriangleSprings, E=E, t=t, area=area,
-                    length=length)
+    return _plate("van_gelder_triangle", _tri.van_gelder_triangle, TriangleSprings, E, t, nu, area=area,
+                  length=length)
 
 
 def lloyd_square(E, t, *, nu=None) -> SquareSprings:
     """Lloyd et al. eqs. 10-11: prestrained square (exact for nu = 1/3)."""
-    positive("E", E), positive("thickness t", t)
-    _nu_optional(nu)
-    same_shape("lloyd_square", E=E, t=t, nu=nu)
-    warn_nu(nu, 1 / 3, "lloyd_square")
-    return evaluate("lloyd_square", _square.lloyd_square, SquareSprings, E=E, t=t)
+    return _plate("lloyd_square", _square.lloyd_square, SquareSprings, E, t, nu)
 
 
 RECTANGLE_FITS = ("equilibrium", "least_squares")
