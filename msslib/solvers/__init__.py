@@ -109,7 +109,8 @@ energy of the time derivative of the motion, grows far beyond what a stable step
 Modules (each imports only those above it)
 -------------------------------------------
 :mod:`~msslib.solvers.protocol` (reading a problem, results, ``F_ref``),
-:mod:`~msslib.solvers.plans` (free-dof submatrices by cached plans, :class:`PlanCache`),
+:mod:`~msslib.solvers.memo` (the process-wide memo of plans), :mod:`~msslib.solvers.plans`
+(free-dof submatrices by cached plans, :class:`PlanCache`),
 :mod:`~msslib.solvers.amg_kernels`, :mod:`~msslib.solvers.amg_cycle`, :mod:`~msslib.solvers.amg`
 (smoothed-aggregation AMG: compiled kernels, V-cycle, set-up),
 :mod:`~msslib.solvers.direct` (banded Cholesky / LU, SuperLU),

@@ -5,18 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .amg_kernels import (
-    _block_diag_inverse,
-    _block_gauss_seidel_sweep,
-    _bsr3_matvec,
-    _bsr_matvec,
-    _gs3_backward,
-    _gs3_forward_from_zero,
-    _gs_forward_from_zero,
-    _prolong_add,
-    _residual3_restrict,
-    _residual_restrict,
-)
+from . import amg_kernels as kernels
 from .plans import _same_readonly
 
 
@@ -31,7 +20,7 @@ class _BlockGaussSeidel:
     def __call__(self, A, x, b):
         if x.ndim != 1 or not x.flags.c_contiguous or x.dtype != np.float64:
             raise TypeError("block Gauss-Seidel needs a contiguous float64 vector")
-        _block_gauss_seidel_sweep(A.indptr, A.indices, A.data, self.dinv, x,
+        kernels._block_gauss_seidel_sweep(A.indptr, A.indices, A.data, self.dinv, x,
                                   np.ascontiguousarray(b, dtype=np.float64).ravel(), self.forward)
 
 
@@ -44,7 +33,7 @@ def _compiled_smoothers(ml, dinv0=None):
         if not (sp.issparse(A) and A.format == "bsr" and A.blocksize[0] == A.blocksize[1]):
             continue
         try:
-            dinv = dinv0 if (k == 0 and dinv0 is not None) else _block_diag_inverse(A.indptr, A.indices, A.data)
+            dinv = dinv0 if (k == 0 and dinv0 is not None) else kernels._block_diag_inverse(A.indptr, A.indices, A.data)
         except np.linalg.LinAlgError:  # a singular diagonal block: pyamg's smoother stays
             continue
         if not np.all(np.isfinite(dinv)):
@@ -144,7 +133,7 @@ class _VCycle:
         False (nothing changed) when a diagonal block is singular."""
         A = self.levels[0]["A"]
         try:
-            dinv = _block_diag_inverse(A.indptr, A.indices, A.data)
+            dinv = kernels._block_diag_inverse(A.indptr, A.indices, A.data)
         except np.linalg.LinAlgError:
             return False
         if not np.all(np.isfinite(dinv)):
@@ -159,17 +148,18 @@ class _VCycle:
         L = self.levels[k]
         A, P, dinv, a, p = L["A"], L["P"], L["dinv"], L["a_data"], L["p_data"]
         three = A.blocksize[0] == 3
-        (_gs3_forward_from_zero if three else _gs_forward_from_zero)(A.indptr, A.indices, a, dinv, b, x, L["s"])
+        forward, residual = ((kernels._gs3_forward_from_zero, kernels._residual3_restrict) if three
+                             else (kernels._gs_forward_from_zero, kernels._residual_restrict))
+        forward(A.indptr, A.indices, a, dinv, b, x, L["s"])
         bc, xc = L["bc"], L["xc"]
         bc.fill(0.0)
-        (_residual3_restrict if three else _residual_restrict)(A.indptr, A.indices, a, x, L["s"],
-                                                               P.indptr, P.indices, p, bc)
+        residual(A.indptr, A.indices, a, x, L["s"], P.indptr, P.indices, p, bc)
         self._cycle(k + 1, bc, xc)
-        _prolong_add(P.indptr, P.indices, p, xc, x)
+        kernels._prolong_add(P.indptr, P.indices, p, xc, x)
         if three:
-            _gs3_backward(A.indptr, A.indices, a, dinv, x, b)
+            kernels._gs3_backward(A.indptr, A.indices, a, dinv, x, b)
         else:
-            _block_gauss_seidel_sweep(A.indptr, A.indices, a, dinv, x, b, False)
+            kernels._block_gauss_seidel_sweep(A.indptr, A.indices, a, dinv, x, b, False)
 
     def __matmul__(self, b):
         b = np.ascontiguousarray(np.asarray(b, dtype=np.float64).ravel())
@@ -183,7 +173,7 @@ class _VCycle:
 def _matvec_of(A):
     """A function ``v -> A v``: compiled for float64 BSR matrices, else ``A @ v``."""
     if sp.issparse(A) and A.format == "bsr" and A.dtype == np.float64:
-        kernel = _bsr3_matvec if A.blocksize == (3, 3) else _bsr_matvec
+        kernel = kernels._bsr3_matvec if A.blocksize == (3, 3) else kernels._bsr_matvec
 
         def mv(v):
             y = np.empty(A.shape[0])

@@ -2,7 +2,8 @@
 
 A :class:`SolverContext` holds what the Newton systems of one problem have in common: the
 spatial dimension and the coordinates of the free nodes (AMG near-null space, band orderings),
-the plans of the free-dof submatrices and band orderings (:class:`~msslib.solvers.plans.PlanCache`),
+the plans of the free-dof submatrices and band orderings (:class:`~msslib.solvers.plans.PlanCache`,
+backed by the process-wide memo of plans :data:`msslib.solvers.memo.PLANS`),
 the kept AMG hierarchy (``cache``), the matrix of the Newton systems whose values are refilled
 (``K``) and the banded factorisation arrays.  It is a dict (its entries are the state) with the
 plan cache as attribute ``plans``.
@@ -17,10 +18,12 @@ largely, its values), rebuilt otherwise.  It goes with the problem.
 
 from __future__ import annotations
 
+import functools
 import threading
 
 import numpy as np
 
+from . import direct
 from .plans import PlanCache
 
 ATTRIBUTE = "_msslib_solver_context"  # where a problem keeps the context of its last static solve
@@ -31,7 +34,7 @@ class SolverContext(dict):
 
     def __init__(self, *args, plans: PlanCache | None = None, **kw):
         super().__init__(*args, **kw)
-        self.plans = plans if plans is not None else PlanCache()
+        self.plans = PlanCache(share=plans)  # its own view of the shared plans (with its geometry)
 
     def __reduce__(self):  # copies and pickles of a problem start afresh (a lock cannot be copied)
         return (SolverContext, ())
@@ -49,6 +52,13 @@ def _keep_context(problem, ctx) -> bool:
     except (AttributeError, TypeError):  # slots, frozen or read-only objects keep nothing
         return False
     return True
+
+
+def _band_inputs(dim, coords):
+    """The inputs of :func:`msslib.solvers.direct._band_plan` besides the pattern, as the memo
+    of plans keys them: the free-node coordinates (the geometric candidate ordering), the
+    dimension and the cost limit (read when asked: it is a module setting)."""
+    return (() if coords is None else (coords,)), (dim, direct.BAND_COST_MAX)
 
 
 def _solver_context(problem, x, free, plans: PlanCache | None = None):
@@ -72,6 +82,7 @@ def _solver_context(problem, x, free, plans: PlanCache | None = None):
             ctx["dim"] = dim
             ctx["node_free"] = whole
             ctx["coords"] = np.asarray(x, dtype=float).reshape(-1, dim)[whole]
+    ctx.plans.band_inputs = functools.partial(_band_inputs, ctx.get("dim"), ctx.get("coords"))
     return ctx
 
 

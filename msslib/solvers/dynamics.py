@@ -12,19 +12,11 @@ from numba import njit
 
 from msslib.errors import ConvergenceError, DivergenceError
 
+from . import protocol
 from .context import _solver_context
 from .linear import _linear_solve
 from .plans import _submatrix
-from .protocol import (
-    TINY,
-    DynamicResult,
-    _energy_or_none,
-    _force_scale,
-    _free_mask,
-    _is_conservative,
-    _load_vector,
-    _NewtonFailure,
-)
+from .protocol import TINY, DynamicResult
 from .roundoff import _force_magnitude, convergence_threshold, roundoff_floor
 from .stability import EXPLICIT_METHODS, _mass_vector, _resolve_damping, check_time_step
 from .statics import _ARMIJO_C, _MAX_BACKTRACKS, _floor_text
@@ -162,7 +154,7 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
     if save_every < 1:
         raise ValueError("save_every must be >= 1")
     n = int(problem.n_dof)
-    free = _free_mask(problem)
+    free = protocol._free_mask(problem)
     mass = _mass_vector(problem)
     if np.any(mass[free] <= 0):
         raise ValueError("masses of free dofs must be positive")
@@ -189,7 +181,7 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
             stats.update(check_time_step(problem, x, dt, method=method, damping=(alpha, beta), load=load,
                                          allow_unstable=allow_unstable))
         limit = stats["stability_limit"]
-    conservative = _is_conservative(problem, x, load)
+    conservative = protocol._is_conservative(problem, x, load)
     mf = mass[free]
     inv_m = 1.0 / mf
     messages: list[str] = []
@@ -213,8 +205,8 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
 
     f_scale = magnitude = None
     if method == "implicit_euler":
-        f_load = _load_vector(problem, x)
-        f_scale = _force_scale(problem, x, free, f_load)
+        f_load = protocol._load_vector(problem, x)
+        f_scale = protocol._force_scale(problem, x, free, f_load)
         with np.errstate(all="ignore"):
             K0 = _submatrix(problem.stiffness(x, load), free, plans=solver_context)
             magnitude = _force_magnitude(K0, x[free], np.nan_to_num(np.abs(load * f_load[free])))
@@ -227,7 +219,7 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
         vs.append(v.copy())
         kes.append(0.5 * float(mass[free] @ (v[free] ** 2)))
         if conservative:
-            pes.append(_energy_or_none(problem, x, load))
+            pes.append(protocol._energy_or_none(problem, x, load))
         if progress is not None:
             progress({"step": step, "t": t, "n_steps": n_steps})
 
@@ -339,7 +331,7 @@ def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, ma
         J = sp.diags(mf * (1.0 + h * alpha)) + (h * h + h * beta) * K
         try:
             dw = _linear_solve(sp.csr_matrix(J), -R, linear_solver, symmetric, messages, solver_context)
-        except _NewtonFailure as exc:
+        except protocol._NewtonFailure as exc:
             raise ConvergenceError(
                 f"implicit Euler linear solve failed at step {step}, t = {t_new:.6g} s, iteration {it}: {exc}",
                 iteration=it, residual=rn, x_last=x.copy(), step=step, time=t_new, load=load) from None

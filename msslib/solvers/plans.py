@@ -12,6 +12,8 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
+from .memo import MISSING, PLANS
+
 
 class PlanCache:
     """The plans of a few sparsity patterns, most recently used first: free-dof extraction plans
@@ -19,14 +21,19 @@ class PlanCache:
 
     An entry is reused only for the very same pattern (the same index arrays, or equal ones) and
     free mask; it holds references to the pattern arrays, so their ids cannot be recycled.  A
-    solver context owns one; the contexts of one problem share it (plans depend on the pattern
-    only)."""
+    solver context owns one; the contexts of one problem share its lists (``share``: plans
+    depend on the pattern only).  A pattern new to the cache is looked up in the process-wide
+    memo (:data:`msslib.solvers.memo.PLANS`) first, and new plans are kept there too; band
+    orderings only when ``band_inputs`` is set: a function giving the inputs of the ordering
+    besides the pattern, as ``(arrays, settings)`` (the owning context's geometry and the cost
+    limit; set by :func:`msslib.solvers.context._solver_context`)."""
 
     SIZE = 4
 
-    def __init__(self):
-        self.entries: list = []  # submatrix and node-block plans
-        self.bands: list = []  # band orderings
+    def __init__(self, share: PlanCache | None = None):
+        self.entries: list = share.entries if share is not None else []  # submatrix and node-block plans
+        self.bands: list = share.bands if share is not None else []  # band orderings
+        self.band_inputs = None
 
     @staticmethod
     def _push(lst, entry, size):
@@ -36,8 +43,28 @@ class PlanCache:
     def add(self, entry):
         self._push(self.entries, entry, self.SIZE)
 
+    def _band_key(self, indptr, indices):
+        """The memo key (arrays, settings) of the band ordering of a pattern, or None when the
+        other inputs of the ordering are unknown."""
+        if self.band_inputs is None:
+            return None
+        arrays, settings = self.band_inputs()
+        return (indptr, indices, *arrays), settings
+
     def add_band(self, entry):
         self._push(self.bands, entry, self.SIZE)
+        key = self._band_key(entry["indptr"], entry["indices"])
+        if key is not None:  # a copy: the factorisation adds its LU map to the context's own plan
+            plan = entry["plan"]
+            PLANS.put("band", key[0], None if plan is None else dict(plan), key[1])
+
+    def seed_band(self, indptr, indices):
+        """Take the band ordering of the pattern ``(indptr, indices)`` from the memo, if it is there."""
+        key = self._band_key(indptr, indices)
+        plan = MISSING if key is None else PLANS.get("band", key[0], key[1])
+        if plan is not MISSING:
+            self._push(self.bands, {"indices": indices, "indptr": indptr,
+                                    "plan": None if plan is None else dict(plan)}, self.SIZE)
 
 
 def _plans_of(plans):
@@ -145,12 +172,17 @@ def _is_node_blocked(indptr, indices, dim):
 
 
 @njit(cache=True, nogil=True)
-def _bsr_plan(indptr, indices, node_free, new_node, dim, bptr, bind):
-    """Block row pointers and block column indices of the free-free node blocks (``bind`` is
-    filled when it is long enough); returns the number of blocks."""
+def _free_blocks(indptr, indices, node_free, dim, new_node, bptr, bind, data, out):
+    """Walk the free-free node blocks of a node-blocked CSR in BSR order (block-major) and return
+    their number.  What is filled, each when its array is not empty: ``bptr`` the block row
+    pointers, ``bind`` (when long enough) the block column indices (``new_node`` numbering),
+    ``out`` the blocks' values from ``data``."""
     nb = 0
     r = 0
-    bptr[0] = 0
+    rows = bptr.shape[0] > 0
+    gather = out.shape[0] > 0
+    if rows:
+        bptr[0] = 0
     for a in range(node_free.shape[0]):
         if not node_free[a]:
             continue
@@ -161,28 +193,22 @@ def _bsr_plan(indptr, indices, node_free, new_node, dim, bptr, bind):
             if node_free[_U(b)]:
                 if nb < bind.shape[0]:
                     bind[_U(nb)] = new_node[_U(b)]
+                if gather:
+                    for i in range(dim):
+                        q = r0 + i * L + t
+                        for j in range(dim):
+                            out[_U(nb), _U(i), _U(j)] = data[_U(q + j)]
                 nb += 1
-        r += 1
-        bptr[r] = nb
+        if rows:
+            r += 1
+            bptr[r] = nb
     return nb
 
 
-@njit(cache=True, nogil=True)
-def _gather_free_bsr(indptr, indices, data, node_free, dim, out):
-    """Values of the free-free node blocks, block-major (BSR), from a node-blocked CSR."""
-    k = 0
-    for a in range(node_free.shape[0]):
-        if not node_free[a]:
-            continue
-        r0 = indptr[_U(dim * a)]
-        L = indptr[_U(dim * a + 1)] - r0
-        for t in range(0, L, dim):
-            if node_free[_U(indices[_U(r0 + t)] // dim)]:
-                for i in range(dim):
-                    q = r0 + i * L + t
-                    for j in range(dim):
-                        out[_U(k), _U(i), _U(j)] = data[_U(q + j)]
-                k += 1
+def _no_index(K):
+    """An empty index array of the index type of the plans of ``K`` (an argument of
+    :func:`_free_blocks` that is not filled)."""
+    return np.empty(0, dtype=np.int32 if K.nnz < 2**31 else np.int64)
 
 
 def _submatrix_bsr(K, node_free, dim, out=None, plans=None):
@@ -200,17 +226,33 @@ def _submatrix_bsr(K, node_free, dim, out=None, plans=None):
     entry = _bsr_entry(K, node_free, dim, plans)
     if entry is None:
         return None
-    node_free = entry["free"]
-    if (out is not None and sp.issparse(out) and out.format == "bsr"
+    if not (out is not None and sp.issparse(out) and out.format == "bsr"
             and _same_readonly(out.indices, entry["bind"]) and out.data.shape == (entry["nblocks"], dim, dim)
             and out.data.dtype == K.data.dtype and out.data.flags.writeable):
-        _gather_free_bsr(K.indptr, K.indices, K.data, node_free, dim, out.data)
-        return out
-    vals = np.empty((entry["nblocks"], dim, dim), dtype=K.data.dtype)
-    _gather_free_bsr(K.indptr, K.indices, K.data, node_free, dim, vals)
-    A = sp.bsr_matrix((vals, entry["bind"], entry["bptr"]), shape=entry["sub_shape"], copy=False)
-    A.has_sorted_indices = True
-    return A
+        out = sp.bsr_matrix((np.empty((entry["nblocks"], dim, dim), dtype=K.data.dtype), entry["bind"],
+                             entry["bptr"]), shape=entry["sub_shape"], copy=False)
+        out.has_sorted_indices = True
+    none = _no_index(K)
+    _free_blocks(K.indptr, K.indices, entry["free"], dim, none, none, none, K.data, out.data)
+    return out
+
+
+def _bsr_block_plan(K, node_free, dim):
+    """The node-block plan of ``K`` and ``node_free`` (the part of a plan entry that depends on
+    them only)."""
+    if not _is_node_blocked(K.indptr, K.indices, dim):
+        return {"blocked": False}
+    none = _no_index(K)
+    new_node = (np.cumsum(node_free) - 1).astype(none.dtype)
+    n_free = int(node_free.sum())
+    bptr = np.empty(n_free + 1, dtype=none.dtype)
+    no_values = np.empty((0, dim, dim), dtype=K.data.dtype)
+    nb = _free_blocks(K.indptr, K.indices, node_free, dim, new_node, bptr, none, K.data, no_values)
+    bind = np.empty(nb, dtype=none.dtype)
+    _free_blocks(K.indptr, K.indices, node_free, dim, new_node, bptr, bind, K.data, no_values)
+    bptr.flags.writeable = False
+    bind.flags.writeable = False
+    return {"blocked": True, "bptr": bptr, "bind": bind, "nblocks": nb, "sub_shape": (dim * n_free, dim * n_free)}
 
 
 def _bsr_entry(K, node_free, dim, plans=None):
@@ -228,24 +270,14 @@ def _bsr_entry(K, node_free, dim, plans=None):
             entry = e
             break
     if entry is None:
-        if not _is_node_blocked(K.indptr, K.indices, dim):
-            entry = {"kind": key, "shape": K.shape, "free_n": node_free.size, "free": node_free.copy(),
-                     "indptr": K.indptr, "indices": K.indices, "blocked": False}
-        else:
-            idx_t = np.int32 if K.nnz < 2**31 else np.int64
-            new_node = (np.cumsum(node_free) - 1).astype(idx_t)
-            n_free = int(node_free.sum())
-            bptr = np.empty(n_free + 1, dtype=idx_t)
-            nb = _bsr_plan(K.indptr, K.indices, node_free, new_node, dim, bptr, np.empty(0, dtype=idx_t))
-            bind = np.empty(nb, dtype=idx_t)
-            _bsr_plan(K.indptr, K.indices, node_free, new_node, dim, bptr, bind)
-            bptr.flags.writeable = False
-            bind.flags.writeable = False
-            entry = {"kind": key, "shape": K.shape, "free_n": node_free.size, "free": node_free.copy(),
-                     "indptr": K.indptr, "indices": K.indices, "blocked": True, "bptr": bptr,
-                     "bind": bind, "nblocks": nb, "sub_shape": (dim * n_free, dim * n_free)}
+        entry = {"kind": key, "shape": K.shape, "free_n": node_free.size, "free": node_free.copy(),
+                 "indptr": K.indptr, "indices": K.indices}
         if cache is not None:
+            entry.update(PLANS.get_or_compute("bsr", (K.indptr, K.indices, node_free),
+                                              lambda: _bsr_block_plan(K, node_free, dim), (dim, K.shape)))
             cache.add(entry)
+        else:
+            entry.update(_bsr_block_plan(K, node_free, dim))
     return entry if entry["blocked"] else None
 
 
@@ -275,13 +307,9 @@ def _eccentricity(ptr, ind):
     return depth[queue[tail - 1]]
 
 
-def _submatrix_plan(K, free, plans=None):
-    cache = _plans_of(plans)
-    for i, entry in enumerate(cache.entries if cache is not None else ()):
-        if entry.get("kind") is None and _pattern_key_matches(entry, K, free):
-            if i:
-                cache.entries.insert(0, cache.entries.pop(i))
-            return entry
+def _free_plan(K, free):
+    """The free-free index arrays of ``K`` and ``free`` (the part of a plan entry that depends on
+    them only)."""
     n_free = int(free.sum())
     idx_t = np.int32 if K.nnz < 2**31 else np.int64
     new_index = (np.cumsum(free) - 1).astype(idx_t)  # increasing: sorted rows stay sorted
@@ -289,13 +317,28 @@ def _submatrix_plan(K, free, plans=None):
     n_keep = _plan_count(K.indptr, K.indices, free, sub_indptr)
     sub_indices = np.empty(n_keep, dtype=idx_t)
     _plan_fill(K.indptr, K.indices, free, new_index, sub_indices)
+    sub_indptr.flags.writeable = False
+    sub_indices.flags.writeable = False
+    return {"nnz": n_keep, "sub_indptr": sub_indptr, "sub_indices": sub_indices, "sub_shape": (n_free, n_free)}
+
+
+def _submatrix_plan(K, free, plans=None):
+    cache = _plans_of(plans)
+    for i, entry in enumerate(cache.entries if cache is not None else ()):
+        if entry.get("kind") is None and _pattern_key_matches(entry, K, free):
+            if i:
+                cache.entries.insert(0, cache.entries.pop(i))
+            return entry
     entry = {"shape": K.shape, "free_n": free.size, "free": free.copy(), "indptr": K.indptr,
-             "indices": K.indices, "nnz": n_keep, "sub_indptr": sub_indptr, "sub_indices": sub_indices,
-             "sub_shape": (n_free, n_free)}
-    entry["sub_indptr"].flags.writeable = False
-    entry["sub_indices"].flags.writeable = False
-    if cache is not None:
+             "indices": K.indices}
+    if cache is None:
+        entry.update(_free_plan(K, free))
+    else:
+        entry.update(PLANS.get_or_compute("free", (K.indptr, K.indices, free), lambda: _free_plan(K, free),
+                                          (K.shape,)))
         cache.add(entry)
+        # the free block's band ordering, if a model of this pattern and geometry had it made
+        cache.seed_band(entry["sub_indptr"], entry["sub_indices"])
     return entry
 
 
