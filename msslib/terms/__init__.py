@@ -76,7 +76,6 @@ from .jit import _U as _U
 from .jit import _drop_stale_numba_cache as _drop_stale_numba_cache
 from .jit import _jit as _jit
 from .jit import _jit_fast as _jit_fast
-from .loops import _gather3 as _gather3
 from .loops import _hex_energy_loop as _hex_energy_loop
 from .loops import _hex_gradient_loop as _hex_gradient_loop
 from .loops import _hex_hessian_loop as _hex_hessian_loop

@@ -146,28 +146,45 @@ def _check_rest_volumes(name, V0):
         raise ValueError(f"{name}: rest volumes V0 must be finite and > 0: {_format_bad(bad, V0, 'cell')}")
 
 
-class TetVolume(_ElementTerm):
+class _VolumeTerm(_ElementTerm):
+    """A volume term of 3D cells with ``nodes`` nodes: one finite coefficient per cell (any
+    sign: only finiteness is checked) and rest volumes ``V0`` > 0; the subclasses name the
+    coefficient and give the loops."""
+
+    _cells = ""  # name of the connectivity argument
+    _nodes = 0
+    _coefficient = ""  # name of the coefficient
+
+    def __init__(self, cells, coefficient, V0):
+        name = type(self).__name__
+        self.dim = 3
+        self.conn = _connectivity(self._cells, cells, self._nodes)
+        m = len(self.conn)
+        self._p = _per_element(self._coefficient, coefficient, m)
+        self.V0 = _per_element("V0", V0, m)
+        if not np.isfinite(self._p).all():
+            raise ValueError(f"{name}: {self._coefficient} must be finite")
+        _check_rest_volumes(name, self.V0)
+        self._q = self.V0
+        self._n_local = (3 * self._nodes) ** 2
+
+
+class TetVolume(_VolumeTerm):
     """Lloyd's tetrahedron volume energy ``k_v / (2 V0^2) (V - V0)^2`` (V the signed volume).
 
     ``tets`` (m, 4) positively oriented, ``k_v`` (m,) in J (N m) — it may be negative (Lloyd's
     k_V is negative for nu < 3/13), only finiteness is checked — ``V0`` (m,) rest volumes > 0.
     """
 
+    _cells, _nodes, _coefficient = "tets", 4, "k_v"
+    _loops = (_tet_energy_loop, _tet_gradient_loop, _tet_hessian_loop)
+
     def __init__(self, tets, k_v, V0):
-        self.dim = 3
-        self.conn = _connectivity("tets", tets, 4)
-        m = len(self.conn)
-        self.k_v = _per_element("k_v", k_v, m)
-        self.V0 = _per_element("V0", V0, m)
-        if not np.isfinite(self.k_v).all():
-            raise ValueError("TetVolume: k_v must be finite")
-        _check_rest_volumes("TetVolume", self.V0)
-        self._p, self._q = self.k_v, self.V0
-        self._n_local = 144
-        self._loops = (_tet_energy_loop, _tet_gradient_loop, _tet_hessian_loop)
+        super().__init__(tets, k_v, V0)
+        self.k_v = self._p
 
 
-class HexVolume(_ElementTerm):
+class HexVolume(_VolumeTerm):
     """Golec's hexahedron volume correction ``kappa / (2 V0) (V - V0)^2`` with the averaged-edge
     volume ``V`` (:func:`msslib.generated.kernels.hex_averaged_volume`).
 
@@ -179,15 +196,9 @@ class HexVolume(_ElementTerm):
     with the springs is positive definite.  Only finiteness is checked.
     """
 
+    _cells, _nodes, _coefficient = "hexes", 8, "kappa"
+    _loops = (_hex_energy_loop, _hex_gradient_loop, _hex_hessian_loop)
+
     def __init__(self, hexes, kappa, V0):
-        self.dim = 3
-        self.conn = _connectivity("hexes", hexes, 8)
-        m = len(self.conn)
-        self.kappa = _per_element("kappa", kappa, m)
-        self.V0 = _per_element("V0", V0, m)
-        if not np.isfinite(self.kappa).all():
-            raise ValueError("HexVolume: kappa must be finite")
-        _check_rest_volumes("HexVolume", self.V0)
-        self._p, self._q = self.kappa, self.V0
-        self._n_local = 576
-        self._loops = (_hex_energy_loop, _hex_gradient_loop, _hex_hessian_loop)
+        super().__init__(hexes, kappa, V0)
+        self.kappa = self._p

@@ -10,152 +10,95 @@ scalars and inlined (see :mod:`msslib.terms.jit` for the cache).
 from __future__ import annotations
 
 import numpy as np
+from numba import njit, types
+from numba.core import cgutils
+from numba.core.errors import RequireLiteralValue, TypingError
+from numba.extending import intrinsic, register_jitable
 
 from msslib.generated import kernels as _K
 
 from .jit import _U, _jit, _jit_fast
 
-# kernels compiled for scalars (they also work on arrays in plain numpy)
-_s2e, _s2g, _s2h = (_jit(f) for f in (_K.spring2d_energy, _K.spring2d_gradient, _K.spring2d_hessian))
-_s3e, _s3g, _s3h = (_jit(f) for f in (_K.spring3d_energy, _K.spring3d_gradient, _K.spring3d_hessian))
-_te, _tg, _th = (_jit(f) for f in (_K.tet_volume_energy, _K.tet_volume_gradient, _K.tet_volume_hessian))
-_he, _hg, _hh = (_jit(f) for f in (_K.hex_volume_energy, _K.hex_volume_gradient, _K.hex_volume_hessian))
+
+@intrinsic
+def _as_tuple(typingctx, c, n):
+    """The first ``n`` entries (``n`` a compile-time constant) of the contiguous 1D array ``c``
+    as a tuple, loaded at constant offsets (numba's ``to_fixed_tuple`` fills its tuple in a
+    loop, which made the element loops up to 8 times slower)."""
+    if not isinstance(n, types.IntegerLiteral):
+        raise RequireLiteralValue("n must be a compile-time constant")
+    if c.ndim != 1 or c.layout != "C":
+        raise TypingError("_as_tuple takes a contiguous 1D array")
+    size = n.literal_value
+    sig = types.UniTuple(c.dtype, size)(c, n)
+
+    def codegen(context, builder, signature, args):
+        ptr = context.make_array(signature.args[0])(context, builder, args[0]).data
+        vals = [builder.load(cgutils.gep_inbounds(builder, ptr, i)) for i in range(size)]
+        return context.make_tuple(builder, signature.return_type, vals)
+
+    return sig, codegen
 
 
-@_jit
-def _spring2d_energy_loop(x, conn, k, L0):
-    e = 0.0
-    for s in range(conn.shape[0]):
-        a, b = 2 * conn[s, 0], 2 * conn[s, 1]
-        e += _s2e(x[a], x[a + 1], x[b], x[b + 1], k[s], L0[s])
-    return e
+@njit(inline="always", error_model="numpy", nogil=True)
+def _gather(x, conn, m, dim, n, c):
+    """The ``n`` coordinates (``dim`` per node) of the nodes of element ``m`` into ``c``."""
+    for j in range(n // dim):
+        a = dim * conn[m, j]
+        for d in range(dim):
+            c[dim * j + d] = x[a + d]
 
 
-@_jit
-def _spring2d_gradient_loop(x, conn, k, L0, g):
-    for s in range(conn.shape[0]):
-        a, b = 2 * conn[s, 0], 2 * conn[s, 1]
-        r = _s2g(x[a], x[a + 1], x[b], x[b + 1], k[s], L0[s])
-        g[a] += r[0]
-        g[a + 1] += r[1]
-        g[b] += r[2]
-        g[b + 1] += r[3]
+def _element_loops(kind, energy, gradient, hessian, dim, n):
+    """The energy, gradient and Hessian loops of an element kind with ``n`` coordinates per
+    element (``dim`` per node) and the generated kernels ``energy``, ``gradient``, ``hessian``
+    (plain functions registered as jitable, compiled into the loops: numba's on-disk cache never
+    finds a loop that holds a compiled function, whose pickled form differs from process to
+    process; it does find one that holds the plain function).  The loops are named
+    ``_<kind>_energy_loop`` etc. (numba names their cache files after them)."""
+
+    def energy_loop(x, conn, p, q):
+        c = np.empty(n)
+        e = 0.0
+        for m in range(conn.shape[0]):
+            _gather(x, conn, m, dim, n, c)
+            e += energy(*_as_tuple(c, n), p[m], q[m])
+        return e
+
+    def gradient_loop(x, conn, p, q, g):
+        c = np.empty(n)
+        for m in range(conn.shape[0]):
+            _gather(x, conn, m, dim, n, c)
+            r = gradient(*_as_tuple(c, n), p[m], q[m])
+            for j in range(n // dim):
+                a = dim * conn[m, j]
+                for d in range(dim):
+                    g[a + d] += r[dim * j + d]
+
+    def hessian_loop(x, conn, p, q, out):
+        c = np.empty(n)
+        for m in range(conn.shape[0]):
+            _gather(x, conn, m, dim, n, c)
+            h = hessian(*_as_tuple(c, n), p[m], q[m])
+            for i in range(n * n):
+                out[m, i] = h[i]
+
+    loops = (energy_loop, gradient_loop, hessian_loop)
+    for loop, op in zip(loops, ("energy", "gradient", "hessian")):
+        loop.__name__ = loop.__qualname__ = f"_{kind}_{op}_loop"
+    for kernel in (energy, gradient, hessian):
+        register_jitable(error_model="numpy")(kernel)
+    return tuple(_jit(loop) for loop in loops)
 
 
-@_jit
-def _spring2d_hessian_loop(x, conn, k, L0, out):
-    for s in range(conn.shape[0]):
-        a, b = 2 * conn[s, 0], 2 * conn[s, 1]
-        h = _s2h(x[a], x[a + 1], x[b], x[b + 1], k[s], L0[s])
-        for i in range(16):
-            out[s, i] = h[i]
-
-
-@_jit
-def _spring3d_energy_loop(x, conn, k, L0):
-    e = 0.0
-    for s in range(conn.shape[0]):
-        a, b = 3 * conn[s, 0], 3 * conn[s, 1]
-        e += _s3e(x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2], k[s], L0[s])
-    return e
-
-
-@_jit
-def _spring3d_gradient_loop(x, conn, k, L0, g):
-    for s in range(conn.shape[0]):
-        a, b = 3 * conn[s, 0], 3 * conn[s, 1]
-        r = _s3g(x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2], k[s], L0[s])
-        for i in range(3):
-            g[a + i] += r[i]
-            g[b + i] += r[3 + i]
-
-
-@_jit
-def _spring3d_hessian_loop(x, conn, k, L0, out):
-    for s in range(conn.shape[0]):
-        a, b = 3 * conn[s, 0], 3 * conn[s, 1]
-        h = _s3h(x[a], x[a + 1], x[a + 2], x[b], x[b + 1], x[b + 2], k[s], L0[s])
-        for i in range(36):
-            out[s, i] = h[i]
-
-
-@_jit
-def _gather3(x, nodes, c):
-    for j in range(nodes.shape[0]):
-        n = 3 * nodes[j]
-        c[3 * j] = x[n]
-        c[3 * j + 1] = x[n + 1]
-        c[3 * j + 2] = x[n + 2]
-
-
-@_jit
-def _tet_energy_loop(x, conn, kv, V0):
-    c = np.empty(12)
-    e = 0.0
-    for m in range(conn.shape[0]):
-        _gather3(x, conn[m], c)
-        e += _te(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11], kv[m], V0[m])
-    return e
-
-
-@_jit
-def _tet_gradient_loop(x, conn, kv, V0, g):
-    c = np.empty(12)
-    for m in range(conn.shape[0]):
-        _gather3(x, conn[m], c)
-        r = _tg(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11], kv[m], V0[m])
-        for j in range(4):
-            n = 3 * conn[m, j]
-            for d in range(3):
-                g[n + d] += r[3 * j + d]
-
-
-@_jit
-def _tet_hessian_loop(x, conn, kv, V0, out):
-    c = np.empty(12)
-    for m in range(conn.shape[0]):
-        _gather3(x, conn[m], c)
-        h = _th(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11], kv[m], V0[m])
-        for i in range(144):
-            out[m, i] = h[i]
-
-
-@_jit
-def _hex_energy_loop(x, conn, kap, V0):
-    c = np.empty(24)
-    e = 0.0
-    for m in range(conn.shape[0]):
-        _gather3(x, conn[m], c)
-        e += _he(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11],
-                 c[12], c[13], c[14], c[15], c[16], c[17], c[18], c[19], c[20], c[21], c[22], c[23],
-                 kap[m], V0[m])
-    return e
-
-
-@_jit
-def _hex_gradient_loop(x, conn, kap, V0, g):
-    c = np.empty(24)
-    for m in range(conn.shape[0]):
-        _gather3(x, conn[m], c)
-        r = _hg(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11],
-                c[12], c[13], c[14], c[15], c[16], c[17], c[18], c[19], c[20], c[21], c[22], c[23],
-                kap[m], V0[m])
-        for j in range(8):
-            n = 3 * conn[m, j]
-            for d in range(3):
-                g[n + d] += r[3 * j + d]
-
-
-@_jit
-def _hex_hessian_loop(x, conn, kap, V0, out):
-    c = np.empty(24)
-    for m in range(conn.shape[0]):
-        _gather3(x, conn[m], c)
-        h = _hh(c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11],
-                c[12], c[13], c[14], c[15], c[16], c[17], c[18], c[19], c[20], c[21], c[22], c[23],
-                kap[m], V0[m])
-        for i in range(576):
-            out[m, i] = h[i]
+_spring2d_energy_loop, _spring2d_gradient_loop, _spring2d_hessian_loop = _element_loops(
+    "spring2d", _K.spring2d_energy, _K.spring2d_gradient, _K.spring2d_hessian, 2, 4)
+_spring3d_energy_loop, _spring3d_gradient_loop, _spring3d_hessian_loop = _element_loops(
+    "spring3d", _K.spring3d_energy, _K.spring3d_gradient, _K.spring3d_hessian, 3, 6)
+_tet_energy_loop, _tet_gradient_loop, _tet_hessian_loop = _element_loops(
+    "tet", _K.tet_volume_energy, _K.tet_volume_gradient, _K.tet_volume_hessian, 3, 12)
+_hex_energy_loop, _hex_gradient_loop, _hex_hessian_loop = _element_loops(
+    "hex", _K.hex_volume_energy, _K.hex_volume_gradient, _K.hex_volume_hessian, 3, 24)
 
 
 # --------------------------------------------------------------------------------------------
