@@ -5,9 +5,8 @@
   of two readings (:data:`READINGS`): built from that load on the loaded boundary faces
   (``boundary``) or for every cube from the forces acting on it from outside (``element``, see
   :mod:`msslib.baudet_correction`); derived factor, or the printed one with ``published=True``;
-* :class:`Path` -- the model with its load multiplied by a factor, moved from one factor to the
-  next (continuation: each equilibrium starts from the previous one);
-* :func:`follow` -- load continuation until a measured quantity reaches a target;
+* :func:`follow` -- load continuation until a measured quantity reaches a target (each equilibrium
+  starts from the previous one; the line search judges the residual);
 * :func:`write` -- atomic NetCDF output through :func:`msslib.io.write_result`.
 
 All quantities SI. Loads are dead loads in the reference configuration (nominal stresses), as in
@@ -22,6 +21,7 @@ from pathlib import Path as _P
 
 import numpy as np
 
+from experiments.script import LoadSegment
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import terms as T
@@ -87,30 +87,6 @@ def block(n, nu, *, published=False, tractions=(), fixed_planes="xyz", fix_all_p
     return mesh, MD.Model(mesh, terms, fixed=fixed)
 
 
-class Path:
-    """``model`` with the load factor mapped from [0, 1] onto [s0, s1] (load continuation)."""
-
-    def __init__(self, model, s0, s1):
-        self.m, self.s0, self.s1 = model, float(s0), float(s1)
-        self.n_dof, self.free, self.symmetric, self.dim = model.n_dof, model.free, model.symmetric, model.dim
-        self.mass = model.mass
-
-    def _s(self, load):
-        return self.s0 + load * (self.s1 - self.s0)
-
-    def force(self, x, load=1.0):
-        return self.m.force(x, self._s(load))
-
-    def stiffness(self, x, load=1.0):
-        return self.m.stiffness(x, self._s(load))
-
-    def energy(self, x, load=1.0):
-        return None
-
-    def apply_prescribed(self, x, load=1.0):
-        return self.m.apply_prescribed(x, self._s(load))
-
-
 def unit_load_norm(model):
     f = model.external_force(1.0)
     return float(np.linalg.norm(f[model.free]))
@@ -131,7 +107,7 @@ def follow(model, measure, target, first_step, *, max_levels=400, tol=1e-10, gro
     dq = target / (n_steps or STEPS)
     for _ in range(max_levels):
         s1 = s + ds
-        r = static_solve(Path(model, s, s1), x, load_steps=1, tol=tol, max_iter=60,
+        r = static_solve(LoadSegment(model, s, s1, energy=False), x, load_steps=1, tol=tol, max_iter=60,
                          force_scale=max(abs(s1), 1e-300) * scale)
         x, s = r.x, s1
         q = measure(x)

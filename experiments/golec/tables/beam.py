@@ -1,7 +1,5 @@
 """Beam under gravity (Golec Fig. 2 (3-4)): deflection, volume, error against FEM, stability."""
 
-import numpy as np
-
 from experiments import script
 from msslib.io import read_result
 
@@ -19,14 +17,14 @@ def main():
     args = script.args(__doc__)
     w = read_result(INPUTS[0]).sel(experiment="beam")
     cmp_ = read_result(INPUTS[1]).sel(case="default")
-    lines = ["**Golec Fig. 2 (3-4): 20 x 4 x 4 cm cantilever under gravity (E = 400 kPa, nu = 0.3).** "
-             "Largest downward displacement, volume change, displacement error against the neo-Hookean FEM "
-             "(relative to the FEM's largest displacement) and the smallest eigenvalue of the stiffness at "
-             "the symmetric equilibrium (negative: unstable, the beam wrinkles). The paper prints no numbers "
-             "for this experiment.", "",
-             "| variant | model | max deflection (cm) | dV (%) | mean error (%) | max error (%) | "
-             "smallest eigenvalue (N/m) | wrinkle amplitude (mm) |",
-             "|---|---|---|---|---|---|---|---|"]
+    lines = script.head(
+        "**Golec Fig. 2 (3-4): 20 x 4 x 4 cm cantilever under gravity (E = 400 kPa, nu = 0.3).** "
+        "Largest downward displacement, volume change, displacement error against the neo-Hookean FEM "
+        "(relative to the FEM's largest displacement) and the smallest eigenvalue of the stiffness at "
+        "the symmetric equilibrium (negative: unstable, the beam wrinkles). The paper prints no numbers "
+        "for this experiment.",
+        ["variant", "model", "max deflection (cm)", "dV (%)", "mean error (%)", "max error (%)",
+         "smallest eigenvalue (N/m)", "wrinkle amplitude (mm)"])
     for v, text in VARIANTS.items():
         r = w.sel(variant=v)
         if v in cmp_.variant.values:
@@ -35,11 +33,9 @@ def main():
         else:
             em = ex = "-"
         lam = float(r.min_eigenvalue)
-        lam_s = "-" if not np.isfinite(lam) else f"{lam:.3g}" + (" (unstable)" if lam < 0 else "")
-        amp = float(r.wrinkle_amplitude)
-        amp_s = "-" if not np.isfinite(amp) else f"{amp * 1e3:.2g}"
-        lines.append(f"| {v} | {text} | {100 * float(r.tip_deflection):.3f} | {100 * float(r.volume_change):+.3f} | "
-                     f"{em} | {ex} | {lam_s} | {amp_s} |")
+        lines.append(script.row(v, text, f"{100 * float(r.tip_deflection):.3f}", f"{100 * float(r.volume_change):+.3f}",
+                                em, ex, script.number(lam, ".3g") + (" (unstable)" if lam < 0 else ""),
+                                script.number(r.wrinkle_amplitude, ".2g", 1e3)))
     script.write_table(args.out, lines)
 
 

@@ -35,6 +35,7 @@ import xarray as xr
 import yaml
 from scipy.stats import spearmanr
 
+from experiments.script import LoadSegment
 from msslib.experiment import interpolate
 from msslib.io import mesh_from_result, write_result
 from msslib.quality import relative_jacobians
@@ -159,29 +160,6 @@ def linear_solve(K, forces, fixed):
     return u.reshape(-1, 3)
 
 
-class Segment:
-    """A problem whose load factor 0..1 runs over the load factors a..b of ``model`` (continuation)."""
-
-    def __init__(self, model, a, b):
-        self.model, self.a, self.b = model, a, b
-        self.n_dof, self.free, self.dim = model.n_dof, model.free, model.dim
-
-    def _load(self, load):
-        return self.a + load * (self.b - self.a)
-
-    def force(self, x, load=1.0):
-        return self.model.force(x, self._load(load))
-
-    def stiffness(self, x, load=1.0):
-        return self.model.stiffness(x, self._load(load))
-
-    def energy(self, x, load=1.0):
-        return self.model.energy(x, self._load(load))
-
-    def apply_prescribed(self, x, load=1.0):
-        return self.model.apply_prescribed(x, self._load(load))
-
-
 def lowest_eigenvalue(model, x, load):
     """Smallest eigenvalue of the free tangent at (x, load), divided by the mean of its diagonal."""
     Kf = model.stiffness(x, load)[model.free][:, model.free].tocsc()
@@ -198,7 +176,7 @@ def continuation(setup, loads, tol=1e-9, eig=True):
     x, a, rows = model.x0.copy(), 0.0, []
     for b in loads:
         try:
-            x = static_solve(Segment(model, a, b), x, load_steps=1, tol=tol, force_scale=f_ref, max_cuts=6).x
+            x = static_solve(LoadSegment(model, a, b), x, load_steps=1, tol=tol, force_scale=f_ref, max_cuts=6).x
         except ConvergenceError:
             return rows, float(b)
         a = float(b)

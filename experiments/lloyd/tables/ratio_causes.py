@@ -17,19 +17,19 @@ SHORT = {"baseline": "nothing (the experiment file)", "equal_forces": "equal nod
 def main(argv=None):
     args = script.args(__doc__, argv)
     ds = xr.load_dataset(ROOT / INPUTS[0])
-    lines = [("**Lloyd Secs. 5.1 and 5.3: what sets the ratio mean/max error** (one factor changed at a time "
-             "from the experiment files' set-up; strains along the load at the top corner node and in the middle "
-             "of the top edge; the paper: 11.2-13.6 % at these two points in Fig. 9a; CST: the squares split into "
-             "constant-strain triangles along one diagonal, up = lower left to upper right, or both)"), "",
-             ("| Sec. | case | changed | load (Pa) | strain corner / middle, FEM (%) | ours max (mm) | ours mean/max | "
-             "published max (mm) | published mean/max | ours - published, mean/max |"),
-             "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = script.head(
+        ("**Lloyd Secs. 5.1 and 5.3: what sets the ratio mean/max error** (one factor changed at a time "
+         "from the experiment files' set-up; strains along the load at the top corner node and in the middle "
+         "of the top edge; the paper: 11.2-13.6 % at these two points in Fig. 9a; CST: the squares split into "
+         "constant-strain triangles along one diagonal, up = lower left to upper right, or both)"),
+        ["Sec.", "case", "changed", "load (Pa)", "strain corner / middle, FEM (%)", "ours max (mm)", "ours mean/max",
+         "published max (mm)", "published mean/max", "ours - published, mean/max"])
     for r in script.rows(ds, "run"):
-        lines.append(
-            f"| {r.section.values} | {r.case.values} | {SHORT.get(str(r.factor.values), str(r.factor.values))} | {float(r['load']):.0f} | "
-            f"{100 * float(r.corner_fem):.1f} / {100 * float(r.middle_fem):.1f} | {1e3 * float(r.error_max):.3g} | "
-            f"{float(r.ratio):.2f} | {1e3 * float(r.published_max):.3g} | {float(r.published_ratio):.2f} | "
-            f"{float(r.ratio) - float(r.published_ratio):+.2f} |")
+        lines.append(script.row(
+            r.section.values, r.case.values, SHORT.get(str(r.factor.values), str(r.factor.values)), f"{float(r['load']):.0f}",
+            f"{100 * float(r.corner_fem):.1f} / {100 * float(r.middle_fem):.1f}", f"{1e3 * float(r.error_max):.3g}",
+            f"{float(r.ratio):.2f}", f"{1e3 * float(r.published_max):.3g}", f"{float(r.published_ratio):.2f}",
+            f"{float(r.ratio) - float(r.published_ratio):+.2f}"))
     script.write_table(args.out, lines)
 
 

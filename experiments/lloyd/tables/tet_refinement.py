@@ -10,8 +10,7 @@ INPUTS = ["results/lloyd/studies/tet_refinement.nc"]
 
 
 def _pct(v):
-    v = float(v)
-    return "n/a" if not np.isfinite(v) else f"{100 * v:.1f}"
+    return script.number(v, ".1f", 100, "n/a")
 
 
 def main():
@@ -25,24 +24,25 @@ def main():
         f"linear FEM on the same mesh (and on h = {h_lin:g} mm). *Full shear*: the non-linear MSS against neo-Hookean FEM on "
         f"the same mesh and on h = {h_nl:g} mm, and that FEM's own discretisation error. Fit: median over elements of "
         "||K_mss - K_fem||_F / ||K_fem||_F (0.2 for a regular tetrahedron).")
-    header = ("| h (mm) | nodes | tetrahedra | radius ratio median (min) | smallest dihedral (deg) | fit eq. 12-13 (best 6 springs) "
-              "| linearised shear / stretch, same mesh | linearised shear vs fine | full shear, same mesh | full shear vs reference "
-              "| neo-Hookean vs reference |")
-    lines = [caption, "", header, "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = script.head(caption, [
+        "h (mm)", "nodes", "tetrahedra", "radius ratio median (min)", "smallest dihedral (deg)",
+        "fit eq. 12-13 (best 6 springs)", "linearised shear / stretch, same mesh", "linearised shear vs fine",
+        "full shear, same mesh", "full shear vs reference", "neo-Hookean vs reference"])
     for r in script.rows(ds, "level"):
-        lines.append(
-            f"| {float(r.h):g} | {int(r.n_nodes)} | {int(r.n_cells)} | {float(r.rho_median):.2f} ({float(r.rho_min):.2f}) "
-            f"| {float(r.dihedral_min):.1f} | {float(r.fit_lloyd_median):.2f} ({float(r.fit_best6_median):.2f}) "
-            f"| {_pct(r.lin_same_max.sel(case='shear'))} / {_pct(r.lin_same_max.sel(case='stretch'))} "
-            f"| {_pct(r.lin_ref_max.sel(case='shear'))} | {_pct(r.nl_mss_same_max)} | {_pct(r.nl_mss_ref_max)} "
-            f"| {_pct(r.nl_nh_ref_max)} |")
+        lines.append(script.row(
+            f"{float(r.h):g}", int(r.n_nodes), int(r.n_cells), f"{float(r.rho_median):.2f} ({float(r.rho_min):.2f})",
+            f"{float(r.dihedral_min):.1f}", f"{float(r.fit_lloyd_median):.2f} ({float(r.fit_best6_median):.2f})",
+            f"{_pct(r.lin_same_max.sel(case='shear'))} / {_pct(r.lin_same_max.sel(case='stretch'))}",
+            _pct(r.lin_ref_max.sel(case='shear')), _pct(r.nl_mss_same_max), _pct(r.nl_mss_ref_max),
+            _pct(r.nl_nh_ref_max)))
     published_note = ("Published (Lloyd et al., Sec. 5.6, Fig. 15): one mesh of 91 nodes, no refinement study; maximum errors "
                       "0.039, 0.111 and 0.088 cm against linear FEM in stretch, compression and shear (loads not printed).")
     paths = ("**Load paths** (continuation in the load factor; eigenvalue: smallest eigenvalue of the free tangent "
              "stiffness divided by the mean of its diagonal).")
-    header2 = ("| experiment | nodes | last converged load factor | Newton fails at | smallest relative Jacobian (last state) "
-               "| smallest eigenvalue (last state) | inverted cells (last state) | first load factor with an inverted cell | published |")
-    lines += ["", published_note, "", paths, "", header2, "|---|---|---|---|---|---|---|---|---|"]
+    lines += ["", published_note, ""] + script.head(paths, [
+        "experiment", "nodes", "last converged load factor", "Newton fails at", "smallest relative Jacobian (last state)",
+        "smallest eigenvalue (last state)", "inverted cells (last state)", "first load factor with an inverted cell",
+        "published"])
     published = {"hole": "Fig. 16b: max error 0.065 cm vs linear FEM (load not printed)", "cone": "Fig. 17: no numbers printed"}
     for name, label in (("hole", "cylinder with hole, 1800 Pa compression"), ("cone", "cone, 2000 Pa shear")):
         load = ds[f"{name}_load"].values
@@ -50,14 +50,12 @@ def main():
         i = int(np.flatnonzero(ok)[-1]) if ok.any() else None
         inv = ds[f"{name}_inverted"].values
         first = load[np.flatnonzero(inv > 0)[0]] if (inv > 0).any() else np.nan
-        failed = float(ds[f"{name}_failed_load"])
         jac = "n/a" if i is None else f"{float(ds[name + '_min_jacobian'][i]):.2f}"
         eig = "n/a" if i is None else f"{float(ds[name + '_eig'][i]):.2e}"
         n_inv = "n/a" if i is None else str(int(inv[i]))
-        fails = "none" if not np.isfinite(failed) else f"{failed:g}"
-        first = "none" if not np.isfinite(first) else f"{first:g}"
-        lines.append(f"| {label} | {int(ds[name + '_nodes'])} | {float(ds[name + '_last_load']):g} | {fails} | {jac} | {eig} "
-                     f"| {n_inv} | {first} | {published[name]} |")
+        lines.append(script.row(label, int(ds[name + '_nodes']), f"{float(ds[name + '_last_load']):g}",
+                                script.number(ds[f"{name}_failed_load"], "g", missing="none"), jac, eig, n_inv,
+                                script.number(first, "g", missing="none"), published[name]))
     script.write_table(args.out, lines)
 
 
