@@ -100,6 +100,23 @@ def least_squares(K_fem, K_mss, unknowns) -> LeastSquares:
     return LeastSquares(tuple(unknowns), sol, res, sp.simplify(res / ref), grad, 2 * G)
 
 
+def frobenius(A, B):
+    """<A, B> = sum_ij A_ij B_ij, cancelled to one rational function (products with a zero left out)."""
+    return sp.factor(sp.cancel(sum(x * y for x, y in zip(A, B) if x != 0 and y != 0)))
+
+
+def normal_equations(basis, K_fem):
+    """``(G, b)`` of the least-squares fit ``sum_p k_p basis_p`` to ``K_fem``: ``G_pq = <basis_p, basis_q>``
+    (symmetric, each pair once), ``b_p = <basis_p, K_fem>``, each entry cancelled to one rational
+    function; left unsolved (with a symbolic shape :func:`least_squares`, which simplifies the whole
+    solution, takes minutes)."""
+    n = len(basis)
+    G = sp.Matrix(n, n, lambda p, q: frobenius(basis[p], basis[q]) if p <= q else 0)
+    G = G + G.T - sp.diag(*[G[p, p] for p in range(n)])
+    b = sp.Matrix([frobenius(B, K_fem) for B in basis])
+    return G, b
+
+
 def is_positive_definite(H: sp.Matrix) -> bool:
     """Sylvester's criterion, exactly (for numeric or sign-determined symbolic minors)."""
     for n in range(1, H.rows + 1):

@@ -133,6 +133,12 @@ def stiffness_at_rest(terms, coords) -> sp.Matrix:
     return K.applyfunc(_simplify)
 
 
+def unit_springs(coords, edges) -> tuple:
+    """Stiffness at rest of a unit spring (k = 1) on each edge ``(i, j)`` of ``edges``: the basis
+    ``K_e`` of the springs' stiffness ``sum_e k_e K_e``."""
+    return tuple(stiffness_at_rest([spring(i, j, sp.Integer(1))], coords) for i, j in edges)
+
+
 def forces_at_rest(terms, coords) -> sp.Matrix:
     """Net force -dW/dx on every dof at the rest positions (zero when the element is in equilibrium)."""
     R = _to_vectors(coords)

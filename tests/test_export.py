@@ -440,6 +440,12 @@ def test_codegen_check_covers_the_c_header(tmp_path, monkeypatch):
     assert codegen.check() == [f"generated/c/{codegen.C_UMBRELLA} does not include exactly the generated modules"]
     umbrella.unlink()
     assert codegen.check() == [f"generated/c/{codegen.C_UMBRELLA} is missing"]
+    umbrella.write_text(codegen.render_c_umbrella())
+    api = out / "c" / codegen.C_API
+    api.write_text(api.read_text().replace("static inline", "static"))
+    assert codegen.check() == [f"generated/c/{codegen.C_API} differs from what the code generator writes"]
+    api.unlink()
+    assert codegen.check() == [f"generated/c/{codegen.C_API} is missing"]
 
 
 def test_codegen_check_finds_a_stale_c_header(monkeypatch):
@@ -455,7 +461,7 @@ def test_export_copies_the_c_headers(tmp_path, capsys):
     code, err = _cli(capsys, "export", scene, "--out", tmp_path / "b", "--format", "c")
     assert code == 0, err
     headers = sorted(export.C_HEADER_PATH.parent.glob("*.h"))
-    assert len(headers) == len(registry.generated()) + 1
+    assert len(headers) == len(registry.generated()) + 2  # the modules', the include list, msslib_api.h
     assert sorted(p.name for p in tmp_path.glob("*.h")) == [h.name for h in headers]
     for h in headers:
         assert (tmp_path / h.name).read_bytes() == h.read_bytes()

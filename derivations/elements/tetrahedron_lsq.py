@@ -29,7 +29,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from derivations import fem, mss, show
+from derivations import fem, match, mss, show
 from derivations.elasticity import E, nu
 from derivations.records import Derivation, Element, Formula
 
@@ -46,11 +46,6 @@ EDGES = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]  # the order of k_0 .. 
 k = sp.symbols("k_0:6", real=True)
 
 
-def frobenius(A, B):
-    """<A, B> = sum_ij A_ij B_ij, cancelled to one rational function."""
-    return sp.factor(sp.cancel(sum(x * y for x, y in zip(A, B) if x != 0 and y != 0)))
-
-
 # %% [markdown]
 # ## The two stiffness matrices
 
@@ -61,17 +56,11 @@ def K_fem():
     return fem.element_stiffness("tetra", COORDS, "3d")
 
 
-@lru_cache(maxsize=None)
-def unit_springs():
-    """Stiffness at rest of a unit spring (k = 1) on each edge."""
-    return tuple(mss.stiffness_at_rest([mss.spring(i, j, sp.Integer(1))], COORDS) for i, j in EDGES)
-
-
 # %%
 if __name__ == "__main__":
     show.matrix(r"K_{\text{FEM}}", K_fem(), rows=slice(0, 6), cols=slice(0, 6),
                 what="the linear tetrahedron, nodes 0 and 1")
-    show.matrix(r"K_{01}", unit_springs()[0], rows=slice(0, 6), cols=slice(0, 6),
+    show.matrix(r"K_{01}", mss.unit_springs(COORDS, EDGES[:1])[0], rows=slice(0, 6), cols=slice(0, 6),
                 what="a unit spring on edge 0-1, nodes 0 and 1")
 
 
@@ -82,11 +71,7 @@ if __name__ == "__main__":
 @lru_cache(maxsize=None)
 def normal_equations():
     """(G, b): G_pq = <K_p, K_q> (geometry only), b_p = <K_p, K_FEM>."""
-    K = unit_springs()
-    G = sp.Matrix(6, 6, lambda p, q: frobenius(K[p], K[q]) if p <= q else 0)
-    G = G + G.T - sp.diag(*[G[p, p] for p in range(6)])
-    b = sp.Matrix([frobenius(Kp, K_fem()) for Kp in K])
-    return G, b
+    return match.normal_equations(mss.unit_springs(COORDS, EDGES), K_fem())
 
 
 REGULAR = {a: 1, x2: sp.Rational(1, 2), y2: sp.sqrt(3) / 2, x3: sp.Rational(1, 2), y3: sp.sqrt(3) / 6,

@@ -32,7 +32,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from derivations import fem, mss, show
+from derivations import fem, match, mss, show
 from derivations.elasticity import E, nu, t
 from derivations.records import Derivation, Element, Formula
 
@@ -48,11 +48,6 @@ EDGES = [(0, 1), (1, 2), (0, 2)]
 k = sp.symbols("k_01 k_12 k_02", real=True)
 
 
-def frobenius(A, B):
-    """<A, B> = sum_ij A_ij B_ij, cancelled to one rational function."""
-    return sp.factor(sp.cancel(sum(x * y for x, y in zip(A, B))))
-
-
 # %% [markdown]
 # ## The two stiffness matrices
 
@@ -64,14 +59,8 @@ def K_fem():
 
 
 @lru_cache(maxsize=None)
-def unit_springs():
-    """Stiffness at rest of a unit spring (k = 1) on each edge."""
-    return tuple(mss.stiffness_at_rest([mss.spring(i, j, sp.Integer(1))], COORDS) for i, j in EDGES)
-
-
-@lru_cache(maxsize=None)
 def K_mss():
-    return sum((kk * K for kk, K in zip(k, unit_springs())), sp.zeros(6, 6))
+    return sum((kk * K for kk, K in zip(k, mss.unit_springs(COORDS, EDGES))), sp.zeros(6, 6))
 
 
 # %%
@@ -87,10 +76,7 @@ if __name__ == "__main__":
 @lru_cache(maxsize=None)
 def normal_equations():
     """(G, b): G_pq = <K_p, K_q> (geometry only), b_p = <K_p, K_CST>."""
-    K = unit_springs()
-    G = sp.Matrix(3, 3, lambda p, q: frobenius(K[p], K[q]))
-    b = sp.Matrix([frobenius(Kp, K_fem()) for Kp in K])
-    return G, b
+    return match.normal_equations(mss.unit_springs(COORDS, EDGES), K_fem())
 
 
 def cramer(G, b):

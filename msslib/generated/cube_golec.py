@@ -1,5 +1,5 @@
 # Generated from derivations/elements/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: a8168c2ba54679e6402a4e966c218a01ad537a3264fab6bd8e4b3f7f596578f3
+# source-sha256: 1e2df523ca75b9a6f219971898ebc94941c5fa451023d6066ad8d551ab21ca1d
 # body-sha256: ead38ff0979f342e371691d41eaa2c1fcc80bd8a3ec45ce6848072726eb1950e
 """Cube with edge, face and inner springs and volume correction (Golec et al.).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 478777193ef1671c154567ac098ef85920d96179492c70be985863302fe88a86
+# source-sha256: cd97bb0af343010fe0dc3fecc084e4e0d71bf4d6bb58367264e8ebe22e3b7fec
 # body-sha256: 3d373773da99006a61be809dfa382060e5f3e52fab7de0235f0cb4b483a8f761
 """Energy, gradient and Hessian kernels.
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 0d0bf17a5dedd15988d2fb7803022fbcfe60cfc94439390d158472ccb5d53756
+# source-sha256: 98de68b95dc7fb66e227e767f4eb058f929642330c83c6b00bbf8f9b7ce1b3db
 # body-sha256: 0b2dbb0b56041ab2d1c0d5c290b0fcfc5ecc68a47555a831b2b6251b8cfd020f
 """Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14).
 

@@ -1,28 +1,14 @@
 // Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 478777193ef1671c154567ac098ef85920d96179492c70be985863302fe88a86
-// body-sha256: 7f5d5f733ea9977037af525660c2fc36b8b662c38c8617e6adddab5a10c656b3
-/* Energy, gradient and Hessian kernels, in C99.
- *
- * Printed by SymPy's C99 printer from the expressions that msslib/generated/kernels.py is
- * printed from (derivations/terms/kernels.py), with the same common subexpressions;
- * `python -m derivations.codegen` writes both, do not edit. msslib_mss.h includes every module.
- * SI units: E in Pa, lengths in m, spring constants in N/m, energies in J, gradients in N,
- * Hessians in N/m (row-major, node by node: x0, y0(, z0), x1, ...).
- * Functions are `static inline` unless MSSLIB_API is defined before this header is
- * included (define it empty to compile them with external linkage, e.g. into a library).
- * Link with -lm. */
+// source-sha256: cd97bb0af343010fe0dc3fecc084e4e0d71bf4d6bb58367264e8ebe22e3b7fec
+// body-sha256: 3c7517ccff04b573e5e29ce2c6a9f72affae7f2595d7f1ac55c6c9ba0e7af367
+/* Energy, gradient and Hessian kernels, in C99 (units and linkage: msslib_api.h).
+ * Printed from the expressions of msslib/generated/kernels.py (derivations/terms/kernels.py). */
 #ifndef MSSLIB_KERNELS_H
 #define MSSLIB_KERNELS_H
 
-#include <math.h>
+#include "msslib_api.h"
 
-#ifndef MSSLIB_API
-#define MSSLIB_API static inline
-#endif
-
-#ifdef __cplusplus
-extern "C" {
-#endif
+MSSLIB_BEGIN_DECLS
 
 /* spring2d_energy: Spring k/2 (|x1 - x0| - L0)^2 in 2D. Energy [J].
  * Returns energy. */
@@ -31,8 +17,7 @@ MSSLIB_API double msslib_spring2d_energy(double x0, double y0, double x1, double
     return (1.0/2.0)*k*pow(L0 - sqrt(pow(x0 - x1, 2) + pow(y0 - y1, 2)), 2);
 }
 
-#define MSSLIB_SPRING2D_GRADIENT_N_OUT 4
-
+enum { MSSLIB_SPRING2D_GRADIENT_N_OUT = 4 };
 /* spring2d_gradient: Spring k/2 (|x1 - x0| - L0)^2 in 2D. Gradient dW/dx [N] (the force is minus this), 4 entries, node by node.
  * Writes out[0..3] = (g0, g1, g2, g3). */
 MSSLIB_API void msslib_spring2d_gradient(double x0, double y0, double x1, double y1, double k, double L0, double *out)
@@ -49,8 +34,7 @@ MSSLIB_API void msslib_spring2d_gradient(double x0, double y0, double x1, double
     out[3] = _c5;
 }
 
-#define MSSLIB_SPRING2D_HESSIAN_N_OUT 16
-
+enum { MSSLIB_SPRING2D_HESSIAN_N_OUT = 16 };
 /* spring2d_hessian: Spring k/2 (|x1 - x0| - L0)^2 in 2D. Hessian [N/m], 4x4 row-major.
  * Writes out[0..15] = (h0, h1, h2, h3, h4, h5, h6, h7, h8, h9, h10, h11, h12, h13, h14, h15). */
 MSSLIB_API void msslib_spring2d_hessian(double x0, double y0, double x1, double y1, double k, double L0, double *out)
@@ -98,8 +82,7 @@ MSSLIB_API double msslib_spring3d_energy(double x0, double y0, double z0, double
     return (1.0/2.0)*k*pow(L0 - sqrt(pow(x0 - x1, 2) + pow(y0 - y1, 2) + pow(z0 - z1, 2)), 2);
 }
 
-#define MSSLIB_SPRING3D_GRADIENT_N_OUT 6
-
+enum { MSSLIB_SPRING3D_GRADIENT_N_OUT = 6 };
 /* spring3d_gradient: Spring k/2 (|x1 - x0| - L0)^2 in 3D. Gradient dW/dx [N] (the force is minus this), 6 entries, node by node.
  * Writes out[0..5] = (g0, g1, g2, g3, g4, g5). */
 MSSLIB_API void msslib_spring3d_gradient(double x0, double y0, double z0, double x1, double y1, double z1, double k, double L0, double *out)
@@ -120,8 +103,7 @@ MSSLIB_API void msslib_spring3d_gradient(double x0, double y0, double z0, double
     out[5] = _c7;
 }
 
-#define MSSLIB_SPRING3D_HESSIAN_N_OUT 36
-
+enum { MSSLIB_SPRING3D_HESSIAN_N_OUT = 36 };
 /* spring3d_hessian: Spring k/2 (|x1 - x0| - L0)^2 in 3D. Hessian [N/m], 6x6 row-major.
  * Writes out[0..35] = (h0, h1, h2, h3, h4, h5, h6, h7, h8, h9, h10, h11, h12, h13, h14, h15, h16, h17, h18, h19, h20, h21, h22, h23, h24, h25, h26, h27, h28, h29, h30, h31, h32, h33, h34, h35). */
 MSSLIB_API void msslib_spring3d_hessian(double x0, double y0, double z0, double x1, double y1, double z1, double k, double L0, double *out)
@@ -216,8 +198,7 @@ MSSLIB_API double msslib_tet_volume_energy(double x0, double y0, double z0, doub
     return (1.0/2.0)*k_v*pow(V0 + _c1*z2 - _c1*z3 - _c10*z0 + _c10*z3 + _c11*z0 - _c11*z1 - _c13*z1 + _c13*z2 + _c14*z0 - _c14*z2 - _c15*z0 + _c15*z1 - _c2*z1 + _c2*z3 + _c3*z1 - _c3*z2 - _c5*z2 + _c5*z3 + _c6*z0 - _c6*z3 - _c7*z0 + _c7*z2 + _c9*z1 - _c9*z3, 2)/pow(V0, 2);
 }
 
-#define MSSLIB_TET_VOLUME_GRADIENT_N_OUT 12
-
+enum { MSSLIB_TET_VOLUME_GRADIENT_N_OUT = 12 };
 /* tet_volume_gradient: Tetrahedron volume energy k_v/(2 V0^2) (V - V0)^2 (Lloyd et al. App. C.2). Gradient dW/dx [N] (the force is minus this), 12 entries, node by node.
  * Writes out[0..11] = (g0, g1, g2, g3, g4, g5, g6, g7, g8, g9, g10, g11). */
 MSSLIB_API void msslib_tet_volume_gradient(double x0, double y0, double z0, double x1, double y1, double z1, double x2, double y2, double z2, double x3, double y3, double z3, double k_v, double V0, double *out)
@@ -279,8 +260,7 @@ MSSLIB_API void msslib_tet_volume_gradient(double x0, double y0, double z0, doub
     out[11] = -_c26*(_c30 - _c37 + _c38 + _c42);
 }
 
-#define MSSLIB_TET_VOLUME_HESSIAN_N_OUT 144
-
+enum { MSSLIB_TET_VOLUME_HESSIAN_N_OUT = 144 };
 /* tet_volume_hessian: Tetrahedron volume energy k_v/(2 V0^2) (V - V0)^2 (Lloyd et al. App. C.2). Hessian [N/m], 12x12 row-major.
  * Writes out[0..143] = (h0, h1, h2, h3, h4, h5, h6, h7, h8, h9, h10, h11, h12, h13, h14, h15, h16, h17, h18, h19, h20, h21, h22, h23, h24, h25, h26, h27, h28, h29, h30, h31, h32, h33, h34, h35, h36, h37, h38, h39, h40, h41, h42, h43, h44, h45, h46, h47, h48, h49, h50, h51, h52, h53, h54, h55, h56, h57, h58, h59, h60, h61, h62, h63, h64, h65, h66, h67, h68, h69, h70, h71, h72, h73, h74, h75, h76, h77, h78, h79, h80, h81, h82, h83, h84, h85, h86, h87, h88, h89, h90, h91, h92, h93, h94, h95, h96, h97, h98, h99, h100, h101, h102, h103, h104, h105, h106, h107, h108, h109, h110, h111, h112, h113, h114, h115, h116, h117, h118, h119, h120, h121, h122, h123, h124, h125, h126, h127, h128, h129, h130, h131, h132, h133, h134, h135, h136, h137, h138, h139, h140, h141, h142, h143). */
 MSSLIB_API void msslib_tet_volume_hessian(double x0, double y0, double z0, double x1, double y1, double z1, double x2, double y2, double z2, double x3, double y3, double z3, double k_v, double V0, double *out)
@@ -605,8 +585,7 @@ MSSLIB_API double msslib_hex_volume_energy(double x0, double y0, double z0, doub
     return (1.0/2.0)*kappa*pow(V0 - 1.0/64.0*(_c10*_c16 - _c14*_c17)*(_c11 + _c3 + _c5 + x0 - x1 + x7) - 1.0/64.0*(-_c10*_c6 + _c12*_c14)*(_c1 + _c2 - z1 + z7) + (1.0/64.0)*(-_c12*_c16 + _c17*_c6)*(_c13 + _c7 + _c9 + y0 - y1 + y7), 2)/V0;
 }
 
-#define MSSLIB_HEX_VOLUME_GRADIENT_N_OUT 24
-
+enum { MSSLIB_HEX_VOLUME_GRADIENT_N_OUT = 24 };
 /* hex_volume_gradient: Hexahedron volume correction kappa/(2 V0) (V - V0)^2, V from the averaged edge vectors (Golec et al.). Gradient dW/dx [N] (the force is minus this), 24 entries, node by node.
  * Writes out[0..23] = (g0, g1, g2, g3, g4, g5, g6, g7, g8, g9, g10, g11, g12, g13, g14, g15, g16, g17, g18, g19, g20, g21, g22, g23). */
 MSSLIB_API void msslib_hex_volume_gradient(double x0, double y0, double z0, double x1, double y1, double z1, double x2, double y2, double z2, double x3, double y3, double z3, double x4, double y4, double z4, double x5, double y5, double z5, double x6, double y6, double z6, double x7, double y7, double z7, double kappa, double V0, double *out)
@@ -698,8 +677,7 @@ MSSLIB_API void msslib_hex_volume_gradient(double x0, double y0, double z0, doub
     out[23] = -_c51;
 }
 
-#define MSSLIB_HEX_VOLUME_HESSIAN_N_OUT 576
-
+enum { MSSLIB_HEX_VOLUME_HESSIAN_N_OUT = 576 };
 /* hex_volume_hessian: Hexahedron volume correction kappa/(2 V0) (V - V0)^2, V from the averaged edge vectors (Golec et al.). Hessian [N/m], 24x24 row-major.
  * Writes out[0..575] = (h0, h1, h2, h3, h4, h5, h6, h7, h8, h9, h10, h11, h12, h13, h14, h15, h16, h17, h18, h19, h20, h21, h22, h23, h24, h25, h26, h27, h28, h29, h30, h31, h32, h33, h34, h35, h36, h37, h38, h39, h40, h41, h42, h43, h44, h45, h46, h47, h48, h49, h50, h51, h52, h53, h54, h55, h56, h57, h58, h59, h60, h61, h62, h63, h64, h65, h66, h67, h68, h69, h70, h71, h72, h73, h74, h75, h76, h77, h78, h79, h80, h81, h82, h83, h84, h85, h86, h87, h88, h89, h90, h91, h92, h93, h94, h95, h96, h97, h98, h99, h100, h101, h102, h103, h104, h105, h106, h107, h108, h109, h110, h111, h112, h113, h114, h115, h116, h117, h118, h119, h120, h121, h122, h123, h124, h125, h126, h127, h128, h129, h130, h131, h132, h133, h134, h135, h136, h137, h138, h139, h140, h141, h142, h143, h144, h145, h146, h147, h148, h149, h150, h151, h152, h153, h154, h155, h156, h157, h158, h159, h160, h161, h162, h163, h164, h165, h166, h167, h168, h169, h170, h171, h172, h173, h174, h175, h176, h177, h178, h179, h180, h181, h182, h183, h184, h185, h186, h187, h188, h189, h190, h191, h192, h193, h194, h195, h196, h197, h198, h199, h200, h201, h202, h203, h204, h205, h206, h207, h208, h209, h210, h211, h212, h213, h214, h215, h216, h217, h218, h219, h220, h221, h222, h223, h224, h225, h226, h227, h228, h229, h230, h231, h232, h233, h234, h235, h236, h237, h238, h239, h240, h241, h242, h243, h244, h245, h246, h247, h248, h249, h250, h251, h252, h253, h254, h255, h256, h257, h258, h259, h260, h261, h262, h263, h264, h265, h266, h267, h268, h269, h270, h271, h272, h273, h274, h275, h276, h277, h278, h279, h280, h281, h282, h283, h284, h285, h286, h287, h288, h289, h290, h291, h292, h293, h294, h295, h296, h297, h298, h299, h300, h301, h302, h303, h304, h305, h306, h307, h308, h309, h310, h311, h312, h313, h314, h315, h316, h317, h318, h319, h320, h321, h322, h323, h324, h325, h326, h327, h328, h329, h330, h331, h332, h333, h334, h335, h336, h337, h338, h339, h340, h341, h342, h343, h344, h345, h346, h347, h348, h349, h350, h351, h352, h353, h354, h355, h356, h357, h358, h359, h360, h361, h362, h363, h364, h365, h366, h367, h368, h369, h370, h371, h372, h373, h374, h375, h376, h377, h378, h379, h380, h381, h382, h383, h384, h385, h386, h387, h388, h389, h390, h391, h392, h393, h394, h395, h396, h397, h398, h399, h400, h401, h402, h403, h404, h405, h406, h407, h408, h409, h410, h411, h412, h413, h414, h415, h416, h417, h418, h419, h420, h421, h422, h423, h424, h425, h426, h427, h428, h429, h430, h431, h432, h433, h434, h435, h436, h437, h438, h439, h440, h441, h442, h443, h444, h445, h446, h447, h448, h449, h450, h451, h452, h453, h454, h455, h456, h457, h458, h459, h460, h461, h462, h463, h464, h465, h466, h467, h468, h469, h470, h471, h472, h473, h474, h475, h476, h477, h478, h479, h480, h481, h482, h483, h484, h485, h486, h487, h488, h489, h490, h491, h492, h493, h494, h495, h496, h497, h498, h499, h500, h501, h502, h503, h504, h505, h506, h507, h508, h509, h510, h511, h512, h513, h514, h515, h516, h517, h518, h519, h520, h521, h522, h523, h524, h525, h526, h527, h528, h529, h530, h531, h532, h533, h534, h535, h536, h537, h538, h539, h540, h541, h542, h543, h544, h545, h546, h547, h548, h549, h550, h551, h552, h553, h554, h555, h556, h557, h558, h559, h560, h561, h562, h563, h564, h565, h566, h567, h568, h569, h570, h571, h572, h573, h574, h575). */
 MSSLIB_API void msslib_hex_volume_hessian(double x0, double y0, double z0, double x1, double y1, double z1, double x2, double y2, double z2, double x3, double y3, double z3, double x4, double y4, double z4, double x5, double y5, double z5, double x6, double y6, double z6, double x7, double y7, double z7, double kappa, double V0, double *out)
@@ -1648,8 +1626,6 @@ MSSLIB_API double msslib_hex_averaged_volume(double x0, double y0, double z0, do
     return (1.0/64.0)*(_c10*_c17 - _c14*_c16)*(_c11 + _c3 + _c5 + x0 - x1 + x7) + (1.0/64.0)*(-_c10*_c6 + _c12*_c14)*(_c1 + _c2 - z1 + z7) + (1.0/64.0)*(-_c12*_c17 + _c16*_c6)*(_c13 + _c7 + _c9 + y0 - y1 + y7);
 }
 
-#ifdef __cplusplus
-}
-#endif
+MSSLIB_END_DECLS
 
 #endif /* MSSLIB_KERNELS_H */

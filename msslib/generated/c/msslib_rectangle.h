@@ -1,37 +1,16 @@
 // Generated from derivations/elements/rectangle.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: d488b63d2b625729c5512315c9616f2ee52a3cc82ecb30f35afbbe996ab2ead5
-// body-sha256: abbb21b2986d82b91592cbecd9d2e125021258fc205f7877db766bafa64eb4a1
-/* Rectangle of aspect ratio r, plane stress, six prestrained springs (generalising Lloyd et al. Sec. 4.1), in C99.
- *
- * Printed by SymPy's C99 printer from the expressions that msslib/generated/rectangle.py is
- * printed from (derivations/elements/rectangle.py), with the same common subexpressions;
- * `python -m derivations.codegen` writes both, do not edit. msslib_mss.h includes every module.
- * SI units: E in Pa, lengths in m, spring constants in N/m, energies in J, gradients in N,
- * Hessians in N/m (row-major, node by node: x0, y0(, z0), x1, ...).
- * Functions are `static inline` unless MSSLIB_API is defined before this header is
- * included (define it empty to compile them with external linkage, e.g. into a library).
- * Link with -lm. */
+// source-sha256: 890f104f183484b327845b4115c12c117598d7262401cc400c5188ce1ac0816a
+// body-sha256: 7164229a583f900ca146aca36a9edbb85c829bd260ee9c182fd4b8ef478eb2c2
+/* Rectangle of aspect ratio r, plane stress, six prestrained springs (generalising Lloyd et al. Sec. 4.1), in C99 (units and linkage: msslib_api.h).
+ * Printed from the expressions of msslib/generated/rectangle.py (derivations/elements/rectangle.py). */
 #ifndef MSSLIB_RECTANGLE_H
 #define MSSLIB_RECTANGLE_H
 
-#include <math.h>
+#include "msslib_api.h"
 
-#ifndef MSSLIB_API
-#define MSSLIB_API static inline
-#endif
+MSSLIB_BEGIN_DECLS
 
-#ifdef __cplusplus
-extern "C" {
-#endif
-
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_N_OUT 6
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_K_H 0
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_K_V 1
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_K_D 2
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_C_H 3
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_C_V 4
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_C_D 5
-
+enum { MSSLIB_RECTANGLE_LEAST_SQUARES_K_H, MSSLIB_RECTANGLE_LEAST_SQUARES_K_V, MSSLIB_RECTANGLE_LEAST_SQUARES_K_D, MSSLIB_RECTANGLE_LEAST_SQUARES_C_H, MSSLIB_RECTANGLE_LEAST_SQUARES_C_V, MSSLIB_RECTANGLE_LEAST_SQUARES_C_D, MSSLIB_RECTANGLE_LEAST_SQUARES_N_OUT };
 /* rectangle_least_squares: Least-squares springs of an a x b rectangle (r = b/a), plane stress, nu = 1/3, per element: k_h (the 2 edges along x, length a), k_v (the 2 edges along y, length b = r a), k_d (the 2 diagonals) and rest-length factors c_h, c_v, c_d (rest length = c times the rest distance). Edge constants add up over the elements sharing the edge. Exact only for r = 1 (Lloyd's 5/16, 7/16 E t; 6/5, 6/7); k and c are positive only for 0.4920 < r < 2.0324, and for r != 1 the element is NOT in equilibrium at rest (see rectangle_least_squares_equilibrium).
  * Writes out[0..5] = (k_h, k_v, k_d, c_h, c_v, c_d). */
 MSSLIB_API void msslib_rectangle_least_squares(double E, double t, double r, double *out)
@@ -54,14 +33,7 @@ MSSLIB_API void msslib_rectangle_least_squares(double E, double t, double r, dou
     out[5] = 2*(-_c0 + _c9 + 1)*(_c0 + _c9 - 1)/_c8;
 }
 
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_N_OUT 6
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_K_H 0
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_K_V 1
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_K_D 2
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_C_H 3
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_C_V 4
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_C_D 5
-
+enum { MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_K_H, MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_K_V, MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_K_D, MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_C_H, MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_C_V, MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_C_D, MSSLIB_RECTANGLE_LEAST_SQUARES_EQUILIBRIUM_N_OUT };
 /* rectangle_least_squares_equilibrium: Least-squares springs of an a x b rectangle (r = b/a), plane stress, nu = 1/3, restricted to elements in equilibrium at rest (spring tensions balance at every node), per element: k_h (the 2 edges along x, length a), k_v (the 2 edges along y, length b = r a), k_d (the 2 diagonals) and rest-length factors c_h, c_v, c_d (rest length = c times the rest distance). Edge constants add up over the elements sharing the edge. Equal to rectangle_least_squares at r = 1; k and c are positive for every r.
  * Writes out[0..5] = (k_h, k_v, k_d, c_h, c_v, c_d). */
 MSSLIB_API void msslib_rectangle_least_squares_equilibrium(double E, double t, double r, double *out)
@@ -87,14 +59,7 @@ MSSLIB_API void msslib_rectangle_least_squares_equilibrium(double E, double t, d
     out[5] = (1.0/2.0)*(_c10 + 62*_c2)/_c11;
 }
 
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_N_OUT 6
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_K_H 0
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_K_V 1
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_K_D 2
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_C_H 3
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_C_V 4
-#define MSSLIB_RECTANGLE_LEAST_SQUARES_NU_C_D 5
-
+enum { MSSLIB_RECTANGLE_LEAST_SQUARES_NU_K_H, MSSLIB_RECTANGLE_LEAST_SQUARES_NU_K_V, MSSLIB_RECTANGLE_LEAST_SQUARES_NU_K_D, MSSLIB_RECTANGLE_LEAST_SQUARES_NU_C_H, MSSLIB_RECTANGLE_LEAST_SQUARES_NU_C_V, MSSLIB_RECTANGLE_LEAST_SQUARES_NU_C_D, MSSLIB_RECTANGLE_LEAST_SQUARES_NU_N_OUT };
 /* rectangle_least_squares_nu: Least-squares springs of an a x b rectangle (r = b/a), plane stress, any Poisson's ratio nu, per element: k_h (the 2 edges along x, length a), k_v (the 2 edges along y, length b = r a), k_d (the 2 diagonals) and rest-length factors c_h, c_v, c_d (rest length = c times the rest distance). Edge constants add up over the elements sharing the edge. rectangle_least_squares is its value at nu = 1/3; not in equilibrium at rest.
  * Writes out[0..5] = (k_h, k_v, k_d, c_h, c_v, c_d). */
 MSSLIB_API void msslib_rectangle_least_squares_nu(double E, double nu, double t, double r, double *out)
@@ -123,8 +88,6 @@ MSSLIB_API void msslib_rectangle_least_squares_nu(double E, double nu, double t,
     out[5] = _c14*(-_c1 + _c15 + 1)*(_c1 + _c15 - 1)/_c13;
 }
 
-#ifdef __cplusplus
-}
-#endif
+MSSLIB_END_DECLS
 
 #endif /* MSSLIB_RECTANGLE_H */

@@ -1,28 +1,14 @@
 // Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 0d0bf17a5dedd15988d2fb7803022fbcfe60cfc94439390d158472ccb5d53756
-// body-sha256: f939343cb2baf0fb848f36b70ff7f3b1f31ba015f97cabe173307781e3e06e1c
-/* Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14), in C99.
- *
- * Printed by SymPy's C99 printer from the expressions that msslib/generated/tetrahedron.py is
- * printed from (derivations/elements/tetrahedron.py), with the same common subexpressions;
- * `python -m derivations.codegen` writes both, do not edit. msslib_mss.h includes every module.
- * SI units: E in Pa, lengths in m, spring constants in N/m, energies in J, gradients in N,
- * Hessians in N/m (row-major, node by node: x0, y0(, z0), x1, ...).
- * Functions are `static inline` unless MSSLIB_API is defined before this header is
- * included (define it empty to compile them with external linkage, e.g. into a library).
- * Link with -lm. */
+// source-sha256: 98de68b95dc7fb66e227e767f4eb058f929642330c83c6b00bbf8f9b7ce1b3db
+// body-sha256: 738438200b0fb2aa500fae7fafe7d5ed17024c3591a585f1464bc59692366c65
+/* Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14), in C99 (units and linkage: msslib_api.h).
+ * Printed from the expressions of msslib/generated/tetrahedron.py (derivations/elements/tetrahedron.py). */
 #ifndef MSSLIB_TETRAHEDRON_H
 #define MSSLIB_TETRAHEDRON_H
 
-#include <math.h>
+#include "msslib_api.h"
 
-#ifndef MSSLIB_API
-#define MSSLIB_API static inline
-#endif
-
-#ifdef __cplusplus
-extern "C" {
-#endif
+MSSLIB_BEGIN_DECLS
 
 /* lloyd_tetrahedron: Per-element spring constant of a regular tetrahedron of edge l (least squares at nu = 1/4, eq. 12); use the equivalent edge length of eq. 13 for other shapes; sum over the tetrahedra sharing the edge.
  * Returns k. */
@@ -38,10 +24,7 @@ MSSLIB_API double msslib_lloyd_tetrahedron_general_nu(double E, double nu, doubl
     return (1.0/15.0)*sqrt(2)*E*l*(nu - 1)/((nu + 1)*(2*nu - 1));
 }
 
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_N_OUT 2
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_K 0
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_K_VOLUME 1
-
+enum { MSSLIB_LLOYD_TETRAHEDRON_VOLUME_K, MSSLIB_LLOYD_TETRAHEDRON_VOLUME_K_VOLUME, MSSLIB_LLOYD_TETRAHEDRON_VOLUME_N_OUT };
 /* lloyd_tetrahedron_volume: Per-element spring constant and volume-energy coefficient k_V of E_V = k_V/(2 V0^2)(V - V0)^2, least squares for any nu (eq. 14 is the case nu = 1/4).
  * Writes out[0..1] = (k, k_volume). */
 MSSLIB_API void msslib_lloyd_tetrahedron_volume(double E, double nu, double l, double *out)
@@ -58,10 +41,7 @@ MSSLIB_API double msslib_equivalent_edge_length(double V)
     return sqrt(2)*cbrt(3)*cbrt(V);
 }
 
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_PUBLISHED_N_OUT 2
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_PUBLISHED_K 0
-#define MSSLIB_LLOYD_TETRAHEDRON_VOLUME_PUBLISHED_K_VOLUME 1
-
+enum { MSSLIB_LLOYD_TETRAHEDRON_VOLUME_PUBLISHED_K, MSSLIB_LLOYD_TETRAHEDRON_VOLUME_PUBLISHED_K_VOLUME, MSSLIB_LLOYD_TETRAHEDRON_VOLUME_PUBLISHED_N_OUT };
 /* lloyd_tetrahedron_volume_published: Lloyd et al.'s eq. 14 as printed (the optimum at nu = 1/4).
  * Writes out[0..1] = (k, k_volume). */
 MSSLIB_API void msslib_lloyd_tetrahedron_volume_published(double E, double l, double *out)
@@ -71,8 +51,6 @@ MSSLIB_API void msslib_lloyd_tetrahedron_volume_published(double E, double l, do
     out[1] = (1.0/210.0)*_c0*pow(l, 3);
 }
 
-#ifdef __cplusplus
-}
-#endif
+MSSLIB_END_DECLS
 
 #endif /* MSSLIB_TETRAHEDRON_H */

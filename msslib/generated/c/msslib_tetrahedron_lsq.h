@@ -1,52 +1,16 @@
 // Generated from derivations/elements/tetrahedron_lsq.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: ff416bdd045175906b1c478acea9b4b64b01edd498ff141e41da658e8a6d155b
-// body-sha256: cdd295929070b1914d0045f23012c41281748fae771a1b80dd2b0474e6910964
-/* Tetrahedron of any shape, six springs fitted to its own linear element by least squares (Natsupakpong and Cavusoglu 2010, normal equations), in C99.
- *
- * Printed by SymPy's C99 printer from the expressions that msslib/generated/tetrahedron_lsq.py is
- * printed from (derivations/elements/tetrahedron_lsq.py), with the same common subexpressions;
- * `python -m derivations.codegen` writes both, do not edit. msslib_mss.h includes every module.
- * SI units: E in Pa, lengths in m, spring constants in N/m, energies in J, gradients in N,
- * Hessians in N/m (row-major, node by node: x0, y0(, z0), x1, ...).
- * Functions are `static inline` unless MSSLIB_API is defined before this header is
- * included (define it empty to compile them with external linkage, e.g. into a library).
- * Link with -lm. */
+// source-sha256: ac485e48d27ea240155981c1c4bd69c1771a38c894ebb55a0829295e276e6097
+// body-sha256: d3424e9148ad293e12c80e2b2d4b32e79d8c09b389dab6212e6df4cdcbe315f0
+/* Tetrahedron of any shape, six springs fitted to its own linear element by least squares (Natsupakpong and Cavusoglu 2010, normal equations), in C99 (units and linkage: msslib_api.h).
+ * Printed from the expressions of msslib/generated/tetrahedron_lsq.py (derivations/elements/tetrahedron_lsq.py). */
 #ifndef MSSLIB_TETRAHEDRON_LSQ_H
 #define MSSLIB_TETRAHEDRON_LSQ_H
 
-#include <math.h>
+#include "msslib_api.h"
 
-#ifndef MSSLIB_API
-#define MSSLIB_API static inline
-#endif
+MSSLIB_BEGIN_DECLS
 
-#ifdef __cplusplus
-extern "C" {
-#endif
-
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_N_OUT 21
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_00 0
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_01 1
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_02 2
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_03 3
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_04 4
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_05 5
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_11 6
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_12 7
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_13 8
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_14 9
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_15 10
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_22 11
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_23 12
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_24 13
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_25 14
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_33 15
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_34 16
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_35 17
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_44 18
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_45 19
-#define MSSLIB_LSQ_TETRAHEDRON_GRAM_G_55 20
-
+enum { MSSLIB_LSQ_TETRAHEDRON_GRAM_G_00, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_01, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_02, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_03, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_04, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_05, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_11, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_12, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_13, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_14, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_15, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_22, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_23, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_24, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_25, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_33, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_34, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_35, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_44, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_45, MSSLIB_LSQ_TETRAHEDRON_GRAM_G_55, MSSLIB_LSQ_TETRAHEDRON_GRAM_N_OUT };
 /* lsq_tetrahedron_gram: Gram matrix G_pq = <K_p, K_q> (upper triangle, dimensionless) of the unit springs of one tetrahedron with nodes (0, 0, 0), (a, 0, 0), (x2, y2, 0), (x3, y3, z3), y2 > 0, z3 > 0 (positively oriented); edges 0-1, 0-2, 0-3, 1-2, 1-3, 2-3. The per-element spring constants (N/m, summed over the tetrahedra sharing an edge) solve G k = b.
  * Writes out[0..20] = (G_00, G_01, G_02, G_03, G_04, G_05, G_11, G_12, G_13, G_14, G_15, G_22, G_23, G_24, G_25, G_33, G_34, G_35, G_44, G_45, G_55). */
 MSSLIB_API void msslib_lsq_tetrahedron_gram(double a, double x2, double y2, double x3, double y3, double z3, double *out)
@@ -95,14 +59,7 @@ MSSLIB_API void msslib_lsq_tetrahedron_gram(double a, double x2, double y2, doub
     out[20] = 4;
 }
 
-#define MSSLIB_LSQ_TETRAHEDRON_RHS_N_OUT 6
-#define MSSLIB_LSQ_TETRAHEDRON_RHS_B_0 0
-#define MSSLIB_LSQ_TETRAHEDRON_RHS_B_1 1
-#define MSSLIB_LSQ_TETRAHEDRON_RHS_B_2 2
-#define MSSLIB_LSQ_TETRAHEDRON_RHS_B_3 3
-#define MSSLIB_LSQ_TETRAHEDRON_RHS_B_4 4
-#define MSSLIB_LSQ_TETRAHEDRON_RHS_B_5 5
-
+enum { MSSLIB_LSQ_TETRAHEDRON_RHS_B_0, MSSLIB_LSQ_TETRAHEDRON_RHS_B_1, MSSLIB_LSQ_TETRAHEDRON_RHS_B_2, MSSLIB_LSQ_TETRAHEDRON_RHS_B_3, MSSLIB_LSQ_TETRAHEDRON_RHS_B_4, MSSLIB_LSQ_TETRAHEDRON_RHS_B_5, MSSLIB_LSQ_TETRAHEDRON_RHS_N_OUT };
 /* lsq_tetrahedron_rhs: Right-hand side b_p = <K_p, K_FEM> (N/m) of one tetrahedron with nodes (0, 0, 0), (a, 0, 0), (x2, y2, 0), (x3, y3, z3), y2 > 0, z3 > 0 (positively oriented); edges 0-1, 0-2, 0-3, 1-2, 1-3, 2-3. The per-element spring constants (N/m, summed over the tetrahedra sharing an edge) solve G k = b.
  * Writes out[0..5] = (b_0, b_1, b_2, b_3, b_4, b_5). */
 MSSLIB_API void msslib_lsq_tetrahedron_rhs(double E, double nu, double a, double x2, double y2, double x3, double y3, double z3, double *out)
@@ -247,8 +204,6 @@ MSSLIB_API void msslib_lsq_tetrahedron_rhs(double E, double nu, double a, double
     out[5] = _c44*a*(-_c10*_c131 + _c103*_c42 - _c103 + _c104*_c42 - _c104 + _c12*_c131 + _c12*_c81 - _c12*_c85 + _c120 - _c16*_c26 - _c16*_c31 - _c17*_c7 + _c26*_c86 + _c27*_c42 - _c27 + _c29*_c42 - _c29 + _c31*_c86 + _c32*_c42 - _c32 + _c34*_c83 - 6*_c34 + _c42*_c47 + _c42*_c65 + _c42*_c93 + _c42*_c95 - _c47 - _c6*_c84 - _c65 - _c67*_c83 + 4*_c7 + _c8*_c81 + _c8*_c84 - _c8*_c85 - _c93 - _c95)/(-_c16 + _c46 - _c81 + _c92);
 }
 
-#ifdef __cplusplus
-}
-#endif
+MSSLIB_END_DECLS
 
 #endif /* MSSLIB_TETRAHEDRON_LSQ_H */

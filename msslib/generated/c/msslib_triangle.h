@@ -1,28 +1,14 @@
 // Generated from derivations/elements/triangle.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 99a127095acd37fc49dab13ca59f00408cd1a1fb9e96269716115758fe0325f8
-// body-sha256: 298fe9aba68a9c879d57af4b9e347fdcc7e03f133b5f7ce26b984974550d7fa7
-/* Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9), in C99.
- *
- * Printed by SymPy's C99 printer from the expressions that msslib/generated/triangle.py is
- * printed from (derivations/elements/triangle.py), with the same common subexpressions;
- * `python -m derivations.codegen` writes both, do not edit. msslib_mss.h includes every module.
- * SI units: E in Pa, lengths in m, spring constants in N/m, energies in J, gradients in N,
- * Hessians in N/m (row-major, node by node: x0, y0(, z0), x1, ...).
- * Functions are `static inline` unless MSSLIB_API is defined before this header is
- * included (define it empty to compile them with external linkage, e.g. into a library).
- * Link with -lm. */
+// source-sha256: 153a22328f5d1af836d3e9db882b2e5f1a1e4f6310c91e3446b683712ca4e5c2
+// body-sha256: d6dd0ef1e5e4fdf007262366fb37c4bb4ff2fd80c599af2d0de2dd1b6fca4599
+/* Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9), in C99 (units and linkage: msslib_api.h).
+ * Printed from the expressions of msslib/generated/triangle.py (derivations/elements/triangle.py). */
 #ifndef MSSLIB_TRIANGLE_H
 #define MSSLIB_TRIANGLE_H
 
-#include <math.h>
+#include "msslib_api.h"
 
-#ifndef MSSLIB_API
-#define MSSLIB_API static inline
-#endif
-
-#ifdef __cplusplus
-extern "C" {
-#endif
+MSSLIB_BEGIN_DECLS
 
 /* lloyd_triangle: Spring constant of each edge of an equilateral triangle, per element (sum over the triangles sharing the edge). Exact for nu = 1/3.
  * Returns k. */
@@ -38,8 +24,6 @@ MSSLIB_API double msslib_van_gelder_triangle(double E, double t, double A_e, dou
     return A_e*E*t/pow(l, 2);
 }
 
-#ifdef __cplusplus
-}
-#endif
+MSSLIB_END_DECLS
 
 #endif /* MSSLIB_TRIANGLE_H */

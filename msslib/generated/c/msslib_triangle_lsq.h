@@ -1,34 +1,16 @@
 // Generated from derivations/elements/triangle_lsq.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 43523c175342e96901e7484d34f5ddc7a8066559a1fc4fe9deeb5c10e5c75e4e
-// body-sha256: 35cfa5258a6ea622815ff5e0a458d6d3923b9380fa07d512086d81ba1af11a2c
-/* Triangle of any shape, three springs fitted to its own CST by least squares (Natsupakpong and Cavusoglu 2010, closed form), in C99.
- *
- * Printed by SymPy's C99 printer from the expressions that msslib/generated/triangle_lsq.py is
- * printed from (derivations/elements/triangle_lsq.py), with the same common subexpressions;
- * `python -m derivations.codegen` writes both, do not edit. msslib_mss.h includes every module.
- * SI units: E in Pa, lengths in m, spring constants in N/m, energies in J, gradients in N,
- * Hessians in N/m (row-major, node by node: x0, y0(, z0), x1, ...).
- * Functions are `static inline` unless MSSLIB_API is defined before this header is
- * included (define it empty to compile them with external linkage, e.g. into a library).
- * Link with -lm. */
+// source-sha256: d5ee0e0e39a2318432e4e2dfcfbc2e66774870bf8b91fb16ad568295fc27ed82
+// body-sha256: c170b5b8e3023be5ac195a0759f71c4844255dea36ed3e84d56a659f5840c7b2
+/* Triangle of any shape, three springs fitted to its own CST by least squares (Natsupakpong and Cavusoglu 2010, closed form), in C99 (units and linkage: msslib_api.h).
+ * Printed from the expressions of msslib/generated/triangle_lsq.py (derivations/elements/triangle_lsq.py). */
 #ifndef MSSLIB_TRIANGLE_LSQ_H
 #define MSSLIB_TRIANGLE_LSQ_H
 
-#include <math.h>
+#include "msslib_api.h"
 
-#ifndef MSSLIB_API
-#define MSSLIB_API static inline
-#endif
+MSSLIB_BEGIN_DECLS
 
-#ifdef __cplusplus
-extern "C" {
-#endif
-
-#define MSSLIB_LSQ_TRIANGLE_N_OUT 3
-#define MSSLIB_LSQ_TRIANGLE_K_01 0
-#define MSSLIB_LSQ_TRIANGLE_K_12 1
-#define MSSLIB_LSQ_TRIANGLE_K_02 2
-
+enum { MSSLIB_LSQ_TRIANGLE_K_01, MSSLIB_LSQ_TRIANGLE_K_12, MSSLIB_LSQ_TRIANGLE_K_02, MSSLIB_LSQ_TRIANGLE_N_OUT };
 /* lsq_triangle: Spring constants k_ij (edge i-j, N/m) of one triangle with nodes (0, 0), (a, 0), (x2, y2), y2 > 0, minimising the Frobenius distance of the springs' stiffness at rest from the triangle's own plane-stress CST (thickness t); per element (sum over the triangles sharing an edge). Exact only on the equilateral triangle at nu = 1/3; can be negative for obtuse triangles.
  * Writes out[0..2] = (k_01, k_12, k_02). */
 MSSLIB_API void msslib_lsq_triangle(double E, double nu, double t, double a, double x2, double y2, double *out)
@@ -89,8 +71,6 @@ MSSLIB_API void msslib_lsq_triangle(double E, double nu, double t, double a, dou
     out[2] = _c44*(-_c1*_c4 - _c11*_c7 + (1.0/4.0)*_c12*_c15*_c35*_c41 + (1.0/4.0)*_c15*_c3*_c35*_c39 + 16*_c2*_c3 + 32*_c2*_c4 + 16*_c20*a*nu - 16*_c21 + 4*_c24 + 4*_c25 + 8*_c3*_c4 - 1.0/4.0*_c31*_c43 + 16*_c4*a*nu*x2 - _c40*_c41 - _c45 - _c46 - _c49 - _c50)/_c13;
 }
 
-#ifdef __cplusplus
-}
-#endif
+MSSLIB_END_DECLS
 
 #endif /* MSSLIB_TRIANGLE_LSQ_H */
