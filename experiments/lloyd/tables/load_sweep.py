@@ -31,7 +31,9 @@ def main(argv=None):
     num = script.number
     for r in script.rows(ds, "run"):
         lo, hi = float(r.stated_low), float(r.stated_high)
-        if float(r.end_at_file_load):  # the sweep ends at the file's load (a solver limit), not at a stated value
+        if float(r.end_at_file_load) and not np.isfinite(hi):  # the sweep's end is the file load's deformation: not run
+            stated = f"> {100 * lo:.3g}; not run in this build"
+        elif float(r.end_at_file_load):  # the sweep ends at the file's load (a solver limit), not at a stated value
             stated = f"> {100 * lo:.3g}; sweep to {100 * hi:.3g}" if lo < hi else f"{100 * lo:.3g}; MSS fails beyond {100 * hi:.3g}"
         else:
             stated = pc(lo, hi)
