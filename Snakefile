@@ -58,19 +58,29 @@ def scripts(kind):
     return {(p.parent.parent.name, p.stem): p for paper in PAPERS for p in sorted(Path("experiments", paper, kind).glob("*.py"))}
 
 
-def declared_inputs(path):
-    """The INPUTS list a figure or table script declares, computed from its top-level assignments
-    only (constants and comprehensions; imports and functions are not run)."""
+def _constants(path):
+    """The top-level constants of an experiment module: its assignments (constants and
+    comprehensions; functions are not run) and the names it imports from other experiment
+    modules (``from experiments.<...> import NAME [as X]``), computed the same way."""
     tree = ast.parse(Path(path).read_text())
-    body = [n for n in tree.body if isinstance(n, ast.Assign)]
     namespace = {"__builtins__": {"range": range, "str": str, "int": int, "len": len, "sorted": sorted,
-                                  "zip": zip, "enumerate": enumerate, "list": list, "dict": dict}}
-    for node in body:
-        try:
-            exec(compile(ast.Module(body=[node], type_ignores=[]), str(path), "exec"), namespace)
-        except Exception:
-            pass
-    return list(namespace.get("INPUTS", []))
+                                  "zip": zip, "enumerate": enumerate, "list": list, "dict": dict, "tuple": tuple}}
+    for node in tree.body:
+        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("experiments."):
+            source = Path(*node.module.split(".")).with_suffix(".py")
+            values = _constants(source) if source.is_file() else {}
+            namespace.update({a.asname or a.name: values[a.name] for a in node.names if a.name in values})
+        elif isinstance(node, ast.Assign):
+            try:
+                exec(compile(ast.Module(body=[node], type_ignores=[]), str(path), "exec"), namespace)
+            except Exception:
+                pass
+    return namespace
+
+
+def declared_inputs(path):
+    """The INPUTS list a figure or table script declares (:func:`_constants`)."""
+    return list(_constants(path).get("INPUTS", []))
 
 
 # `snakemake --report`: figures, tables and the paper, one category per paper (captions in paper/report/)

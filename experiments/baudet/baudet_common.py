@@ -34,6 +34,10 @@ NU_LABELS = tuple(f"{v:g}" for v in NUS)
 FACTORS = ("derived", "printed")
 READINGS = ("boundary", "element")  # readings of the correction force (msslib.baudet_correction)
 STEPS = 40  # load levels per curve (set to 10 by --quick)
+# the cantilever's MSS resolutions and the results its figure and table read
+CANTILEVER_RES = ("4x1x1", "8x2x2", "16x4x4", "32x8x8")
+CANTILEVER_INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in CANTILEVER_RES]
+                     + ["results/baudet/cantilever/gravity__fem.nc", "results/baudet/studies/cantilever_eq10.nc"])
 
 
 def parse(doc):

@@ -1,11 +1,9 @@
 """Baudet Figs. 9-10: deflection of the cantilever's neutral axis, MSS (and 32x8x8 beyond the paper) and FEM against eq. 10."""
 
 from experiments.baudet import baudet_common as C
+from experiments.baudet.baudet_common import CANTILEVER_INPUTS as INPUTS
+from experiments.baudet.baudet_common import CANTILEVER_RES as RES
 from msslib import plotting
-
-RES = ("4x1x1", "8x2x2", "16x4x4", "32x8x8")
-INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]
-          + ["results/baudet/cantilever/gravity__fem.nc", "results/baudet/studies/cantilever_eq10.nc"])
 
 
 def main():

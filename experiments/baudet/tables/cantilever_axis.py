@@ -2,10 +2,8 @@
 
 from experiments import script
 from experiments.baudet import baudet_common as C
-
-RES = ("4x1x1", "8x2x2", "16x4x4", "32x8x8")
-INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in RES]
-          + ["results/baudet/cantilever/gravity__fem.nc", "results/baudet/studies/cantilever_eq10.nc"])
+from experiments.baudet.baudet_common import CANTILEVER_INPUTS as INPUTS
+from experiments.baudet.baudet_common import CANTILEVER_RES as RES
 
 
 def main():
