@@ -15,6 +15,7 @@ from msslib import mesh as M
 from msslib.model import Model
 from msslib.models.checks import FormulaValidityWarning
 from msslib.models.lsq import (
+    _not_positive_definite,
     check_stable_at_rest,
     lsq_tetrahedron_springs,
     lsq_triangle_springs,
@@ -94,9 +95,14 @@ def test_an_unstable_fit_is_refused_in_one_line(apex):
     assert _spectrum(signed, mesh)[0] < -1e-6
 
 
-def test_the_check_agrees_with_the_dense_spectrum_on_random_signed_lattices():
+@pytest.mark.parametrize("band_limit", [2e8, 0.0], ids=["banded Cholesky", "sparse LDLT"])
+def test_the_check_agrees_with_the_dense_spectrum_on_random_signed_lattices(band_limit, monkeypatch):
     """Random constants of either sign on a jittered tetrahedral grid: the check raises exactly
-    when the dense stiffness has an eigenvalue below zero beyond the six rigid-body modes."""
+    when the dense stiffness has an eigenvalue below zero beyond the six rigid-body modes (by
+    either factorisation)."""
+    from msslib.models import lsq
+
+    monkeypatch.setattr(lsq, "BAND_LIMIT", band_limit)
     mesh = jittered(M.tet_grid(1.0, 1.0, 1.0, 2, 2, 2), 0.05, seed=3)
     pairs = M.unique_edges(mesh).pairs
     rest = np.linalg.norm(mesh.points[pairs[:, 1]] - mesh.points[pairs[:, 0]], axis=1)
@@ -116,3 +122,24 @@ def test_the_check_agrees_with_the_dense_spectrum_on_random_signed_lattices():
             verdicts.append((stable, False))
     assert all(a == b for a, b in verdicts)
     assert {v for v, _ in verdicts} == {True, False}  # both outcomes occur
+
+
+@pytest.mark.parametrize("band_limit", [np.inf, 0.0], ids=["banded Cholesky", "sparse LDLT"])
+def test_both_factorisations_tell_positive_definite_matrices_from_the_others(band_limit):
+    """Random sparse symmetric matrices shifted to a chosen smallest eigenvalue: both paths (the
+    banded Cholesky and, for large bandwidths, SuperLU's symmetric LDL^T) say positive definite
+    exactly when the dense smallest eigenvalue is positive, and name the first bad pivot."""
+    import scipy.sparse as sps
+
+    rng = np.random.default_rng(11)
+    for trial in range(20):
+        n = 40 + trial
+        B = sps.random(n, n, density=0.08, random_state=trial, format="csr")
+        A = (B + B.T + sps.diags(rng.uniform(0.5, 1.0, n))).tocsr()
+        lam = np.linalg.eigvalsh(A.toarray())[0]
+        shift = -lam + (1.0 if trial % 2 else -0.05) * abs(lam)  # smallest eigenvalue +|lam| or -0.05|lam|
+        A = (A + shift * sps.identity(n, format="csr")).tocsr()
+        smallest = np.linalg.eigvalsh(A.toarray())[0]
+        info = _not_positive_definite(A, "test", band_limit=band_limit)
+        assert (info == 0) == (smallest > 0), (trial, smallest, info)
+        assert 0 <= info <= n

@@ -160,6 +160,43 @@ def rigid_modes(points) -> np.ndarray:
     return np.column_stack(modes)
 
 
+BAND_LIMIT = 2e8  # n (bandwidth + 1) above which the sparse LDL^T is used instead of a banded Cholesky
+
+
+def _not_positive_definite(A, label: str, band_limit: float | None = None) -> int:
+    """0 if the symmetric sparse matrix ``A`` is positive definite, else the 1-based index of the
+    first pivot that is not positive.  A banded Cholesky (LAPACK ``pbtrf``) in reverse Cuthill-McKee
+    order when ``n (bandwidth + 1) <= band_limit`` (default :data:`BAND_LIMIT`), else SuperLU's LU in a symmetric minimum-degree
+    order without pivoting (``diag_pivot_thresh = 0``): then ``U``'s diagonal is ``D`` of ``A =
+    L D L^T`` and, by Sylvester's law of inertia, ``A`` is positive definite if and only if it is
+    positive.  Raises ValueError if SuperLU had to pivot (a zero diagonal): no verdict then."""
+    import scipy.linalg as la
+    import scipy.sparse.linalg as spla
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    band_limit = BAND_LIMIT if band_limit is None else band_limit
+    A = A.tocsr()
+    n = A.shape[0]
+    order = reverse_cuthill_mckee(A, symmetric_mode=True)
+    B = A[order][:, order].tocoo()
+    bw = int(np.max(np.abs(B.row - B.col))) if B.nnz else 0
+    if n * (bw + 1.0) <= band_limit:
+        ab = np.zeros((bw + 1, n))
+        low = B.row >= B.col
+        np.add.at(ab, (B.row[low] - B.col[low], B.col[low]), B.data[low])
+        return int(la.lapack.dpbtrf(ab, lower=1)[1])
+    try:
+        lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                       options={"SymmetricMode": True})
+    except RuntimeError:  # an exactly zero pivot: singular, so not positive definite
+        return 1
+    if not np.array_equal(lu.perm_r, lu.perm_c):
+        raise ValueError(f"{label}: cannot check the stability of this lattice at rest (the symmetric "
+                         "factorisation needed pivoting)")
+    bad = np.flatnonzero(~(lu.U.diagonal() > 0))
+    return int(bad[0]) + 1 if len(bad) else 0
+
+
 def check_stable_at_rest(springs, points, label: str) -> None:
     """Raise ValueError unless the springs' stiffness at rest ``K`` (``points`` stress free) is
     positive definite apart from the rigid-body motions.
@@ -168,10 +205,9 @@ def check_stable_at_rest(springs, points, label: str) -> None:
     with the dofs of a rigid-body-pinning set removed (chosen by pivoted QR of the rigid modes)
     is positive definite: a rigid motion is in ``K``'s null space at a stress-free state, and it
     is the only displacement that matches an arbitrary motion on the pinned dofs. That reduced
-    matrix is factored by a banded Cholesky in reverse Cuthill-McKee order."""
+    matrix is factored by :func:`_not_positive_definite`."""
     import scipy.linalg as la
     import scipy.sparse as sps
-    from scipy.sparse.csgraph import reverse_cuthill_mckee
 
     p = np.asarray(points, dtype=float)
     n = p.size
@@ -181,21 +217,12 @@ def check_stable_at_rest(springs, points, label: str) -> None:
     pinned = la.qr(R.T, pivoting=True, mode="r")[1][: R.shape[1]]
     keep = np.setdiff1d(np.arange(n), pinned)
     Kr = K[keep][:, keep].tocsr()
-    order = reverse_cuthill_mckee(Kr, symmetric_mode=True)
-    Kr = Kr[order][:, order].tocoo()
-    bw = int(np.max(np.abs(Kr.row - Kr.col))) if Kr.nnz else 0
-    if Kr.shape[0] * (bw + 1) > 2e8:
-        raise ValueError(f"{label}: cannot check the stability of this lattice at rest (bandwidth {bw} of "
-                         f"{Kr.shape[0]} dofs is too large)")
-    ab = np.zeros((bw + 1, Kr.shape[0]))
-    low = Kr.row >= Kr.col
-    np.add.at(ab, (Kr.row[low] - Kr.col[low], Kr.col[low]), Kr.data[low])
-    _, info = la.lapack.dpbtrf(ab, lower=1)
+    info = _not_positive_definite(Kr, label)
     if info != 0:
         neg = np.flatnonzero(springs.k <= 0)
         raise ValueError(
             f"{label}: the fitted lattice is not stable at rest (its stiffness, rigid-body motions "
-            f"removed, is not positive definite: leading minor {info} of {Kr.shape[0]}); "
+            f"removed, is not positive definite: pivot {info} of {Kr.shape[0]}); "
             f"{len(neg)} spring(s) have a non-positive summed constant, e.g. nodes "
             f"{tuple(int(v) for v in springs.conn[neg[0]])} with k = {springs.k[neg[0]]:.4g} N/m. "
             f"Use a mesh without very obtuse (triangle) or flat (tetrahedron) elements, or another model")
