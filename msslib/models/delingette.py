@@ -27,6 +27,7 @@ from msslib.models.common import _require, material_arrays
 from msslib.models.spec import Exactness, ModelSpec
 from msslib.terms import Term
 from msslib.terms.assembly import _block_pattern
+from msslib.terms.jit import _jit
 
 __all__ = ["TriangleAngularSprings", "delingette_triangle"]  # the parameters (gathered by msslib.parameters)
 
@@ -95,24 +96,20 @@ class TriangleAngular(Term):
     def max_node(self) -> int:
         return int(self.conn.max()) if self.conn.size else -1
 
-    def _edges(self, x):
-        x = np.asarray(x, dtype=float).reshape(-1, 2)
-        d = x[self.conn[:, EDGES[:, 1]]] - x[self.conn[:, EDGES[:, 0]]]  # (m, 3, 2)
-        return x, d, np.einsum("mei,mei->me", d, d) - self.L2
+    def _x(self, x):
+        x = np.ascontiguousarray(x, dtype=float).reshape(-1)
+        if 2 * (self.max_node() + 1) > len(x):
+            raise ValueError(f"TriangleAngular: x has {len(x)} entries, the cells need {2 * (self.max_node() + 1)}")
+        return x
 
     def energy(self, x) -> float:
-        _, _, D = self._edges(x)
-        return float(0.25 * np.einsum("me,mef,mf->", D, self.Q, D))
+        return float(_angular_energy(self._x(x), self.conn, self.Q, self.L2))
 
     def gradient(self, x) -> np.ndarray:
-        x, d, D = self._edges(x)
-        s = np.einsum("mef,mf->me", self.Q, D)  # 2 dW/dD_e
+        x = self._x(x)
         g = np.zeros_like(x)
-        for e, (a, b) in enumerate(EDGES):
-            f = s[:, e, None] * d[:, e]  # dW/dx_b = 2 dW/dD_e d_e
-            np.add.at(g, self.conn[:, b], f)
-            np.add.at(g, self.conn[:, a], -f)
-        return g.ravel()
+        _angular_gradient(x, self.conn, self.Q, self.L2, g)
+        return g
 
     def hessian_pattern(self):
         if self._pattern is None:
@@ -121,20 +118,76 @@ class TriangleAngular(Term):
 
     def hessian_values(self, x) -> np.ndarray:
         """Element blocks (m, 6, 6), row-major, in the order of :meth:`hessian_pattern`."""
-        _, d, D = self._edges(x)
-        m = len(self.conn)
-        s = np.einsum("mef,mf->me", self.Q, D)
-        J = np.zeros((m, 3, 3, 2))  # dD_e / dx_node
-        for e, (a, b) in enumerate(EDGES):
-            J[:, e, b] += 2 * d[:, e]
-            J[:, e, a] -= 2 * d[:, e]
-        J = J.reshape(m, 3, 6)
-        H = 0.5 * np.einsum("mei,mef,mfj->mij", J, self.Q, J)
-        for e, (a, b) in enumerate(EDGES):
-            blk = s[:, e, None, None] * np.eye(2)
-            for p, q, sign in ((a, a, 1), (b, b, 1), (a, b, -1), (b, a, -1)):
-                H[:, 2 * p:2 * p + 2, 2 * q:2 * q + 2] += sign * blk
-        return H.ravel()
+        out = np.empty(36 * len(self.conn))
+        _angular_hessian(self._x(x), self.conn, self.Q, self.L2, out)
+        return out
+
+
+# The element loops of TriangleAngular. Per triangle, edge e = (a, b) of EDGES has the vector
+# d_e = x_b - x_a and D_e = |d_e|^2 - L2_e; W = 1/4 D^T Q D, so dW/dx_b = -dW/dx_a = s_e d_e with
+# s = Q D, and the Hessian is 1/2 J^T Q J (J = dD/dx: +-2 d_e) plus s_e (+-I) on the node blocks of
+# edge e.
+
+@_jit
+def _edge_state(x, conn, Q, L2, m, d, D, s):
+    for e in range(3):
+        a, b = conn[m, EDGES[e, 0]], conn[m, EDGES[e, 1]]
+        d[e, 0] = x[2 * b] - x[2 * a]
+        d[e, 1] = x[2 * b + 1] - x[2 * a + 1]
+        D[e] = d[e, 0] * d[e, 0] + d[e, 1] * d[e, 1] - L2[m, e]
+    for e in range(3):
+        s[e] = Q[m, e, 0] * D[0] + Q[m, e, 1] * D[1] + Q[m, e, 2] * D[2]
+
+
+@_jit
+def _angular_energy(x, conn, Q, L2):
+    d, D, s = np.empty((3, 2)), np.empty(3), np.empty(3)
+    w = 0.0
+    for m in range(conn.shape[0]):
+        _edge_state(x, conn, Q, L2, m, d, D, s)
+        w += 0.25 * (D[0] * s[0] + D[1] * s[1] + D[2] * s[2])
+    return w
+
+
+@_jit
+def _angular_gradient(x, conn, Q, L2, g):
+    d, D, s = np.empty((3, 2)), np.empty(3), np.empty(3)
+    for m in range(conn.shape[0]):
+        _edge_state(x, conn, Q, L2, m, d, D, s)
+        for e in range(3):
+            a, b = conn[m, EDGES[e, 0]], conn[m, EDGES[e, 1]]
+            for k in range(2):
+                g[2 * b + k] += s[e] * d[e, k]
+                g[2 * a + k] -= s[e] * d[e, k]
+
+
+@_jit
+def _angular_hessian(x, conn, Q, L2, out):
+    d, D, s = np.empty((3, 2)), np.empty(3), np.empty(3)
+    J = np.zeros((3, 6))
+    for m in range(conn.shape[0]):
+        _edge_state(x, conn, Q, L2, m, d, D, s)
+        J[:] = 0.0
+        for e in range(3):
+            a, b = EDGES[e, 0], EDGES[e, 1]
+            for k in range(2):
+                J[e, 2 * b + k] = 2.0 * d[e, k]
+                J[e, 2 * a + k] = -2.0 * d[e, k]
+        base = 36 * m
+        for i in range(6):
+            for j in range(6):
+                h = 0.0
+                for e in range(3):
+                    for f in range(3):
+                        h += J[e, i] * Q[m, e, f] * J[f, j]
+                out[base + 6 * i + j] = 0.5 * h
+        for e in range(3):
+            a, b = EDGES[e, 0], EDGES[e, 1]
+            for k in range(2):
+                out[base + 6 * (2 * a + k) + 2 * a + k] += s[e]
+                out[base + 6 * (2 * b + k) + 2 * b + k] += s[e]
+                out[base + 6 * (2 * a + k) + 2 * b + k] -= s[e]
+                out[base + 6 * (2 * b + k) + 2 * a + k] -= s[e]
 
 
 def delingette_springs(mesh, materials, t: float) -> list[Term]:
