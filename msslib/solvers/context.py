@@ -18,12 +18,10 @@ largely, its values), rebuilt otherwise.  It goes with the problem.
 
 from __future__ import annotations
 
-import functools
 import threading
 
 import numpy as np
 
-from . import direct
 from .plans import PlanCache
 
 ATTRIBUTE = "_msslib_solver_context"  # where a problem keeps the context of its last static solve
@@ -54,13 +52,6 @@ def _keep_context(problem, ctx) -> bool:
     return True
 
 
-def _band_inputs(dim, coords):
-    """The inputs of :func:`msslib.solvers.direct._band_plan` besides the pattern, as the memo
-    of plans keys them: the free-node coordinates (the geometric candidate ordering), the
-    dimension and the cost limit (read when asked: it is a module setting)."""
-    return (() if coords is None else (coords,)), (dim, direct.BAND_COST_MAX)
-
-
 def _solver_context(problem, x, free, plans: PlanCache | None = None):
     """Context of :func:`msslib.solvers.linear._linear_solve`: spatial dimension and coordinates
     of the free nodes when the free dofs are whole nodes (all or none of a node's dofs free).
@@ -82,7 +73,6 @@ def _solver_context(problem, x, free, plans: PlanCache | None = None):
             ctx["dim"] = dim
             ctx["node_free"] = whole
             ctx["coords"] = np.asarray(x, dtype=float).reshape(-1, dim)[whole]
-    ctx.plans.band_inputs = functools.partial(_band_inputs, ctx.get("dim"), ctx.get("coords"))
     return ctx
 
 

@@ -10,6 +10,7 @@ import scipy.sparse.linalg as spla
 
 from msslib.blas_threads import BLOCKED_BANDWIDTH, one_blas_thread
 
+from . import plans as _plans
 from .plans import _plans_of, _same_readonly
 from .protocol import TINY
 
@@ -31,7 +32,10 @@ def _band_plan(A, context):
     longest side of the bounding box (node by node, dofs of a node together).  The one with the
     smallest bandwidth wins.  Returns None when the estimated cost ``n (b + 1)^2`` exceeds
     ``BAND_COST_MAX``.  The plan is kept in the :class:`~msslib.solvers.plans.PlanCache` of
-    ``context`` (a solver context), if it has one."""
+    ``context`` (a solver context), if it has one, and in the process-wide memo of plans
+    (:data:`msslib.solvers.memo.PLANS`), keyed by everything it is computed from: the pattern,
+    the free-node coordinates, the dimension and the cost limit.  Each context gets its own copy
+    of the plan dict (a factorisation adds its LU map to it)."""
     cache = _plans_of(context)
     for entry in (cache.bands if cache is not None else ()):
         if _same_readonly(entry["indices"], A.indices) and _same_readonly(entry["indptr"], A.indptr):
@@ -39,13 +43,24 @@ def _band_plan(A, context):
         if (entry["indices"].shape == A.indices.shape and entry["indptr"].shape == A.indptr.shape
                 and np.array_equal(entry["indices"], A.indices) and np.array_equal(entry["indptr"], A.indptr)):
             return entry["plan"]
+    dim = context.get("dim") if context else None
+    coords = context.get("coords") if context else None
+    arrays = (A.indptr, A.indices) + (() if coords is None else (np.ascontiguousarray(coords),))
+    plan = _plans.PLANS.get_or_compute("band", arrays, lambda: _new_band_plan(A, dim, coords),
+                                       (dim, BAND_COST_MAX))
+    plan = None if plan is None else dict(plan)
+    if cache is not None:
+        cache.add_band({"indices": A.indices, "indptr": A.indptr, "plan": plan})
+    return plan
+
+
+def _new_band_plan(A, dim, coords):
+    """The band plan of :func:`_band_plan`, computed."""
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
     n = A.shape[0]
     pattern = sp.csr_matrix((np.ones(A.nnz), A.indices, A.indptr), shape=A.shape)
     candidates = [np.asarray(reverse_cuthill_mckee(pattern, symmetric_mode=True), dtype=np.int64)]
-    dim = context.get("dim") if context else None
-    coords = context.get("coords") if context else None
     if dim and coords is not None and n == dim * len(coords) and len(coords):
         ext = np.ptp(coords, axis=0)
         axes = np.argsort(ext)  # shortest first: lexsort's last key is the primary one
@@ -54,23 +69,20 @@ def _band_plan(A, context):
     widths = [_bandwidth(A, p) for p in candidates]
     k = int(np.argmin(widths))
     perm, bw = candidates[k], widths[k]
-    plan = None
-    if n * (bw + 1.0) ** 2 <= BAND_COST_MAX:
-        inv = np.empty_like(perm)
-        inv[perm] = np.arange(n)
-        rows = inv[np.repeat(np.arange(n), np.diff(A.indptr))]
-        cols = inv[A.indices]
-        lower = np.flatnonzero(rows >= cols)
-        # LAPACK lower band storage: ab[i - j, j] = A[i, j] (i, j in the permuted numbering);
-        # general band storage (for the LU fallback): ab[bw + i - j, j] = A[i, j]; both arrays
-        # in Fortran order (LAPACK's), as flat positions (a C-ordered array would be copied on
-        # every call)
-        plan = {"perm": perm, "bw": bw, "src": lower,
-                "dst": (rows[lower] - cols[lower]) + cols[lower] * (bw + 1),
-                "dst_full": (bw + rows - cols) + cols * (2 * bw + 1)}
-    if cache is not None:
-        cache.add_band({"indices": A.indices, "indptr": A.indptr, "plan": plan})
-    return plan
+    if n * (bw + 1.0) ** 2 > BAND_COST_MAX:
+        return None
+    inv = np.empty_like(perm)
+    inv[perm] = np.arange(n)
+    rows = inv[np.repeat(np.arange(n), np.diff(A.indptr))]
+    cols = inv[A.indices]
+    lower = np.flatnonzero(rows >= cols)
+    # LAPACK lower band storage: ab[i - j, j] = A[i, j] (i, j in the permuted numbering);
+    # general band storage (for the LU fallback): ab[bw + i - j, j] = A[i, j]; both arrays
+    # in Fortran order (LAPACK's), as flat positions (a C-ordered array would be copied on
+    # every call)
+    return {"perm": perm, "bw": bw, "src": lower,
+            "dst": (rows[lower] - cols[lower]) + cols[lower] * (bw + 1),
+            "dst_full": (bw + rows - cols) + cols * (2 * bw + 1)}
 
 
 def _banded_cholesky_solve(A, b, context):

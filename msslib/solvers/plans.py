@@ -12,7 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .memo import MISSING, PLANS
+from .memo import PLANS
 
 
 class PlanCache:
@@ -23,17 +23,14 @@ class PlanCache:
     free mask; it holds references to the pattern arrays, so their ids cannot be recycled.  A
     solver context owns one; the contexts of one problem share its lists (``share``: plans
     depend on the pattern only).  A pattern new to the cache is looked up in the process-wide
-    memo (:data:`msslib.solvers.memo.PLANS`) first, and new plans are kept there too; band
-    orderings only when ``band_inputs`` is set: a function giving the inputs of the ordering
-    besides the pattern, as ``(arrays, settings)`` (the owning context's geometry and the cost
-    limit; set by :func:`msslib.solvers.context._solver_context`)."""
+    memo (:data:`msslib.solvers.memo.PLANS`) first, and new plans are kept there too (band
+    orderings by :func:`msslib.solvers.direct._band_plan` itself, keyed by all its inputs)."""
 
     SIZE = 4
 
     def __init__(self, share: PlanCache | None = None):
         self.entries: list = share.entries if share is not None else []  # submatrix and node-block plans
         self.bands: list = share.bands if share is not None else []  # band orderings
-        self.band_inputs = None
 
     @staticmethod
     def _push(lst, entry, size):
@@ -43,28 +40,8 @@ class PlanCache:
     def add(self, entry):
         self._push(self.entries, entry, self.SIZE)
 
-    def _band_key(self, indptr, indices):
-        """The memo key (arrays, settings) of the band ordering of a pattern, or None when the
-        other inputs of the ordering are unknown."""
-        if self.band_inputs is None:
-            return None
-        arrays, settings = self.band_inputs()
-        return (indptr, indices, *arrays), settings
-
     def add_band(self, entry):
         self._push(self.bands, entry, self.SIZE)
-        key = self._band_key(entry["indptr"], entry["indices"])
-        if key is not None:  # a copy: the factorisation adds its LU map to the context's own plan
-            plan = entry["plan"]
-            PLANS.put("band", key[0], None if plan is None else dict(plan), key[1])
-
-    def seed_band(self, indptr, indices):
-        """Take the band ordering of the pattern ``(indptr, indices)`` from the memo, if it is there."""
-        key = self._band_key(indptr, indices)
-        plan = MISSING if key is None else PLANS.get("band", key[0], key[1])
-        if plan is not MISSING:
-            self._push(self.bands, {"indices": indices, "indptr": indptr,
-                                    "plan": None if plan is None else dict(plan)}, self.SIZE)
 
 
 def _plans_of(plans):
@@ -337,8 +314,6 @@ def _submatrix_plan(K, free, plans=None):
         entry.update(PLANS.get_or_compute("free", (K.indptr, K.indices, free), lambda: _free_plan(K, free),
                                           (K.shape,)))
         cache.add(entry)
-        # the free block's band ordering, if a model of this pattern and geometry had it made
-        cache.seed_band(entry["sub_indptr"], entry["sub_indices"])
     return entry
 
 
