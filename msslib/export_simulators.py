@@ -88,7 +88,10 @@ def _springs_only_model(exp: MssExport):
     from msslib.model import Model
     from msslib.terms import Springs
 
-    return Model(exp.setup.mesh, [Springs(exp.pairs, exp.stiffness, exp.rest_length, exp.dim)],
+    # a non-positive constant here comes from a model that accepted it after checking its
+    # lattice's stability (least-squares springs, msslib.models.lsq): carried as it is
+    signed = bool(np.any(np.asarray(exp.stiffness) <= 0))
+    return Model(exp.setup.mesh, [Springs(exp.pairs, exp.stiffness, exp.rest_length, exp.dim, signed=signed)],
                  fixed=exp.fixed, masses=exp.masses)
 
 

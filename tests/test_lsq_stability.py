@@ -143,3 +143,48 @@ def test_both_factorisations_tell_positive_definite_matrices_from_the_others(ban
         info = _not_positive_definite(A, "test", band_limit=band_limit)
         assert (info == 0) == (smallest > 0), (trial, smallest, info)
         assert 0 <= info <= n
+
+
+def test_negative_springs_are_exported_as_they_are_and_mujoco_rests_at_msslibs_equilibrium(tmp_path):
+    """Lloyd's gmsh cylinder with least-squares springs (some summed constants negative, lattice
+    stable): the JSON and the MuJoCo model carry the negative constants; MuJoCo's forces vanish at
+    msslib's static equilibrium (to 1e-9 of the applied forces)."""
+    import json
+
+    import yaml
+
+    mujoco = pytest.importorskip("mujoco")
+    from msslib import cli, export
+    from msslib.solvers import static_solve
+
+    scene = {"name": "lsq_cylinder",
+             "geometry": {"generator": "cylinder_mesh", "args": {"radius": 0.01, "height": 0.02, "h": 0.008, "seed": 0}},
+             "materials": [{"E": 14630.0, "nu": 0.25, "density": 1000.0}],
+             "model": "lsq_tetrahedron",
+             "boundary": [{"select": {"plane": ["z", 0.0]}, "fix": "all"}],
+             "loads": [{"type": "traction", "select": {"plane": ["z", 0.02]}, "traction": [0.0, 0.0, 200.0]}]}
+    path = tmp_path / "lsq.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FormulaValidityWarning)
+        assert cli.main(["export", str(path), "--out", str(tmp_path / "m"), "--format", "json,mjcf"]) == 0
+        exp = export.build(path)
+    (springs,) = [t for t in exp.model.terms if isinstance(t, Springs)]
+    assert np.count_nonzero(springs.k < 0) > 0
+    doc = json.loads((tmp_path / "m.json").read_text())
+    (k_json,) = [c["values"] for c in doc["tables"]["springs"]["columns"] if c["name"] == "stiffness"]
+    np.testing.assert_array_equal(k_json, springs.k)
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "m_mujoco.xml"))
+    np.testing.assert_array_equal(m.tendon_stiffness, springs.k)
+    res = static_solve(exp.model, exp.model.x0, load_steps=2, tol=1e-12)
+    x_star = res.x.reshape(-1, 3)
+    start = exp.points + exp.prescribed
+    d = mujoco.MjData(m)
+    for j in range(m.njnt):
+        node, axis = m.joint(j).name[4:].split("_")
+        d.qpos[m.jnt_qposadr[j]] = x_star[int(node), "xyz".index(axis)] - start[int(node), "xyz".index(axis)]
+    mujoco.mj_forward(m, d)
+    residual = d.qfrc_passive + d.qfrc_actuator - d.qfrc_bias
+    scale = np.abs(exp.model.external_force(1.0)).sum()
+    assert np.abs(x_star - exp.points).max() > 1e-6 and scale > 0
+    assert np.abs(residual).max() <= 1e-9 * scale, (np.abs(residual).max(), scale)
