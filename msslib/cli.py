@@ -535,10 +535,16 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     previous = warnings.showwarning
 
+    shown = set()
+
     def show(message, category, filename, lineno, file=None, line=None):
-        # one line per warning: msslib's own as they are, others (numpy, scipy, ...) with their origin
+        # one line per distinct warning (a model built again, e.g. by plan's repeats, says the same
+        # once): msslib's own as they are, others (numpy, scipy, ...) with their origin
         origin = "" if issubclass(category, MsslibWarning) else f" ({category.__name__} in {Path(filename).name})"
-        print(f"msslib: warning: {_one_line(message)}{origin}", file=sys.stderr)
+        text = f"msslib: warning: {_one_line(message)}{origin}"
+        if text not in shown:
+            shown.add(text)
+            print(text, file=sys.stderr)
 
     warnings.showwarning = show
     try:
