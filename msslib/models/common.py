@@ -86,12 +86,12 @@ def _combine(pairs: _mesh.NodePairs, k_inc, rest_inc):
     return k, rest
 
 
-def _springs_from(mesh, pairs, k, rest):
+def _springs_from(mesh, pairs, k, rest, signed=False):
     length = np.linalg.norm(mesh.points[pairs.pairs[:, 1]] - mesh.points[pairs.pairs[:, 0]], axis=1)
-    return Springs(pairs.pairs, k, length if rest is None else rest, mesh.dim)
+    return Springs(pairs.pairs, k, length if rest is None else rest, mesh.dim, signed=signed)
 
 
-def assemble_springs(mesh, pair_kind, k_per_cell_fn) -> Springs:
+def assemble_springs(mesh, pair_kind, k_per_cell_fn, signed: bool = False) -> Springs:
     """Springs on the node pairs of ``mesh`` with constants summed over the cells sharing a pair.
 
     ``pair_kind``: ``"edges"``, ``"face_diagonals"``, ``"inner_diagonals"`` or a
@@ -100,7 +100,7 @@ def assemble_springs(mesh, pair_kind, k_per_cell_fn) -> Springs:
     contributed by that cell (m,), or a tuple ``(k, rest_length)``.  The spring of a pair gets
     ``k = sum`` of its contributions and the rest length: the distance of its nodes, or with
     explicit rest lengths their k-weighted mean.  Raises ValueError (from :class:`Springs`) if a
-    summed constant is not positive.
+    summed constant is not positive, unless ``signed`` (the caller checks the lattice itself).
     """
     pairs = _pairs_of(mesh, pair_kind)
     node_pairs = np.repeat(pairs.pairs, pairs.counts, axis=0)
@@ -110,7 +110,7 @@ def assemble_springs(mesh, pair_kind, k_per_cell_fn) -> Springs:
     else:
         k_inc, rest_inc = np.broadcast_to(np.asarray(res, dtype=float), (len(node_pairs),)), None
     k, rest = _combine(pairs, k_inc, rest_inc)
-    return _springs_from(mesh, pairs, k, rest)
+    return _springs_from(mesh, pairs, k, rest, signed)
 
 
 def _merge_springs(springs: list[Springs]) -> Springs:

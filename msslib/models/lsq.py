@@ -38,10 +38,9 @@ from msslib.models.checks import (
     positive,
     same_shape,
 )
-from msslib.models.common import _combine, _pairs_of, _require, material_arrays
+from msslib.models.common import _require, assemble_springs, material_arrays
 from msslib.models.delingette import local_coordinates
 from msslib.models.spec import Exactness, ModelSpec, split_terms
-from msslib.terms import Springs
 
 __all__ = ["TriangleLsqSprings", "TetrahedronLsqSprings", "lsq_triangle", "lsq_tetrahedron", "check_stable_at_rest"]
 
@@ -166,12 +165,15 @@ BAND_LIMIT = 2e8  # n (bandwidth + 1) above which the sparse LDL^T is used inste
 def _not_positive_definite(A, label: str, band_limit: float | None = None) -> int:
     """0 if the symmetric sparse matrix ``A`` is positive definite, else the 1-based index of the
     first pivot that is not positive.  A banded Cholesky (LAPACK ``pbtrf``) in reverse Cuthill-McKee
-    order when ``n (bandwidth + 1) <= band_limit`` (default :data:`BAND_LIMIT`), else SuperLU's LU in a symmetric minimum-degree
+    order when ``n (bandwidth + 1) <= band_limit`` (default :data:`BAND_LIMIT`; the solvers' band
+    plan is not used: it gives up at a factorisation cost meant for repeated solves, while one
+    factorisation here is worth a wider band), else SuperLU's LU in a symmetric minimum-degree
     order without pivoting (``diag_pivot_thresh = 0``): then ``U``'s diagonal is ``D`` of ``A =
     L D L^T`` and, by Sylvester's law of inertia, ``A`` is positive definite if and only if it is
     positive.  Raises ValueError if SuperLU had to pivot (a zero diagonal): no verdict then."""
     import scipy.linalg as la
     import scipy.sparse.linalg as spla
+
     from scipy.sparse.csgraph import reverse_cuthill_mckee
 
     band_limit = BAND_LIMIT if band_limit is None else band_limit
@@ -232,14 +234,8 @@ def _lsq_springs(mesh, k, edges, label):
     """Springs on the edges of ``mesh`` with the per-element constants ``k`` (m, edges) summed per
     edge, rest lengths the mesh distances; non-positive sums only if the lattice is stable."""
     _warn_negative(k, label)
-    pairs = _pairs_of(mesh, "edges")
-    cells = pairs.cells
-    node_pairs = np.repeat(pairs.pairs, pairs.counts, axis=0)
-    k_sum, _ = _combine(pairs, k[cells, _local_index(mesh, cells, node_pairs, edges)], None)
-    length = np.linalg.norm(mesh.points[pairs.pairs[:, 1]] - mesh.points[pairs.pairs[:, 0]], axis=1)
-    signed = bool(np.any(k_sum <= 0))
-    springs = Springs(pairs.pairs, k_sum, length, mesh.dim, signed=signed)
-    if signed:
+    springs = assemble_springs(mesh, "edges", lambda c, pairs: k[c, _local_index(mesh, c, pairs, edges)], signed=True)
+    if np.any(springs.k <= 0):
         check_stable_at_rest(springs, mesh.points, label)
     return [springs]
 
