@@ -301,7 +301,7 @@ def test_derivation_module_runs_as_script_and_is_a_notebook():
     r = subprocess.run([sys.executable, "-m", "derivations.elements.triangle"], capture_output=True, text=True,
                        timeout=120, cwd=codegen.ROOT)
     assert r.returncode == 0, r.stderr
-    assert "agrees" in r.stdout and "DIFFERS" not in r.stdout
+    assert "(Lloyd eq. 8): holds" in r.stdout and "FAILS" not in r.stdout
     nb = jupytext.read(codegen.ROOT / "derivations" / "elements" / "triangle.py")
     assert len(nb.cells) >= 5 and any(c.cell_type == "markdown" for c in nb.cells)
 

@@ -78,8 +78,9 @@ def test_triangle_notebook_shows_the_matrices(triangle_markdown):
     assert "21 distinct equations" in md and "```python" in md
     (s,) = triangle.exact().solutions
     assert f"k_{{01}} &= {sp.latex(s[triangle.k[0]])}" in md
-    assert md.count("Check (holds)") == 3 and "FAILS" not in md
-    assert "published eq. 8: k = sqrt(3)/4 E t -> agrees" in md  # printed output of the last cell
+    assert md.count("Check (holds)") == 4 and "FAILS" not in md
+    assert r"\text{(Lloyd eq. 8)}" in md  # the published constant, checked against the derived one
+    assert "Equilateral triangle, plane stress" in md  # printed output of the last cell (the summary)
 
 
 def test_triangle_notebook_html_has_mathml(triangle_html):
@@ -129,4 +130,4 @@ def test_triangle_imports_silently_and_runs_as_script():
                        timeout=120, cwd=ROOT)
     assert r.returncode == 0, r.stderr
     assert "K_FEM =" in r.stdout and "check: K_FEM - K_MSS = 0 at the solution: holds" in r.stdout
-    assert "FAILS" not in r.stdout and "agrees" in r.stdout
+    assert "FAILS" not in r.stdout and "(Lloyd eq. 8): holds" in r.stdout

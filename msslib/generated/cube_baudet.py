@@ -1,5 +1,5 @@
 # Generated from derivations/elements/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 4b80ffed81f24c0124c8e9876f65625b1c65f30e591535b2b2d042eafe2de62a
+# source-sha256: 3a266b7c89a007afddc26a9036503a7b5c4559ab9ac2bc133156430be6d2ab1e
 # body-sha256: ead1efdd2788a93d1bcf1adc1fdb9209f754b2834f6888e42bd556b419504f40
 """Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.).
 

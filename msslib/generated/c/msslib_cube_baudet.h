@@ -1,5 +1,5 @@
 // Generated from derivations/elements/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 4b80ffed81f24c0124c8e9876f65625b1c65f30e591535b2b2d042eafe2de62a
+// source-sha256: 3a266b7c89a007afddc26a9036503a7b5c4559ab9ac2bc133156430be6d2ab1e
 // body-sha256: ed3871ac34bc05ede2d93d77dc6bfa5d5cf9d38e7fe0c566cea46cd9da016706
 /* Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/cube_baudet.py (derivations/elements/cube_baudet.py). */
