@@ -34,44 +34,12 @@ from msslib.terms import BaudetCorrection, HexVolume, Springs, TetVolume
 
 # ---- scenes -----------------------------------------------------------------------------------
 
-GOLEC = {  # Golec's full model: springs and volume terms, gravity
-    "name": "golec_beam",
-    "geometry": {"generator": "hex_grid", "args": {"lx": 0.2, "ly": 0.05, "lz": 0.05, "nx": 4, "ny": 1, "nz": 1}},
-    "materials": [{"E": 1.0e5, "nu": 0.3, "density": 1000.0}],
-    "model": {"type": "golec_cube"},
-    "boundary": [{"select": {"plane": ["x", 0.0]}, "fix": "all"}],
-    "loads": [{"type": "gravity", "g": [0.0, 0.0, -9.81]}],
-}
+# The scenes are data (tests/data/export_scenes.yaml): Golec's full model with gravity, his springs
+# alone, Lloyd's prestrained 2D square with partial fixing, a prescribed displacement, a traction and
+# gravity, Baudet's springs and correction under tension, Lloyd's tetrahedra with the volume term.
+_SCENES = yaml.safe_load((Path(__file__).parent / "data" / "export_scenes.yaml").read_text())
+GOLEC, SQUARE, BAUDET, LLOYD_TET = (_SCENES[key] for key in ("golec", "square", "baudet", "lloyd_tet"))
 GOLEC_SPRINGS = {**GOLEC, "name": "golec_springs", "model": {"type": "golec_cube", "terms": ["springs"]}}
-SQUARE = {  # 2D, prestrained springs (rest length != distance), partial fixing, a prescribed displacement,
-    # a traction and gravity
-    "name": "square_membrane",
-    "geometry": {"generator": "quad_grid", "args": {"lx": 0.1, "ly": 0.1, "nx": 3, "ny": 3}},
-    "materials": [{"E": 1.0e5, "nu": 0.3333333333333333, "density": 1000.0}],
-    "thickness": 0.01,
-    "model": "lloyd_square",
-    "boundary": [{"select": {"plane": ["y", 0.0]}, "fix": ["y"]},
-                 {"select": {"plane": ["x", 0.0]}, "fix": ["x"]},
-                 {"select": {"plane": ["y", 0.1]}, "fix": ["y"], "displacement": [None, 0.002]}],
-    "loads": [{"type": "traction", "select": {"plane": ["x", 0.1]}, "traction": [2.0e3, 0.0]},
-              {"type": "gravity", "g": [0.0, -9.81]}],
-}
-BAUDET = {  # Baudet's springs and correction under tension
-    "name": "baudet_bar",
-    "geometry": {"generator": "hex_grid", "args": {"lx": 0.1, "ly": 0.05, "lz": 0.05, "nx": 2, "ny": 1, "nz": 1}},
-    "materials": [{"E": 1.0e5, "nu": 0.3}],
-    "model": "baudet_cube",
-    "boundary": [{"select": {"plane": ["x", 0.0]}, "fix": "all"}],
-    "loads": [{"type": "traction", "select": {"plane": ["x", 0.1]}, "traction": [1.0e3, 0.0, 0.0]}],
-}
-LLOYD_TET = {  # Lloyd's tetrahedra with the volume term
-    "name": "tet_block",
-    "geometry": {"generator": "tet_grid", "args": {"lx": 0.1, "ly": 0.1, "lz": 0.1, "nx": 1, "ny": 1, "nz": 1}},
-    "materials": [{"E": 1.0e5, "nu": 0.3}],
-    "model": "lloyd_tetrahedron_volume",
-    "boundary": [{"select": {"plane": ["z", 0.0]}, "fix": "all"}],
-    "loads": [{"type": "nodal_force", "select": {"plane": ["z", 0.1]}, "total": [0.0, 0.0, -1.0]}],
-}
 
 
 def _scene_file(tmp_path: Path, scene: dict, name: str | None = None) -> Path:
