@@ -180,9 +180,13 @@ def _fmt_point(p) -> str:
     return "(" + ", ".join(f"{v:.4g}" for v in p) + ")"
 
 
+@dataclass(frozen=True)
 class _Verdict:
     """What the verdicts on one state and on a run share: the counts ``n_inverted`` and
-    ``n_collapsed`` (numbers for one state, arrays per state for a run) and what makes them ok."""
+    ``n_collapsed`` (numbers for one state, int64 arrays per state for a run) and what makes them ok."""
+
+    n_inverted: int | np.ndarray
+    n_collapsed: int | np.ndarray
 
     @property
     def _unphysical(self):
@@ -210,8 +214,6 @@ class StateQuality(_Verdict):
     threshold: float
     ratio: np.ndarray
     state: np.ndarray
-    n_inverted: int
-    n_collapsed: int
     n_undefined: int
     worst_cell: int
     worst_value: float
@@ -275,8 +277,6 @@ class HistoryQuality(_Verdict):
     """
 
     times: np.ndarray | None
-    n_inverted: np.ndarray
-    n_collapsed: np.ndarray
     min_ratio: np.ndarray
 
     @property
