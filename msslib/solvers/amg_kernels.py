@@ -74,6 +74,17 @@ def _block_rows_times(dinv, v):
 
 
 @njit(inline="always", nogil=True, fastmath={"contract"})
+def _acc_product(out, a, b, a_transposed):
+    """``out += a b`` (or ``a^T b``) for small dense blocks; the generic (not 3 x 3) path of the
+    block products below, inlined."""
+    for r in range(out.shape[0]):
+        for s in range(b.shape[0]):
+            av = a[s, r] if a_transposed else a[r, s]
+            for c in range(out.shape[1]):
+                out[r, c] += av * b[s, c]
+
+
+@njit(inline="always", nogil=True, fastmath={"contract"})
 def _row_times(a_ptr, a_ind, a_data, i, t_ptr, t_ind, t_data, mark, ks, y, values):
     """Block row ``i`` of ``A T`` (``A`` BSR with square blocks ``d``, ``T`` BSR with blocks
     ``(d, m)``) into the dense accumulator ``y[K]`` over the block columns ``K`` it reaches,
@@ -108,11 +119,7 @@ def _row_times(a_ptr, a_ind, a_data, i, t_ptr, t_ind, t_data, mark, ks, y, value
                     Y[1, c] += a10 * t0 + a11 * t1 + a12 * t2
                     Y[2, c] += a20 * t0 + a21 * t1 + a22 * t2
             else:
-                for r in range(d):
-                    for s in range(d):
-                        av = a_data[_U(q), r, s]
-                        for c in range(m):
-                            y[_U(K), r, c] += av * t_data[_U(pt), s, c]
+                _acc_product(y[_U(K)], a_data[_U(q)], t_data[_U(pt)], False)
     return nk
 
 
@@ -293,6 +300,13 @@ def _block3_times(B, x0, x1, x2):
             B[2, 0] * x0 + B[2, 1] * x1 + B[2, 2] * x2)
 
 
+@njit(inline="always", nogil=True, fastmath={"contract"})
+def _acc_block3(B, x, j, a0, a1, a2, sign):
+    """``(a0, a1, a2) + sign B x[j:j + 3]`` for a 3 x 3 block ``B`` (inlined; ``sign`` is +-1)."""
+    b0, b1, b2 = _block3_times(B, x[j], x[j + _U(1)], x[j + _U(2)])
+    return a0 + sign * b0, a1 + sign * b1, a2 + sign * b2
+
+
 @njit(cache=True, nogil=True, fastmath={"contract"})
 def _bsr3_matvec(indptr, indices, data, x, y):
     """:func:`_bsr_matvec` unrolled for 3 x 3 blocks (about a third faster: it then runs near
@@ -300,11 +314,7 @@ def _bsr3_matvec(indptr, indices, data, x, y):
     for i in range(indptr.shape[0] - 1):
         a0 = a1 = a2 = 0.0
         for q in range(indptr[_U(i)], indptr[_U(i + 1)]):
-            j = _U(3 * indices[_U(q)])
-            b0, b1, b2 = _block3_times(data[_U(q)], x[j], x[j + _U(1)], x[j + _U(2)])
-            a0 += b0
-            a1 += b1
-            a2 += b2
+            a0, a1, a2 = _acc_block3(data[_U(q)], x, _U(3 * indices[_U(q)]), a0, a1, a2, 1.0)
         y[_U(3 * i)], y[_U(3 * i + 1)], y[_U(3 * i + 2)] = a0, a1, a2
 
 
@@ -317,11 +327,7 @@ def _gs3_forward_from_zero(indptr, indices, data, dinv, b, x, s):
             jb = indices[_U(q)]
             if jb >= i:
                 break
-            j = _U(3 * jb)
-            b0, b1, b2 = _block3_times(data[_U(q)], x[j], x[j + _U(1)], x[j + _U(2)])
-            r0 -= b0
-            r1 -= b1
-            r2 -= b2
+            r0, r1, r2 = _acc_block3(data[_U(q)], x, _U(3 * jb), r0, r1, r2, -1.0)
         s[_U(3 * i)], s[_U(3 * i + 1)], s[_U(3 * i + 2)] = r0, r1, r2
         x[_U(3 * i)], x[_U(3 * i + 1)], x[_U(3 * i + 2)] = _block3_times(dinv[_U(i)], r0, r1, r2)
 
@@ -336,11 +342,7 @@ def _residual3_restrict(indptr, indices, data, x, s, p_ptr, p_ind, p_data, bc):
             jb = indices[_U(q)]
             if jb < i:
                 break
-            j = _U(3 * jb)
-            b0, b1, b2 = _block3_times(data[_U(q)], x[j], x[j + _U(1)], x[j + _U(2)])
-            r0 -= b0
-            r1 -= b1
-            r2 -= b2
+            r0, r1, r2 = _acc_block3(data[_U(q)], x, _U(3 * jb), r0, r1, r2, -1.0)
         for pp in range(p_ptr[_U(i)], p_ptr[_U(i + 1)]):
             J = _U(p_ind[_U(pp)] * m)
             Q = p_data[_U(pp)]
@@ -359,11 +361,7 @@ def _gs3_backward(indptr, indices, data, dinv, x, b):
         for q in range(indptr[_U(i)], indptr[_U(i + 1)]):
             jb = indices[_U(q)]
             if jb != i:
-                j = _U(3 * jb)
-                b0, b1, b2 = _block3_times(data[_U(q)], x[j], x[j + _U(1)], x[j + _U(2)])
-                r0 -= b0
-                r1 -= b1
-                r2 -= b2
+                r0, r1, r2 = _acc_block3(data[_U(q)], x, _U(3 * jb), r0, r1, r2, -1.0)
         x[_U(3 * i)], x[_U(3 * i + 1)], x[_U(3 * i + 2)] = _block3_times(dinv[_U(i)], r0, r1, r2)
 
 
@@ -402,11 +400,7 @@ def _galerkin_numeric(a_ptr, a_ind, a_data, p_ptr, p_ind, p_data, c_ptr, c_ind, 
                         for c in range(m):
                             Ct[r, c] += p0 * Y[0, c] + p1 * Y[1, c] + p2 * Y[2, c]
                 else:
-                    for r in range(m):
-                        for s in range(d):
-                            pv = p_data[_U(pp), s, r]
-                            for c in range(m):
-                                c_data[_U(t), r, c] += pv * y[_U(K), s, c]
+                    _acc_product(c_data[_U(t)], p_data[_U(pp)], y[_U(K)], True)
 
 
 @njit(cache=True, nogil=True)
