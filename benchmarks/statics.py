@@ -64,7 +64,7 @@ def run_scaling(res, quick: bool):
             colds.append(time.perf_counter() - t0)
         runs = []
 
-        def solve():
+        def solve(model=model, runs=runs):
             runs.append(S.static_solve(model, model.x0))
 
         t = median_time(solve, repeat=max(rep, 3), warmup=0)  # warm: at least 3 (shared hosts)
@@ -77,7 +77,7 @@ def run_scaling(res, quick: bool):
             cg_sizes.append(len(dofs) - 1)
         ratio = None
         if n in lu_sizes:
-            t_lu = median_time(lambda: S.static_solve(model, model.x0, linear_solver=superlu_default),
+            t_lu = median_time(lambda model=model: S.static_solve(model, model.x0, linear_solver=superlu_default),
                                repeat=3 if n <= 10 else 1, warmup=0)
             lu_dofs.append(nd)
             lu_times.append(t_lu)
@@ -88,7 +88,7 @@ def run_scaling(res, quick: bool):
                 f"cold (first solve of a new model) {cold[-1]:.3g} s")
         if n in lu_sizes:
             res.add(f"static_solve_superlu_{nd}_dofs", lu_times[-1], "s", 1.0, "itself")
-        del model, runs
+        del model, runs, solve  # free this size's model before the next
     big = "" if quick else f" ({dofs[-1]} dofs)"
     for label, times in (("warm", warm), ("cold", cold)):
         slope = float(np.polyfit(np.log(dofs), np.log(times), 1)[0])
@@ -139,7 +139,7 @@ def run_cantilever(res, quick: bool):
     for kind in ("baudet", "golec"):
         model = cantilever(kind)
         t = median_time(lambda: S.static_solve(model, model.x0), repeat=5 if quick else 9, warmup=2)
-        t_lu = median_time(lambda: S.static_solve(model, model.x0, linear_solver=superlu_default), repeat=3)
+        t_lu = median_time(lambda model=model: S.static_solve(model, model.x0, linear_solver=superlu_default), repeat=3)
         r = S.static_solve(model, model.x0)
         tip = float(-(r.x - model.x0).reshape(-1, 3)[:, 2].min())
         res.add(f"cantilever_static_{kind}", t * 1e3, "ms", t_lu / t, "same with scipy SuperLU default",
