@@ -139,7 +139,7 @@ def run_cantilever(res, quick: bool):
     for kind in ("baudet", "golec"):
         model = cantilever(kind)
         t = median_time(lambda: S.static_solve(model, model.x0), repeat=5 if quick else 9, warmup=2)
-        t_lu = median_time(lambda model=model: S.static_solve(model, model.x0, linear_solver=superlu_default), repeat=3)
+        t_lu = median_time(lambda: S.static_solve(model, model.x0, linear_solver=superlu_default), repeat=3)
         r = S.static_solve(model, model.x0)
         tip = float(-(r.x - model.x0).reshape(-1, 3)[:, 2].min())
         res.add(f"cantilever_static_{kind}", t * 1e3, "ms", t_lu / t, "same with scipy SuperLU default",
