@@ -5,7 +5,8 @@ An experiment file (YAML, one per experiment of the papers, under ``experiments/
 .. code-block:: yaml
 
     name: lloyd_membrane_equilateral       # optional; default: the file name
-    paper: lloyd                           # lloyd | baudet | golec
+    paper: lloyd                           # lloyd | baudet | golec | performance; optional: a
+                                           # user's own experiment belongs to no paper
     title: Equilateral membrane, stretch / compression / shear
     section: "Sec. 5.1, Fig. 9"
     scene: {...}                           # a scene (see msslib.scene), the common part
@@ -75,11 +76,12 @@ def load_experiment(path) -> Experiment:
     unknown = sorted(set(raw) - KEYS)
     if unknown:
         _fail(f"experiment.{unknown[0]}", f"unknown key; expected one of {', '.join(sorted(KEYS))}")
-    for key in ("paper", "scene", "models"):
+    for key in ("scene", "models"):
         if key not in raw:
             _fail(f"experiment.{key}", "missing")
-    if raw["paper"] not in PAPERS:
-        _fail("experiment.paper", f"{raw['paper']!r} is not one of {PAPERS}")
+    paper = raw.get("paper") or ""
+    if paper and paper not in PAPERS:
+        _fail("experiment.paper", f"{paper!r} is not one of {PAPERS} (leave it out for an experiment of your own)")
     cases = raw.get("cases") or {"default": {}}
     models = raw["models"]
     for key, val in (("cases", cases), ("models", models), ("scene", raw["scene"])):
@@ -101,7 +103,7 @@ def load_experiment(path) -> Experiment:
             for metric, v in values.items():
                 if not (isinstance(v, list) and len(v) == 2 and v[1] in UNITS):
                     _fail(f"experiment.published.{case}.{model}.{metric}", f"expected [value, unit] with unit in {sorted(UNITS)}, got {v!r}")
-    return Experiment(name=raw.get("name", path.stem), paper=raw["paper"], title=raw.get("title", path.stem),
+    return Experiment(name=raw.get("name", path.stem), paper=paper, title=raw.get("title", path.stem),
                       section=str(raw.get("section", "")), scene=raw["scene"], cases=cases, models=models,
                       reference=ref, quick=raw.get("quick") or {}, published=published, base_dir=path.parent,
                       description=raw.get("description", ""), path=path)
@@ -145,41 +147,6 @@ def run(exp: Experiment, case: str, model: str, quick: bool = False, progress=Fa
 
 # ---- comparison ------------------------------------------------------------------------------
 
-def interpolate(ref_mesh, ref_u, points):
-    """Reference displacement at ``points`` with the reference mesh's shape functions.
-
-    Points outside the reference mesh (a curved or zig-zag boundary meshed at another resolution)
-    take the displacement of the nearest reference node; the rest are interpolated exactly.
-    """
-    from scipy.spatial import cKDTree
-    from skfem import Basis
-
-    from msslib.fem import to_skfem
-
-    skmesh, elem = to_skfem(ref_mesh)
-    basis = Basis(skmesh, elem)
-
-    def probe(pts):
-        P = basis.probes(pts.T)
-        return np.column_stack([P @ ref_u[:, d] for d in range(ref_u.shape[1])])
-
-    try:
-        return probe(points)
-    except ValueError:  # some points lie outside: probe one by one
-        pass
-    out = np.empty((len(points), ref_u.shape[1]))
-    outside = []
-    for i, p in enumerate(points):
-        try:
-            out[i] = probe(p[None, :])[0]
-        except ValueError:
-            outside.append(i)
-    if outside:
-        _, nearest = cKDTree(ref_mesh.points).query(points[outside])
-        out[outside] = ref_u[nearest]
-    return out
-
-
 def _published(exp, case, model):
     out = {}
     for metric, (value, unit) in (exp.published.get(case, {}).get(model, {}) or {}).items():
@@ -192,6 +159,7 @@ def compare(exp: Experiment, results: dict):
     (case, variant) of error statistics against the reference and the published values."""
     import xarray as xr
 
+    from msslib.compare import interpolate
     from msslib.io import mesh_from_result
     from msslib.metrics import displacement_error
 
@@ -250,7 +218,8 @@ def markdown_table(ds) -> str:
     """The comparison as a Markdown table: ours (absolute and relative to the largest reference
     displacement), the published values as printed, and the difference ours - published for the
     mean and maximum where the paper gives them (in mm, or in % for relative values)."""
-    lines = [f"**{ds.attrs['title']}** ({ds.attrs['paper']}, {ds.attrs['section']}); reference: {ds.attrs['reference'] or '-'}", "",
+    source = ", ".join(str(v) for v in (ds.attrs['paper'], ds.attrs['section']) if str(v))
+    lines = [f"**{ds.attrs['title']}**{f' ({source})' if source else ''}; reference: {ds.attrs['reference'] or '-'}", "",
              "| case | model | mean (mm) | SD (mm) | max (mm) | mean (%) | SD (%) | max (%) | published | "
              "ours - published, mean | ours - published, max | wall time (s) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]

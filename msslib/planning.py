@@ -256,7 +256,7 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
     breaks on a scene is a result too."""
     import xarray as xr
 
-    from msslib.experiment import interpolate
+    from msslib.compare import interpolate
     from msslib.io import mesh_from_result
     from msslib.metrics import displacement_error
 

@@ -362,11 +362,11 @@ def deformed_mesh(ax, ds, *, color="tab:red", colorby=None, deformed: bool = Tru
 def node_error(ds, ref_ds) -> np.ndarray:
     """Euclidean distance (m) between the displacements of ``ds`` and ``ref_ds`` at every node of
     ``ds``; when the rest meshes differ, the reference is interpolated at ``ds``'s nodes with its
-    own shape functions (:func:`msslib.experiment.interpolate`)."""
+    own shape functions (:func:`msslib.compare.interpolate`)."""
     X, u, _, _ = _arrays(ds)
     Xr, ur, _, _ = _arrays(ref_ds)
     if not (X.shape == Xr.shape and np.allclose(X, Xr, atol=1e-12 * max(np.abs(Xr).max(), 1e-300))):
-        from msslib.experiment import interpolate
+        from msslib.compare import interpolate
         from msslib.io import mesh_from_result
 
         ur = interpolate(mesh_from_result(ref_ds), ur, X)

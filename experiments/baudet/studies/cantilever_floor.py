@@ -166,7 +166,7 @@ def main():
 
 def at_points(ref, u_ref, X):
     """The reference displacement at the points X (exact at shared nodes)."""
-    from msslib.experiment import interpolate
+    from msslib.compare import interpolate
     from msslib.io import mesh_from_result
 
     Xr = ref["rest_position"].transpose("node", "axis").values

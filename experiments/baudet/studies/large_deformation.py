@@ -30,7 +30,7 @@ def label(n):
 
 
 def at_points(ds, u, X):
-    from msslib.experiment import interpolate
+    from msslib.compare import interpolate
     from msslib.io import mesh_from_result
 
     Xr = ds["rest_position"].transpose("node", "axis").values

@@ -36,7 +36,7 @@ import yaml
 from scipy.stats import spearmanr
 
 from experiments.script import LoadSegment
-from msslib.experiment import interpolate
+from msslib.compare import interpolate
 from msslib.io import mesh_from_result, write_result
 from msslib.quality import relative_jacobians
 from msslib.scene import load_scene, prepare, run_scene
