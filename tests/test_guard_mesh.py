@@ -4,7 +4,6 @@ unused materials, and bad mesh files (one-line errors, never SystemExit)."""
 from __future__ import annotations
 
 import struct
-import sys
 from pathlib import Path
 
 import meshio
@@ -333,7 +332,7 @@ def test_meshio_sys_exit_and_odd_exceptions_never_escape(tmp_path, monkeypatch):
     for exc, shown in ((SystemExit(3), "meshio chatter"), (struct.error("unpack requires a buffer"), "error: unpack"),
                        (KeyError("CellData"), "KeyError: 'CellData'"), (IndexError("index 5"), "IndexError: index 5")):
         def fail(*args, exc=exc, **kwargs):
-            print("meshio chatter", file=sys.stderr)
+            meshio._common.error("meshio chatter")  # how meshio speaks (a rich console on stderr)
             raise exc
 
         monkeypatch.setattr(meshio, "read", fail)

@@ -27,7 +27,8 @@ Contents of this package, one concern per module; every name below is importable
   positively oriented;
 * :mod:`msslib.mesh.files`, input/output: :func:`read` (every failure one ValueError naming the
   file; keeps the file's physical groups, cell sets and node sets), :func:`write_vtu`,
-  :func:`readable_suffixes`, :func:`check_mesh_suffix`;
+  :func:`readable_suffixes`, :func:`check_mesh_suffix`; :mod:`msslib.mesh.meshio_output` collects what
+  meshio says while it reads, per thread, without replacing ``sys.stdout`` or ``sys.stderr``;
 * :mod:`msslib.mesh.groups`, groups and selections: :func:`materials_from_groups` (a material
   index per cell from cell groups), :func:`select_nodes`;
 * :mod:`msslib.mesh.topology`: :class:`NodePairs`, :func:`unique_edges`, :func:`face_diagonals`,
@@ -42,7 +43,7 @@ Contents of this package, one concern per module; every name below is importable
 
 The modules import one another in one direction: ``core`` <- ``topology``, ``geometry``,
 ``groups``; ``geometry`` <- ``structured``, ``unstructured``; ``groups`` <- ``hygiene`` <-
-``files``.  gmsh and meshio are imported only when a mesh is generated or a file is read or
+``files`` -> ``meshio_output``.  gmsh and meshio are imported only when a mesh is generated or a file is read or
 written.
 
 The L-shaped block (:func:`l_block_hex`, :func:`l_block_tet`) of edge ``size`` ``s`` is the cube

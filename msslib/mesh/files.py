@@ -39,23 +39,20 @@ def check_mesh_suffix(path) -> None:
 def _meshio_read(path: Path):
     """``meshio.read`` that never exits the interpreter: any failure (meshio calls ``sys.exit``
     for some files and raises anything from ``struct.error`` to ``UnicodeDecodeError`` for others)
-    becomes one ValueError naming the file.  What meshio prints is captured: part of the message on
-    failure; on success returned with the mesh and the warnings it raised, ``(mesh, printed,
-    warnings)``, for :func:`read` to pass on once the mesh has passed its own checks."""
-    import io
-    import warnings
-    from contextlib import redirect_stderr, redirect_stdout
-
+    becomes one ValueError naming the file.  What meshio says is collected for this thread alone
+    (:func:`msslib.mesh.meshio_output.collected`; ``sys.stdout`` and ``sys.stderr`` are never
+    replaced, so threads may read at once): part of the message on failure; on success returned
+    with the mesh, ``(mesh, said)``, for :func:`read` to pass on once the mesh has passed its own
+    checks."""
     import meshio
 
-    printed = io.StringIO()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    from .meshio_output import collected
+
+    with collected() as messages:
         try:
-            with redirect_stdout(printed), redirect_stderr(printed):
-                m = meshio.read(path)
+            m = meshio.read(path)
         except (Exception, SystemExit) as exc:  # noqa: BLE001 - every failure of a reader is bad input
-            said = " ".join(printed.getvalue().replace("Error:", " ").split())
+            said = " ".join(" ".join(messages).replace("Error:", " ").split())
             if isinstance(exc, UnicodeDecodeError):
                 detail = (f"not UTF-8 text where the {path.suffix or 'chosen'} reader expects text "
                           f"({exc.reason} at byte {exc.start})")
@@ -73,7 +70,7 @@ def _meshio_read(path: Path):
                 detail = detail[:297] + "..."
             raise ValueError(f"{path}: cannot read mesh: {detail}; allowed: a valid mesh file in a format meshio "
                              f"reads, chosen by its suffix") from None
-    return m, " ".join(printed.getvalue().split()), caught
+    return m, " ".join(" ".join(messages).split())
 
 
 def read(path, material_key: str = "material", coincident_nodes: str = "merge",
@@ -128,7 +125,7 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
     check_mesh_suffix(path)
     if path.stat().st_size == 0:
         raise ValueError(f"{path}: cannot read mesh: the file is empty; allowed: a mesh file with cells")
-    m, said, caught = _meshio_read(path)
+    m, said = _meshio_read(path)
     try:
         mesh, used, notes = _mesh_from_meshio(path, m, material_key)
     except (ValueError, TypeError, IndexError, KeyError) as exc:  # one line naming the file, whatever it is
@@ -140,8 +137,6 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
         raise ValueError(text) from None
     import warnings
 
-    for w in caught:
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     if said:
         from msslib.errors import MsslibWarning
 
