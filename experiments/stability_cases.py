@@ -166,7 +166,7 @@ def elementwise_lsq(X, E, nu):
 def lloyd_constant(X, E, nu):
     """Lloyd's per-element constant: the regular-tetrahedron optimum for the element's volume."""
     V = np.linalg.det(X[1:] - X[0]) / 6.0
-    return float(P.lloyd_tetrahedron(E, P.equivalent_edge_length(V), nu=nu).k)
+    return float(P.lloyd_tetrahedron(E, l=P.equivalent_edge_length(V), nu=nu).k)
 
 
 def shape_case(shape, nu=0.3):

@@ -122,7 +122,7 @@ def test_spring_constants(cube):
     np.testing.assert_allclose(table.rest_distance, table.rest_length, rtol=1e-12)  # no prestrain in Golec's cube
     # 2 x 2 x 2 cubes: 54 edges, 72 face diagonals (36 faces), 32 inner diagonals
     assert dict(table.sizes) == {"spring": 54 + 72 + 32, "cell": 8}
-    golec = parameters.golec_cube(1.0e6, 0.3, 0.05, 1.0)
+    golec = parameters.golec_cube(1.0e6, nu=0.3, a=0.05, A=1.0)
     np.testing.assert_allclose(table.kappa, golec.kappa, rtol=1e-12)
     np.testing.assert_allclose(table.rest_volume, 0.05**3, rtol=1e-12)
     assert table.spring_constant.attrs["units"] == "N m-1" and table.kappa.attrs["units"] == "Pa"

@@ -23,22 +23,22 @@ BAD_NU = [0.5, 0.7, -1.0, -1.5]
 # ---- parameters --------------------------------------------------------------------------
 
 PARAMETER_FUNCTIONS_E = {
-    "lloyd_triangle": lambda e: P.lloyd_triangle(e, T),
-    "van_gelder_triangle": lambda e: P.van_gelder_triangle(e, T, 0.5, 1.0),
-    "lloyd_square": lambda e: P.lloyd_square(e, T),
-    "lloyd_tetrahedron": lambda e: P.lloyd_tetrahedron(e, 1.0),
-    "lloyd_tetrahedron_volume": lambda e: P.lloyd_tetrahedron_volume(e, 1.0, 0.3),
-    "baudet_cube": lambda e: P.baudet_cube(e, 0.3, 1.0),
-    "golec_cube": lambda e: P.golec_cube(e, 0.3, 1.0, 1.0),
+    "lloyd_triangle": lambda e: P.lloyd_triangle(e, t=T),
+    "van_gelder_triangle": lambda e: P.van_gelder_triangle(e, t=T, area=0.5, length=1.0),
+    "lloyd_square": lambda e: P.lloyd_square(e, t=T),
+    "lloyd_tetrahedron": lambda e: P.lloyd_tetrahedron(e, l=1.0),
+    "lloyd_tetrahedron_volume": lambda e: P.lloyd_tetrahedron_volume(e, l=1.0, nu=0.3),
+    "baudet_cube": lambda e: P.baudet_cube(e, nu=0.3, a=1.0),
+    "golec_cube": lambda e: P.golec_cube(e, nu=0.3, a=1.0, A=1.0),
 }
 PARAMETER_FUNCTIONS_NU = {
-    "lloyd_triangle": lambda nu: P.lloyd_triangle(E, T, nu=nu),
-    "van_gelder_triangle": lambda nu: P.van_gelder_triangle(E, T, 0.5, 1.0, nu=nu),
-    "lloyd_square": lambda nu: P.lloyd_square(E, T, nu=nu),
-    "lloyd_tetrahedron": lambda nu: P.lloyd_tetrahedron(E, 1.0, nu=nu),
-    "lloyd_tetrahedron_volume": lambda nu: P.lloyd_tetrahedron_volume(E, 1.0, nu),
-    "baudet_cube": lambda nu: P.baudet_cube(E, nu, 1.0),
-    "golec_cube": lambda nu: P.golec_cube(E, nu, 1.0, 1.0),
+    "lloyd_triangle": lambda nu: P.lloyd_triangle(E, t=T, nu=nu),
+    "van_gelder_triangle": lambda nu: P.van_gelder_triangle(E, t=T, area=0.5, length=1.0, nu=nu),
+    "lloyd_square": lambda nu: P.lloyd_square(E, t=T, nu=nu),
+    "lloyd_tetrahedron": lambda nu: P.lloyd_tetrahedron(E, l=1.0, nu=nu),
+    "lloyd_tetrahedron_volume": lambda nu: P.lloyd_tetrahedron_volume(E, l=1.0, nu=nu),
+    "baudet_cube": lambda nu: P.baudet_cube(E, nu=nu, a=1.0),
+    "golec_cube": lambda nu: P.golec_cube(E, nu=nu, a=1.0, A=1.0),
 }
 
 

@@ -69,7 +69,7 @@ def test_constants_are_those_of_the_generated_formula_for_random_triangles():
     (s,) = D.exact().solutions
     for _ in range(5):
         a, x2, y2, n = rng.uniform(0.5, 2), rng.uniform(-1, 2), rng.uniform(0.2, 2), rng.uniform(-0.9, 0.49)
-        p = delingette_triangle(3.0, n, 0.1, a, x2, y2)
+        p = delingette_triangle(3.0, nu=n, t=0.1, a=a, x2=x2, y2=y2)
         at = {E: 3, nu: sp.Float(n, 30), t: sp.Rational(1, 10), D.a: sp.Float(a, 30), D.x2: sp.Float(x2, 30),
               D.y2: sp.Float(y2, 30)}
         for name, sym in zip(("k_01", "k_12", "k_02", "c_01_12", "c_12_02", "c_01_02"), list(D.k) + list(D.c)):

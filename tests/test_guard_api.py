@@ -65,33 +65,33 @@ def test_parameters_reject_wrong_types(function, param, bad):
 
 
 def test_optional_nu_may_be_none():
-    assert P.lloyd_tetrahedron(1e6, 1.0, nu=None).k == P.lloyd_tetrahedron(1e6, 1.0).k
+    assert P.lloyd_tetrahedron(1e6, l=1.0, nu=None).k == P.lloyd_tetrahedron(1e6, l=1.0).k
     with pytest.warns(P.FormulaValidityWarning):
-        P.lloyd_triangle(1e6, 0.01, nu=0.3)
+        P.lloyd_triangle(1e6, t=0.01, nu=0.3)
 
 
 @pytest.mark.parametrize("value", ["yes", 1, None])
 def test_published_must_be_a_bool(value):
     with pytest.raises(ValueError, match=rf"published must be True or False, got .*{value!r}"):
-        P.golec_cube(1e6, 0.3, 1.0, 1.0, published=value)
+        P.golec_cube(1e6, nu=0.3, a=1.0, A=1.0, published=value)
 
 
 def test_arrays_of_one_shape_are_elementwise():
     E = np.array([1e6, 2e6, 3e6])
     nu = np.array([0.2, 0.3, 0.35])
-    out = P.golec_cube(E, nu, 0.1, 1.0)
+    out = P.golec_cube(E, nu=nu, a=0.1, A=1.0)
     for i in range(3):
-        one = P.golec_cube(float(E[i]), float(nu[i]), 0.1, 1.0)
+        one = P.golec_cube(float(E[i]), nu=float(nu[i]), a=0.1, A=1.0)
         for field in ("k_edge", "k_face", "k_inner", "kappa"):
             assert getattr(out, field)[i] == pytest.approx(getattr(one, field), rel=1e-15)
 
 
 @pytest.mark.parametrize("call", [
-    lambda: P.golec_cube(np.ones(3) * 1e6, np.full(2, 0.3), 1.0, 1.0),
-    lambda: P.golec_cube(np.ones(3) * 1e6, 0.3, np.ones((3, 1)), 1.0),  # would broadcast to (3, 3)
-    lambda: P.baudet_cube(np.ones(2) * 1e6, np.full(3, 0.3), 1.0),
-    lambda: P.check_material(np.ones(2) * 1e6, np.full(3, 0.3)),
-    lambda: P.lloyd_triangle(np.ones(2) * 1e6, np.full(3, 0.01)),
+    lambda: P.golec_cube(np.ones(3) * 1e6, nu=np.full(2, 0.3), a=1.0, A=1.0),
+    lambda: P.golec_cube(np.ones(3) * 1e6, nu=0.3, a=np.ones((3, 1)), A=1.0),  # would broadcast to (3, 3)
+    lambda: P.baudet_cube(np.ones(2) * 1e6, nu=np.full(3, 0.3), a=1.0),
+    lambda: P.check_material(np.ones(2) * 1e6, nu=np.full(3, 0.3)),
+    lambda: P.lloyd_triangle(np.ones(2) * 1e6, t=np.full(3, 0.01)),
 ])
 def test_arrays_of_different_shapes_are_refused(call):
     with pytest.raises(ValueError, match="same shape"):
@@ -99,11 +99,11 @@ def test_arrays_of_different_shapes_are_refused(call):
 
 
 @pytest.mark.parametrize("call, names", [
-    (lambda: P.golec_cube(1e308, 0.3, 10.0, 1.0), ["golec_cube", "E=1e+308", "k_edge", "infinite"]),
-    (lambda: P.baudet_cube(1e308, 0.3, 100.0), ["baudet_cube", "E=1e+308", "a=100.0"]),
-    (lambda: P.van_gelder_triangle(1e300, 1e10, 1.0, 1e-10), ["van_gelder_triangle", "E=1e+300", "length=1e-10"]),
-    (lambda: P.lloyd_tetrahedron_volume(1e6, 1e120, 0.3), ["lloyd_tetrahedron_volume", "l=1e+120"]),
-    (lambda: P.golec_cube(np.array([1e6, 1e308]), 0.3, 10.0, 1.0), ["golec_cube", "array of shape (2,)"]),
+    (lambda: P.golec_cube(1e308, nu=0.3, a=10.0, A=1.0), ["golec_cube", "E=1e+308", "k_edge", "infinite"]),
+    (lambda: P.baudet_cube(1e308, nu=0.3, a=100.0), ["baudet_cube", "E=1e+308", "a=100.0"]),
+    (lambda: P.van_gelder_triangle(1e300, t=1e10, area=1.0, length=1e-10), ["van_gelder_triangle", "E=1e+300", "length=1e-10"]),
+    (lambda: P.lloyd_tetrahedron_volume(1e6, l=1e120, nu=0.3), ["lloyd_tetrahedron_volume", "l=1e+120"]),
+    (lambda: P.golec_cube(np.array([1e6, 1e308]), nu=0.3, a=10.0, A=1.0), ["golec_cube", "array of shape (2,)"]),
 ])
 def test_results_out_of_double_range_are_refused(call, names):
     with pytest.raises(ValueError) as info:

@@ -67,7 +67,7 @@ def test_tetrahedron_normal_equations_are_the_engines_least_squares():
     K_mss = mss.stiffness_at_rest([mss.spring(i, j, kk) for (i, j), kk in zip(DT.EDGES, DT.k)], coords)
     ls = match.least_squares(K_fem, K_mss, DT.k)
     want = np.array([float(ls.solution[kk]) for kk in DT.k])
-    got = lsq_tetrahedron(1.0, 0.3, np.array(coords, dtype=float)).k
+    got = lsq_tetrahedron(1.0, nu=0.3, points=np.array(coords, dtype=float)).k
     assert got == pytest.approx(want, rel=1e-12)
     assert np.ptp(want) > 0.4  # six different constants
 
@@ -87,9 +87,9 @@ def test_equilateral_fit_is_lloyds_eq8_at_one_third():
     """Equilateral: k = 2 sqrt(3)/9 E t / (1 - nu^2) for every nu (derived), sqrt(3)/4 E t at nu = 1/3."""
     for kk, v in D.equilateral().items():
         assert sp.simplify(v - 2 * sp.sqrt(3) / 9 * E * t / (1 - nu**2)) == 0
-    p = lsq_triangle(2.0, 1 / 3, 0.1, 1.5, 0.75, 1.5 * np.sqrt(3) / 2)
-    assert (p.k_01, p.k_12, p.k_02) == pytest.approx([lloyd_triangle(2.0, 0.1).k] * 3, rel=1e-13)
-    assert lsq_triangle(2.0, 0.2, 0.1, 1.5, 0.75, 1.5 * np.sqrt(3) / 2).k_01 != pytest.approx(lloyd_triangle(2.0, 0.1).k)
+    p = lsq_triangle(2.0, nu=1 / 3, t=0.1, a=1.5, x2=0.75, y2=1.5 * np.sqrt(3) / 2)
+    assert (p.k_01, p.k_12, p.k_02) == pytest.approx([lloyd_triangle(2.0, t=0.1).k] * 3, rel=1e-13)
+    assert lsq_triangle(2.0, nu=0.2, t=0.1, a=1.5, x2=0.75, y2=1.5 * np.sqrt(3) / 2).k_01 != pytest.approx(lloyd_triangle(2.0, t=0.1).k)
 
 
 @pytest.mark.parametrize("n", [0.1, 0.25, 0.4])
@@ -99,10 +99,10 @@ def test_regular_tetrahedron_fit_is_lloyds_least_squares(n):
     assert sp.simplify(DT.regular()[0] - sp.sqrt(2) * E * (1 - nu) / (15 * (1 + nu) * (1 - 2 * nu))) == 0
     l = 0.7
     X = l * np.array([[0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0], [0.5, np.sqrt(3) / 6, np.sqrt(2 / 3)]])
-    k = lsq_tetrahedron(3.0, n, X).k
-    assert k == pytest.approx([lloyd_tetrahedron(3.0, l, nu=n).k] * 6, rel=1e-12)
+    k = lsq_tetrahedron(3.0, nu=n, points=X).k
+    assert k == pytest.approx([lloyd_tetrahedron(3.0, l=l, nu=n).k] * 6, rel=1e-12)
     if n == 0.25:
-        assert k == pytest.approx([lloyd_tetrahedron(3.0, l).k] * 6, rel=1e-12)
+        assert k == pytest.approx([lloyd_tetrahedron(3.0, l=l).k] * 6, rel=1e-12)
 
 
 # ---- optimality of the simulated constants ---------------------------------------------------------
@@ -179,6 +179,6 @@ def test_isosceles_constant_opposite_an_obtuse_apex_turns_negative(n, angle):
     """Isosceles triangle (legs 1): the constant of the base changes sign at the apex angle given."""
     def k_base(deg):
         th = np.radians(deg)
-        return lsq_triangle(1.0, n, 1.0, 1.0, np.cos(th), np.sin(th)).k_12
+        return lsq_triangle(1.0, nu=n, t=1.0, a=1.0, x2=np.cos(th), y2=np.sin(th)).k_12
 
     assert k_base(angle - 1e-3) > 0 > k_base(angle + 1e-3)

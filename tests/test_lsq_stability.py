@@ -116,7 +116,7 @@ def test_the_check_agrees_with_the_dense_spectrum_on_random_signed_lattices(band
         w = _spectrum(springs, mesh)
         stable = w[6] > 1e-9 and w[0] > -1e-9
         try:
-            check_stable_at_rest(springs, mesh.points, "test")
+            check_stable_at_rest(springs, points=mesh.points, label="test")
             verdicts.append((stable, True))
         except ValueError:
             verdicts.append((stable, False))

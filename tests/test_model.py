@@ -266,7 +266,7 @@ def spring_table(springs):
 def test_lloyd_square_sums_over_shared_elements(params):
     mesh = M.quad_grid(2.0, 2.0, 2, 2)  # unit squares, centre node 4
     (springs,) = lloyd_square_springs(mesh, [(E0, NU0)], T0)
-    p = params.lloyd_square(E0, T0)
+    p = params.lloyd_square(E0, t=T0)
     table = spring_table(springs)
     assert len(table) == 12 + 8
     k, r = table[(1, 4)]  # interior edge: two squares
@@ -289,7 +289,7 @@ def test_lloyd_and_van_gelder_triangles(params):
     materials = [(E0, NU0), (3 * E0, NU0)]
     (lloyd,) = lloyd_triangle_springs(mesh, materials, T0)
     table = spring_table(lloyd)
-    unit = params.lloyd_triangle(E0, T0).k
+    unit = params.lloyd_triangle(E0, t=T0).k
     assert np.isclose(unit, np.sqrt(3) / 4 * E0 * T0)
     # diagonal 0-4 is shared by cells 0 (material 0) and 1 (material 1)
     assert np.isclose(table[(0, 4)][0], unit + 3 * unit)
@@ -308,20 +308,20 @@ def test_lloyd_tet_with_volume_term(params):
     mesh = M.tet_grid(1.0, 1.0, 1.0, 1, 1, 1)  # Kuhn split: six tetrahedra share the diagonal 0-7
     springs, vol = lloyd_tet_springs(mesh, [(E0, 0.4)], volume=True)
     l_hat = np.cbrt(6 * np.sqrt(2) * (1.0 / 6))
-    p = params.lloyd_tetrahedron_volume(E0, l_hat, 0.4)
+    p = params.lloyd_tetrahedron_volume(E0, l=l_hat, nu=0.4)
     diag = tuple(sorted((int(np.argmin(mesh.points.sum(1))), int(np.argmax(mesh.points.sum(1))))))
     assert np.isclose(spring_table(springs)[diag][0], 6 * p.k)
     assert isinstance(vol, TetVolume) and np.allclose(vol.k_v, p.k_volume)
     model = Model(mesh, [springs, vol])
     assert np.abs(model.force(model.x0)).max() <= 1e-12 * E0
     (plain,) = lloyd_tet_springs(mesh, [(E0, 0.4)])
-    assert np.isclose(spring_table(plain)[diag][0], 6 * params.lloyd_tetrahedron(E0, l_hat).k)
+    assert np.isclose(spring_table(plain)[diag][0], 6 * params.lloyd_tetrahedron(E0, l=l_hat).k)
 
 
 def test_cube_builders(params):
     mesh = M.hex_grid(2.0, 2.0, 2.0, 2, 2, 2)  # 8 unit cubes; the centre node has 6 edges shared by 4
     (springs,) = baudet_cube_springs(mesh, [(E0, NU0)])
-    p = params.baudet_cube(E0, NU0, 1.0)
+    p = params.baudet_cube(E0, nu=NU0, a=1.0)
     counts = M.unique_edges(mesh).counts
     assert len(springs.pairs) == len(counts) + 4 * 8
     centre = int(np.argmin(np.linalg.norm(mesh.points - 1.0, axis=1)))
@@ -333,7 +333,7 @@ def test_cube_builders(params):
     assert np.isclose(table[(0, int(mesh.cells[0, 6]))][0], p.k_diagonal)
     assert np.isclose(p.k_edge, E0 * (4 * NU0 + 1) / (8 * (1 + NU0)))
     springs_g, hexvol = golec_cube_springs(mesh, [(E0, NU0)], A=1.0)
-    g = params.golec_cube(E0, NU0, 1.0, 1.0)
+    g = params.golec_cube(E0, nu=NU0, a=1.0, A=1.0)
     assert len(springs_g.pairs) == len(counts) + len(M.face_diagonals(mesh).pairs) + 32
     assert np.allclose(hexvol.kappa, g.kappa) and np.allclose(hexvol.V0, 1.0)
     for terms in ([springs], [springs_g, hexvol]):
@@ -411,7 +411,7 @@ def test_baudet_correction_single_cube(params):
     top = mesh.cells[:, 4:]  # top face, counter-clockwise seen from above
     trac = Traction(mesh, top, [0.0, 0.0, 8.0])  # F_i = 8 N on the top face
     corr = baudet_correction(mesh, [(E0, NU0)], [trac])
-    c = params.baudet_cube(E0, NU0, 1.0).correction_factor
+    c = params.baudet_cube(E0, nu=NU0, a=1.0).correction_factor
     assert np.isclose(c, -(4 * NU0 - 1) / 2)  # derived: resultants per face (erratum of eq. 8)
     assert np.allclose(corr.face_force[0], [0, 8.0, 0, 0, 0, 0])
     f = corr.nodal

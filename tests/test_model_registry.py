@@ -318,13 +318,13 @@ def test_rectangle_each_quad_its_own_aspect_ratio():
     springs = _model("lloyd_rectangle", mesh=mesh, nu=1 / 3).terms[0]
     mid = np.flatnonzero(np.all(np.isclose(x[springs.pairs, 0], [[1.0, 1.0]]), axis=1))  # the shared vertical edge
     assert len(mid) == 1
-    square, wide = lloyd_rectangle(1.0, T, 1.0), lloyd_rectangle(1.0, T, 0.5)
+    square, wide = lloyd_rectangle(1.0, t=T, r=1.0), lloyd_rectangle(1.0, t=T, r=0.5)
     assert springs.k[mid[0]] == pytest.approx(2 * square.k_v)  # the two unit squares at x = 0..2
     shared = np.flatnonzero(np.all(np.isclose(x[springs.pairs, 0], [[2.0, 2.0]]), axis=1))  # square | wide quad
     assert springs.k[shared[0]] == pytest.approx(square.k_v + wide.k_v)
     assert wide.k_v != pytest.approx(square.k_v)
     last = np.flatnonzero(np.all(np.isclose(x[springs.pairs, 0], [[4.0, 4.0]]), axis=1))
-    assert springs.k[last[0]] == pytest.approx(lloyd_rectangle(1.0, T, 0.5).k_v)
+    assert springs.k[last[0]] == pytest.approx(lloyd_rectangle(1.0, t=T, r=0.5).k_v)
 
 
 def test_rectangle_refuses_quads_that_are_not_rectangles():

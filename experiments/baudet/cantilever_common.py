@@ -97,7 +97,7 @@ def lattice_tensor(E, nu, a=1.0):
     tests/test_baudet_cantilever.py), numerically and in milliseconds."""
     from msslib.parameters import baudet_cube
 
-    p = baudet_cube(E, nu, a)
+    p = baudet_cube(E, nu=nu, a=a)
     springs = []
     for ax in range(3):  # 4 parallel edges per axis
         r = np.zeros(3)

@@ -33,7 +33,7 @@ class BaudetCube:
     correction_factor: float  # F_perp = factor x F_i, resultants per face
 
 
-def baudet_cube(E, nu, a, *, published=False) -> BaudetCube:
+def baudet_cube(E, *, nu, a, published=False) -> BaudetCube:
     """Baudet et al. eqs. 7-8 for a cube of edge a; the correction factor is for resultants per face
     (derived: -(4 nu - 1)/2); ``published=True`` gives the printed -(4 nu - 1)/16."""
     positive("E", E), poisson(nu), positive("cube edge a", a)
@@ -51,7 +51,7 @@ def baudet_cube(E, nu, a, *, published=False) -> BaudetCube:
 def baudet_cube_springs(mesh, materials, published: bool = False) -> list[Term]:
     """Baudet et al.'s springs on a mesh of cubes: per cube ``k_edge`` on its 12 edges (summed over
     the cubes sharing an edge) and ``k_diagonal`` on its 4 inner diagonals
-    (``parameters.baudet_cube(E, nu, a)``, ``a`` the cube's edge).  Add :func:`baudet_correction`
+    (``parameters.baudet_cube(E, nu=nu, a=a)``, ``a`` the cube's edge).  Add :func:`baudet_correction`
     for the Poisson effect under load. (The printed and derived spring constants agree;
     ``published`` is accepted for symmetry with the other builders.)"""
     k_e, k_d = cube_constants(mesh, materials, baudet_cube, ("k_edge", "k_diagonal"), published=published)
@@ -60,7 +60,7 @@ def baudet_cube_springs(mesh, materials, published: bool = False) -> list[Term]:
 
 def baudet_correction(mesh, materials, loads, published: bool = False) -> BaudetCorrection:
     """:class:`msslib.terms.BaudetCorrection` for a mesh of cubes with the per-cube factor
-    ``parameters.baudet_cube(E, nu, a).correction_factor``; ``loads`` (n, 3) nodal surface forces
+    ``parameters.baudet_cube(E, nu=nu, a=a).correction_factor``; ``loads`` (n, 3) nodal surface forces
     at unit load, or a list of terms whose external forces are summed (leave gravity out).
     ``published=True`` uses the printed factor -(4 nu - 1)/16 (see the errata)."""
     (c,) = cube_constants(mesh, materials, baudet_cube, ("correction_factor",), published=published)
@@ -74,7 +74,7 @@ def baudet_correction(mesh, materials, loads, published: bool = False) -> Baudet
 
 def element_correction(mesh, materials, published: bool = False) -> ElementBaudetCorrection:
     """:class:`ElementBaudetCorrection` for a mesh of cubes with each cube's ``k_edge``,
-    ``k_diagonal`` and ``correction_factor`` from ``parameters.baudet_cube(E, nu, a)``
+    ``k_diagonal`` and ``correction_factor`` from ``parameters.baudet_cube(E, nu=nu, a=a)``
     (``published=True``: the printed factor -(4 nu - 1)/16)."""
     k_e, k_d, c = cube_constants(mesh, materials, baudet_cube, ("k_edge", "k_diagonal", "correction_factor"),
                                  published=published)

@@ -34,16 +34,22 @@ def _field(result, name):
     raise AttributeError(f"{type(result).__name__} has no field {name!r}")
 
 
-def _per_cell(fn, fields, *args):
-    """Call a parameters function on per-cell arrays; returns one float array per field.
+def _per_cell(fn, fields, E, **named):
+    """Call a parameters function ``fn(E, **named)`` on per-cell arrays (its arguments past ``E``
+    are keyword-only); returns one float array per field.
 
     Tries one vectorised call; if the function only takes scalars, calls it cell by cell
     (genuine errors, e.g. an invalid nu, are then raised by the scalar call)."""
-    arrays = [np.asarray(a, dtype=float) for a in args]
+    names = list(named)
+    arrays = [np.asarray(a, dtype=float) for a in (E, *named.values())]
     m = max((a.size for a in arrays if a.ndim), default=1)
     arrays = [np.broadcast_to(a, (m,)) for a in arrays]
+
+    def call(values):
+        return fn(values[0], **dict(zip(names, values[1:])))
+
     try:
-        res = fn(*arrays)
+        res = call(arrays)
         out = [np.broadcast_to(np.asarray(_field(res, f), dtype=float), (m,)).copy() for f in fields]
         return out
     except (TypeError, ValueError, AttributeError):
@@ -53,7 +59,7 @@ def _per_cell(fn, fields, *args):
     for i in range(m):
         key = tuple(float(a[i]) for a in arrays)
         if key not in cache:
-            res = fn(*key)
+            res = call(key)
             cache[key] = [float(_field(res, f)) for f in fields]
         for o, v in zip(out, cache[key]):
             o[i] = v
@@ -144,14 +150,14 @@ def _cube_edges(mesh, rtol=1e-6):
     return a
 
 
-def cube_constants(mesh, materials, parameters, fields, *args, published: bool = False) -> list[np.ndarray]:
-    """Per-cube constants on a mesh of cubes: ``fields`` of ``parameters(E, nu, a, *args,
+def cube_constants(mesh, materials, parameters, fields, published: bool = False, **named) -> list[np.ndarray]:
+    """Per-cube constants on a mesh of cubes: ``fields`` of ``parameters(E, nu=nu, a=a, **named,
     published=published)``, ``E`` and ``nu`` from ``materials``, ``a`` each cube's edge; one float
     array per field (see :func:`_per_cell`).  ValueError unless the cells are cubes."""
     _require(mesh, "hexahedron")
     a = _cube_edges(mesh)
     E, nu = material_arrays(mesh, materials)
-    return _per_cell(partial(parameters, published=published), fields, E, nu, a, *args)
+    return _per_cell(partial(parameters, published=published), fields, E, nu=nu, a=a, **named)
 
 
 def cube_springs(mesh, constants) -> Springs:

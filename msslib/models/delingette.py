@@ -52,7 +52,7 @@ class TriangleAngularSprings:
     c_01_02: float
 
 
-def delingette_triangle(E, nu, t, a, x2, y2) -> TriangleAngularSprings:
+def delingette_triangle(E, *, nu, t, a, x2, y2) -> TriangleAngularSprings:
     """The six constants of one triangle with nodes ``(0, 0)``, ``(a, 0)``, ``(x2, y2)``
     (``a > 0``, ``y2 > 0``), Young's modulus ``E``, Poisson's ratio ``nu`` and thickness ``t``."""
     positive("E", E), positive("thickness t", t), positive("a", a), positive("y2", y2)
@@ -196,7 +196,7 @@ def delingette_springs(mesh, materials, t: float) -> list[Term]:
     _require(mesh, "triangle")
     E, nu = material_arrays(mesh, materials)
     a, x2, y2 = local_coordinates(mesh.points, mesh.cells)
-    p = delingette_triangle(E, nu, t, a, x2, y2)
+    p = delingette_triangle(E, nu=nu, t=t, a=a, x2=x2, y2=y2)
     Q = np.empty((mesh.n_cells, 3, 3))
     Q[:, [0, 1, 2], [0, 1, 2]] = np.stack([p.k_01, p.k_12, p.k_02], axis=1)
     for value, (e, f) in zip((p.c_01_12, p.c_12_02, p.c_01_02), PAIRS):

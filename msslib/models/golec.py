@@ -36,7 +36,7 @@ class GolecCube:
     kappa: float  # Pa: coefficient of kappa/(2 V0) (V - V0)^2
 
 
-def golec_cube(E, nu, a, A, *, published=False) -> GolecCube:
+def golec_cube(E, *, nu, a, A, published=False) -> GolecCube:
     """Golec et al.'s hybrid cube with ratio A = k_inner/k_face (derived per-element constants that
     make the lattice exactly isotropic with E and nu); ``published=True`` gives the printed values
     (k_edge and k_face there are interior totals, see the errata)."""
@@ -58,14 +58,14 @@ def _hex_rest_volumes(mesh):
 
 
 def golec_cube_springs(mesh, materials, A, published: bool = False) -> list[Term]:
-    """Golec et al.'s cube model: per cube ``parameters.golec_cube(E, nu, a, A)`` gives ``k_edge``
+    """Golec et al.'s cube model: per cube ``parameters.golec_cube(E, nu=nu, a=a, A=A)`` gives ``k_edge``
     (12 edges), ``k_face`` (12 face diagonals) and ``k_inner`` (4 inner diagonals), each summed over
     the cubes sharing the pair, and ``kappa`` for a :class:`HexVolume` term per cube with ``V0``
     the averaged-edge volume at rest.  ``A`` (a scalar or one value per cell) is passed through to
     ``golec_cube``. ``published=True`` uses the printed constants, per element (see the errata);
     the volume term keeps the dimensionally consistent energy kappa/(2 V0) (V - V0)^2."""
-    k_e, k_f, k_i, kappa = cube_constants(mesh, materials, golec_cube, ("k_edge", "k_face", "k_inner", "kappa"), A,
-                                          published=published)
+    k_e, k_f, k_i, kappa = cube_constants(mesh, materials, golec_cube, ("k_edge", "k_face", "k_inner", "kappa"),
+                                          A=A, published=published)
     springs = cube_springs(mesh, [("edges", k_e), ("face_diagonals", k_f), ("inner_diagonals", k_i)])
     return [springs, HexVolume(mesh.cells, kappa, _hex_rest_volumes(mesh))]
 

@@ -117,18 +117,18 @@ def _plate(function, formula, cls, E, t, nu, **sizes):
     return evaluate(function, formula, cls, E=E, t=t, **sizes)
 
 
-def lloyd_triangle(E, t, *, nu=None) -> TriangleSprings:
+def lloyd_triangle(E, *, t, nu=None) -> TriangleSprings:
     """Lloyd et al. eq. 8: k = sqrt(3)/4 E t per equilateral triangle (exact for nu = 1/3)."""
     return _plate("lloyd_triangle", _tri.lloyd_triangle, TriangleSprings, E, t, nu)
 
 
-def van_gelder_triangle(E, t, area, length, *, nu=None) -> TriangleSprings:
+def van_gelder_triangle(E, *, t, area, length, nu=None) -> TriangleSprings:
     """Van Gelder: k = E t A_e / l^2 per triangle of area A_e, for its edge of length l (Lloyd eq. 9)."""
     return _plate("van_gelder_triangle", _tri.van_gelder_triangle, TriangleSprings, E, t, nu, area=area,
                   length=length)
 
 
-def lloyd_square(E, t, *, nu=None) -> SquareSprings:
+def lloyd_square(E, *, t, nu=None) -> SquareSprings:
     """Lloyd et al. eqs. 10-11: prestrained square (exact for nu = 1/3)."""
     return _plate("lloyd_square", _square.lloyd_square, SquareSprings, E, t, nu)
 
@@ -136,7 +136,7 @@ def lloyd_square(E, t, *, nu=None) -> SquareSprings:
 RECTANGLE_FITS = ("equilibrium", "least_squares")
 
 
-def lloyd_rectangle(E, t, r, *, nu=None, fit="equilibrium") -> RectangleSprings:
+def lloyd_rectangle(E, *, t, r, nu=None, fit="equilibrium") -> RectangleSprings:
     """Six prestrained springs of an a x b rectangle, aspect ratio ``r = b / a`` (the square of
     Lloyd et al. Sec. 4.1 extended; ``derivations/elements/rectangle.py``).
 
@@ -175,7 +175,7 @@ def equivalent_edge_length(volume):
     return _tet.equivalent_edge_length(volume)
 
 
-def lloyd_tetrahedron(E, l, *, nu=None) -> TetrahedronSprings:
+def lloyd_tetrahedron(E, *, l, nu=None) -> TetrahedronSprings:
     """Lloyd et al. eq. 12: least-squares k = 2 sqrt(2)/25 E l (nu = 1/4); with ``nu`` given, the
     least-squares optimum for that nu (derived; eq. 12 is its value at 1/4)."""
     positive("E", E), positive("edge length l", l)
@@ -187,7 +187,7 @@ def lloyd_tetrahedron(E, l, *, nu=None) -> TetrahedronSprings:
     return evaluate("lloyd_tetrahedron", _tet.lloyd_tetrahedron_general_nu, TetrahedronSprings, E=E, nu=nu, l=l)
 
 
-def lloyd_tetrahedron_volume(E, l, nu=0.25, *, published=False) -> TetrahedronVolumeSprings:
+def lloyd_tetrahedron_volume(E, *, l, nu=0.25, published=False) -> TetrahedronVolumeSprings:
     """Lloyd et al. eq. 14 with the volume energy: the least-squares optimum for ``nu`` (derived);
     ``published=True`` gives eq. 14 as printed (its value at nu = 1/4, whatever ``nu``)."""
     positive("E", E), positive("edge length l", l), poisson(nu)
@@ -251,7 +251,7 @@ def lloyd_rectangle_springs(mesh, materials, t: float, fit: str = "equilibrium")
     _mesh.check_cells(mesh)
     a, b = rectangle_sides(mesh)
     E, nu = material_arrays(mesh, materials)
-    p = lloyd_rectangle(E, t, b / a, nu=None if fit == "equilibrium" else nu, fit=fit)
+    p = lloyd_rectangle(E, t=t, r=b / a, nu=None if fit == "equilibrium" else nu, fit=fit)
     k = np.stack([np.broadcast_to(np.asarray(getattr(p, f"k_{s}"), dtype=float), a.shape) for s in "hvd"])
     c = np.stack([np.broadcast_to(np.asarray(getattr(p, f"c_{s}"), dtype=float), a.shape) for s in "hvd"])
 
@@ -272,17 +272,17 @@ def lloyd_rectangle_springs(mesh, materials, t: float, fit: str = "equilibrium")
 
 def lloyd_triangle_springs(mesh, materials, t: float) -> list[Term]:
     """Lloyd et al.'s springs on the edges of a triangle mesh (plane stress, thickness ``t`` m):
-    per triangle ``parameters.lloyd_triangle(E, t).k`` on each of its edges, summed over the
+    per triangle ``parameters.lloyd_triangle(E, t=t).k`` on each of its edges, summed over the
     triangles sharing an edge; rest lengths are the mesh distances."""
     _require(mesh, "triangle")
     E, nu = material_arrays(mesh, materials)
     check_material(E, nu, "lloyd_triangle", VALID_NU)
-    (k,) = _per_cell(lloyd_triangle, ("k",), E, t)
+    (k,) = _per_cell(lloyd_triangle, ("k",), E, t=t)
     return [assemble_springs(mesh, "edges", lambda cells, _p: k[cells])]
 
 
 def van_gelder_springs(mesh, materials, t: float) -> list[Term]:
-    """Van Gelder's springs: per triangle ``parameters.van_gelder_triangle(E, t, A_e, l).k`` on each
+    """Van Gelder's springs: per triangle ``parameters.van_gelder_triangle(E, t=t, area=A_e, length=l).k`` on each
     edge of length ``l`` (``A_e`` the triangle's area), summed over the adjacent triangles."""
     area = _require(mesh, "triangle")
     E, nu = material_arrays(mesh, materials)
@@ -290,7 +290,7 @@ def van_gelder_springs(mesh, materials, t: float) -> list[Term]:
     fn = van_gelder_triangle
 
     def k_fn(cells, node_pairs):
-        (k,) = _per_cell(fn, ("k",), E[cells], t, area[cells], _pair_lengths(mesh, node_pairs))
+        (k,) = _per_cell(fn, ("k",), E[cells], t=t, area=area[cells], length=_pair_lengths(mesh, node_pairs))
         return k
 
     return [assemble_springs(mesh, "edges", k_fn)]
@@ -298,14 +298,14 @@ def van_gelder_springs(mesh, materials, t: float) -> list[Term]:
 
 def lloyd_square_springs(mesh, materials, t: float) -> list[Term]:
     """Lloyd et al.'s springs on a mesh of squares (quads): per element ``k_edge`` on its four
-    edges and ``k_diagonal`` on both diagonals (``parameters.lloyd_square(E, t)``), summed over
+    edges and ``k_diagonal`` on both diagonals (``parameters.lloyd_square(E, t=t)``), summed over
     the elements sharing them; rest lengths are ``rest_factor_edge`` and ``rest_factor_diagonal``
     times the mesh distances (prestrained springs)."""
     _require(mesh, "quad")
     E, nu = material_arrays(mesh, materials)
     check_material(E, nu, "lloyd_square", VALID_NU)
     k_e, k_d, f_e, f_d = _per_cell(lloyd_square,
-                                   ("k_edge", "k_diagonal", "rest_factor_edge", "rest_factor_diagonal"), E, t)
+                                   ("k_edge", "k_diagonal", "rest_factor_edge", "rest_factor_diagonal"), E, t=t)
     edges = assemble_springs(mesh, "edges", lambda c, p: (k_e[c], f_e[c] * _pair_lengths(mesh, p)))
     diags = assemble_springs(mesh, "face_diagonals", lambda c, p: (k_d[c], f_d[c] * _pair_lengths(mesh, p)))
     return [_merge_springs([edges, diags])]
@@ -320,9 +320,9 @@ def lloyd_tet_springs(mesh, materials, volume: bool = False, published: bool = F
     """Lloyd et al.'s springs on the edges of a tetrahedral mesh.
 
     Each tetrahedron of volume ``V`` is treated as a regular one of the same volume, edge
-    ``l_hat = (6 sqrt(2) V)^(1/3)``; its constant ``parameters.lloyd_tetrahedron(E, l_hat).k`` is
+    ``l_hat = (6 sqrt(2) V)^(1/3)``; its constant ``parameters.lloyd_tetrahedron(E, l=l_hat).k`` is
     added to each of its edges.  With ``volume=True`` the constants come from
-    ``parameters.lloyd_tetrahedron_volume(E, l_hat, nu)`` (``k``, ``k_volume``) and a
+    ``parameters.lloyd_tetrahedron_volume(E, l=l_hat, nu=nu)`` (``k``, ``k_volume``) and a
     :class:`TetVolume` term with ``k_v = k_volume`` and ``V0 = V`` is added; ``published=True`` uses
     eq. 14 as printed (its values at nu = 1/4) instead of the optimum for each nu.
     """
@@ -331,9 +331,9 @@ def lloyd_tet_springs(mesh, materials, volume: bool = False, published: bool = F
     check_material(E, nu, None if volume else "lloyd_tetrahedron", VALID_NU)
     l_hat = np.cbrt(6.0 * np.sqrt(2.0) * V)
     if volume:
-        k, k_vol = _per_cell(partial(lloyd_tetrahedron_volume, published=published), ("k", "k_volume"), E, l_hat, nu)
+        k, k_vol = _per_cell(partial(lloyd_tetrahedron_volume, published=published), ("k", "k_volume"), E, l=l_hat, nu=nu)
     else:
-        (k,) = _per_cell(lloyd_tetrahedron, ("k",), E, l_hat)
+        (k,) = _per_cell(lloyd_tetrahedron, ("k",), E, l=l_hat)
     terms: list[Term] = [assemble_springs(mesh, "edges", lambda c, _p: k[c])]
     if volume:
         terms.append(TetVolume(mesh.cells, k_vol, _tet_rest_volumes(mesh)))

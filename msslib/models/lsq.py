@@ -70,7 +70,7 @@ class TetrahedronLsqSprings:
     k: np.ndarray  # (..., 6) N/m, per element, edges 0-1, 0-2, 0-3, 1-2, 1-3, 2-3
 
 
-def lsq_triangle(E, nu, t, a, x2, y2) -> TriangleLsqSprings:
+def lsq_triangle(E, *, nu, t, a, x2, y2) -> TriangleLsqSprings:
     """Least-squares constants of one triangle with nodes ``(0, 0)``, ``(a, 0)``, ``(x2, y2)``
     (``a > 0``, ``y2 > 0``), Young's modulus ``E``, Poisson's ratio ``nu``, thickness ``t``."""
     positive("E", E), positive("thickness t", t), positive("a", a), positive("y2", y2)
@@ -96,7 +96,7 @@ def tetra_frame(points):
         np.einsum("...i,...i->...", e3, n)
 
 
-def lsq_tetrahedron(E, nu, points) -> TetrahedronLsqSprings:
+def lsq_tetrahedron(E, *, nu, points) -> TetrahedronLsqSprings:
     """Least-squares constants of tetrahedra with node coordinates ``points`` (4, 3) or (m, 4, 3)
     (positively oriented, VTK order), Young's modulus ``E`` and Poisson's ratio ``nu`` (scalars or
     (m,) arrays): the solution of the generated normal equations ``G k = b`` of each element."""
@@ -199,7 +199,7 @@ def _not_positive_definite(A, label: str, band_limit: float | None = None) -> in
     return int(bad[0]) + 1 if len(bad) else 0
 
 
-def check_stable_at_rest(springs, points, label: str) -> None:
+def check_stable_at_rest(springs, *, points, label: str) -> None:
     """Raise ValueError unless the springs' stiffness at rest ``K`` (``points`` stress free) is
     positive definite apart from the rigid-body motions.
 
@@ -236,7 +236,7 @@ def _lsq_springs(mesh, k, edges, label):
     _warn_negative(k, label)
     springs = assemble_springs(mesh, "edges", lambda c, pairs: k[c, _local_index(mesh, c, pairs, edges)], signed=True)
     if np.any(springs.k <= 0):
-        check_stable_at_rest(springs, mesh.points, label)
+        check_stable_at_rest(springs, points=mesh.points, label=label)
     return [springs]
 
 
@@ -246,7 +246,7 @@ def lsq_triangle_springs(mesh, materials, t: float):
     _require(mesh, "triangle")
     E, nu = material_arrays(mesh, materials)
     a, x2, y2 = local_coordinates(mesh.points, mesh.cells)
-    p = lsq_triangle(E, nu, t, a, x2, y2)
+    p = lsq_triangle(E, nu=nu, t=t, a=a, x2=x2, y2=y2)
     k = np.stack([np.broadcast_to(np.asarray(getattr(p, f), dtype=float), a.shape) for f in ("k_01", "k_12", "k_02")],
                  axis=1)
     return _lsq_springs(mesh, k, TRIANGLE_EDGES, "lsq_triangle")
@@ -257,7 +257,7 @@ def lsq_tetrahedron_springs(mesh, materials):
     constants of its own shape and material."""
     _require(mesh, "tetra")
     E, nu = material_arrays(mesh, materials)
-    return _lsq_springs(mesh, lsq_tetrahedron(E, nu, mesh.points[mesh.cells]).k, TETRA_EDGES, "lsq_tetrahedron")
+    return _lsq_springs(mesh, lsq_tetrahedron(E, nu=nu, points=mesh.points[mesh.cells]).k, TETRA_EDGES, "lsq_tetrahedron")
 
 
 def _build_triangle(ctx):

@@ -41,7 +41,7 @@ def printed_as_totals(mesh, E, nu, A):
     """The printed constants read as interior totals (errata 4): per element k_e/4 (an edge is
     shared by 4 cubes), k_f/2 (a face diagonal by 2), k_c; the correction term as derived."""
     a = L / N
-    c = golec_cube(E, nu, a, A, published=True)
+    c = golec_cube(E, nu=nu, a=a, A=A, published=True)
     springs = Springs(*[np.concatenate(v) for v in zip(*[
         (s.pairs, s.k, s.rest_length) for s in (assemble_springs(mesh, "edges", lambda cells, _p: c.k_edge / 4),
                                                  assemble_springs(mesh, "face_diagonals", lambda cells, _p: c.k_face / 2),
