@@ -1,7 +1,9 @@
 """Mesh hygiene: nodes at the same place with different numbers, which cut a body in two
 (:func:`coincident_nodes`, :func:`resolve_coincident_nodes`: merged or refused), connected parts
 (:func:`connected_parts`) and the parts whose fixed dofs leave a rigid-body mode free
-(:func:`loose_parts`, :class:`LoosePart`: floating, or free to slide or turn).
+(:func:`loose_parts`, :class:`LoosePart`: floating, free to slide or turn, or a mechanism: pieces
+joined only at a vertex, or an edge in 3D, that turn about it), and the shape of each cell
+(:func:`cell_shapes`: aspect ratio and smallest angle, which name a sliver).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import numpy as np
 
 from .core import COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _compact, _fmt_point
 from .groups import _renumbered_groups
+from .topology import facet_connected_cells
 
 
 def _bbox_diagonal(points: np.ndarray) -> float:
@@ -148,7 +151,11 @@ class LoosePart(NamedTuple):
     parallel to an axis (e.g. ``"translation along x"``, ``"rotation about the z axis"``,
     ``"rotation about the line x = 0.1, y = 0 (parallel to z)"``, in 2D ``"rotation about the
     point (0, 0)"``; ``"rotation about an axis parallel to z"`` when a free translation lets the
-    axis slide); otherwise the names found and ``"N other rigid-body mode(s) (...)"``.
+    axis slide); otherwise the names found and ``"N other rigid-body mode(s) (...)"``.  A part held
+    as a whole but made of pieces joined only at a vertex (or an edge in 3D) that turn about it
+    is a mechanism: ``hinges`` holds the nodes where the moving pieces meet the rest (ascending),
+    ``hanging_cells`` the cell count of the moving pieces, ``n_free`` the number of motions and
+    ``modes`` is empty.
     """
 
     part: int
@@ -158,6 +165,8 @@ class LoosePart(NamedTuple):
     floating: bool
     n_free: int
     modes: tuple
+    hinges: tuple = ()
+    hanging_cells: int = 0
 
     def describe(self, mesh: Mesh) -> str:
         """One phrase: which part, and what is loose (for error messages)."""
@@ -168,7 +177,23 @@ class LoosePart(NamedTuple):
                 if self.n_parts > 1 else f"the mesh ({self.n_cells} {mesh.cell_type} cells, {at})")
         if self.floating:
             return f"{what} is floating: none of its dofs is fixed"
+        if self.hinges:
+            facet = "face" if mesh.dim == 3 else "edge"
+            return (f"{what} is a mechanism: {self.hanging_cells} {mesh.cell_type} cell(s) hang on the rest only at "
+                    f"{_hinge_text(mesh, self.hinges)}, a hinge (the cells there share no {facet}), and can turn "
+                    f"about it ({self.n_free} free mode(s)); join them through a shared {facet} or hold the "
+                    f"hanging cells too")
         return f"{what} has {self.n_free} free rigid-body mode(s): {', '.join(self.modes)}"
+
+
+def _hinge_text(mesh: Mesh, nodes) -> str:
+    shown = [f"{int(i)} at {_fmt_point(mesh.points[i])}" for i in nodes[:3]]
+    if len(nodes) == 1:
+        return f"node {shown[0]}"
+    if len(nodes) == 2:
+        return f"the edge from node {shown[0]} to node {shown[1]}"
+    more = f" and {len(nodes) - 3} more" if len(nodes) > 3 else ""
+    return f"nodes {', '.join(shown)}{more}"
 
 
 def _rigid_modes(x: np.ndarray, center: np.ndarray, scale: float) -> np.ndarray:
@@ -244,8 +269,12 @@ def loose_parts(mesh: Mesh, fixed, rtol: float = 1e-8) -> list[LoosePart]:
     the rigid-body modes (translations and infinitesimal rotations; 3 in 2D, 6 in 3D) restricted to
     its fixed dofs form a matrix whose null space (singular values below ``rtol`` times the
     largest) holds the free modes.  A part no dof of which is fixed is ``floating``.  A node that
-    no cell uses is a part of its own, loose unless all its dofs are fixed.  Returns the loose parts
-    in part order (empty: every part is held).
+    no cell uses is a part of its own, loose unless all its dofs are fixed.  A part that its fixed
+    dofs hold as a whole is also checked for hinges (:func:`_mechanism`): its pieces of cells joined
+    through whole facets (:func:`msslib.mesh.topology.facet_connected_cells`), each taken as a rigid body
+    moving with its shared nodes and held by its own fixed dofs, must not be able to move; two
+    cubes sharing one corner, one clamped, turn about the corner.  Returns the loose parts in part
+    order (empty: every part is held).
     """
     fixed = np.asarray(fixed, dtype=bool)
     dim = mesh.dim
@@ -276,8 +305,75 @@ def loose_parts(mesh: Mesh, fixed, rtol: float = 1e-8) -> list[LoosePart]:
         _, s, vt = np.linalg.svd(np.linalg.qr(modes, mode="r"), full_matrices=True)  # QR first: O(n_fixed)
         rank = int(np.sum(s > rtol * s.max())) if s.size and s.max() > 0 else 0
         if rank == n_modes:
+            hinge = _mechanism(mesh, fixed, cell_part == p, rtol)
+            if hinge is not None:
+                out.append(LoosePart(p, n_parts, int(n_cells[p]), node, False, hinge[0], (), hinge[1], hinge[2]))
             continue
         null = vt[rank:].T
         out.append(LoosePart(p, n_parts, int(n_cells[p]), node, False, n_modes - rank,
                              _name_free_modes(null, dim, center, scale)))
     return out
+
+
+#: above this many pieces joined at hinges in one part, :func:`_mechanism` does not look (a dense
+#: analysis of 6 rigid-body modes per piece)
+MAX_HINGED_PIECES = 400
+
+
+def _orthonormal_rows(a: np.ndarray, rtol: float) -> np.ndarray:
+    """An orthonormal basis (rows) of the row space of ``a``."""
+    if a.size == 0:
+        return np.zeros((0, a.shape[1]))
+    _, s, vt = np.linalg.svd(np.linalg.qr(a, mode="r"), full_matrices=False)
+    rank = int(np.sum(s > rtol * s.max())) if s.size and s.max() > 0 else 0
+    return vt[:rank]
+
+
+def _mechanism(mesh: Mesh, fixed: np.ndarray, in_part: np.ndarray, rtol: float):
+    """Whether the cells ``in_part`` (one connected part, held as one rigid body by its fixed dofs)
+    are a mechanism: pieces joined through whole facets (:func:`facet_connected_cells`) taken as
+    rigid bodies, joined to each other at their shared nodes (same velocity there) and held by
+    their own fixed dofs; a motion of the pieces that meets these conditions is a mechanism.
+
+    Returns None, or ``(n_free, hinge_nodes, hanging_cells)``: the number of independent motions,
+    the shared nodes of the pieces that move (ascending) and the number of cells of those pieces.
+    """
+    cells = np.flatnonzero(in_part)
+    sub = Mesh(mesh.points, mesh.cells[cells], mesh.cell_type)
+    n_pieces, piece = facet_connected_cells(sub)
+    if n_pieces < 2 or n_pieces > MAX_HINGED_PIECES:
+        return None
+    dim = mesh.dim
+    n_modes = 3 if dim == 2 else 6
+    node_piece = np.unique(np.stack([sub.cells.ravel(), np.repeat(piece, sub.nodes_per_cell)], axis=1), axis=0)
+    by_piece = node_piece[np.lexsort((node_piece[:, 0], node_piece[:, 1]))]
+    nodes_of = np.split(by_piece[:, 0], np.searchsorted(by_piece[:, 1], np.arange(1, n_pieces)))
+    frames = []
+    rows = []
+    for k, nodes in enumerate(nodes_of):
+        x = mesh.points[nodes]
+        frames.append((x.mean(axis=0), _bbox_diagonal(x) or 1.0))
+        held = _orthonormal_rows(_rigid_modes(x, *frames[k])[fixed[nodes]], rtol)
+        block = np.zeros((len(held), n_pieces * n_modes))
+        block[:, k * n_modes:(k + 1) * n_modes] = held
+        rows.append(block)
+    shared_nodes, first, counts = np.unique(node_piece[:, 0], return_index=True, return_counts=True)
+    for node, start, count in zip(shared_nodes[counts > 1], first[counts > 1], counts[counts > 1]):
+        pieces = node_piece[start:start + count, 1]
+        x = mesh.points[node][None, :]
+        ref = _rigid_modes(x, *frames[pieces[0]])[0]  # (dim, n_modes)
+        for k in pieces[1:]:
+            block = np.zeros((dim, n_pieces * n_modes))
+            block[:, pieces[0] * n_modes:(pieces[0] + 1) * n_modes] = ref
+            block[:, k * n_modes:(k + 1) * n_modes] = -_rigid_modes(x, *frames[k])[0]
+            rows.append(block)
+    a = np.vstack(rows)
+    _, s, vt = np.linalg.svd(a, full_matrices=True)
+    rank = int(np.sum(s > rtol * s.max())) if s.size and s.max() > 0 else 0
+    if rank == a.shape[1]:
+        return None
+    null = vt[rank:].reshape(-1, n_pieces, n_modes)
+    moving = np.flatnonzero(np.abs(null).max(axis=(0, 2)) > 1e-6)
+    on_moving = np.isin(node_piece[:, 1], moving)
+    hinge_nodes = np.intersect1d(shared_nodes[counts > 1], node_piece[on_moving, 0])
+    return a.shape[1] - rank, tuple(int(i) for i in hinge_nodes), int(np.isin(piece, moving).sum())

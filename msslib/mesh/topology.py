@@ -1,7 +1,9 @@
 """Topology of a mesh: its edges and diagonals as unique node pairs with the cells sharing each
 (:class:`NodePairs`, :func:`unique_edges`, :func:`face_diagonals`, :func:`inner_diagonals`), its
-boundary facets (:func:`boundary_facets`), and whether given facets are faces of its cells
-(:func:`facet_cell_counts`).
+boundary facets (:func:`boundary_facets`), whether given facets are faces of its cells
+(:func:`facet_cell_counts`), and its pieces of cells joined through whole facets
+(:func:`facet_connected_cells`: two pieces that share only a vertex, or an edge in 3D, meet at a
+hinge).
 """
 
 from __future__ import annotations
@@ -125,3 +127,42 @@ def facet_cell_counts(mesh: Mesh, facets) -> np.ndarray:
     inverse = inverse.ravel()
     counts = np.bincount(inverse[:len(own)], minlength=int(inverse.max(initial=-1)) + 1)
     return counts[inverse[len(own):]]
+
+
+def facet_connected_cells(mesh: Mesh) -> tuple[int, np.ndarray]:
+    """Pieces of a mesh whose cells are joined through shared facets (faces in 3D, edges in 2D).
+
+    Returns ``(n_pieces, piece)`` with ``piece`` the piece of each cell, ``0 .. n_pieces - 1``,
+    numbered in the order of their lowest cell.  Cells sharing nodes but no whole facet (a single
+    vertex, or a single edge of a 3D mesh) are in different pieces: where such pieces meet is a
+    hinge, about which one can turn against the other.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    m = mesh.n_cells
+    if m == 0:
+        return 0, np.zeros(0, dtype=np.int64)
+    local = _LOCAL_FACETS[mesh.cell_type]
+    facets = np.sort(mesh.cells[:, local].reshape(-1, local.shape[1]), axis=1).astype(np.int64)
+    n = np.int64(max(mesh.n_nodes, 1))
+    # pairs of node indices as one int64 key each (n^2 < 2^63): a lexsort of 2 keys, not np.unique(axis=0)
+    keys = [facets[:, j] * n + facets[:, j + 1] if j + 1 < facets.shape[1] else facets[:, j]
+            for j in range(0, facets.shape[1], 2)]
+    order = np.lexsort(keys[::-1])
+    new = np.ones(len(order), dtype=bool)
+    for k in keys:
+        new[1:] &= k[order][1:] == k[order][:-1]
+    new[1:] = ~new[1:]
+    inverse = np.empty(len(order), dtype=np.int64)
+    inverse[order] = np.cumsum(new) - 1
+    n_facets = int(inverse.max()) + 1
+    cell_of = np.repeat(np.arange(m, dtype=np.int64), len(local))
+    graph = coo_matrix((np.ones(len(cell_of)), (cell_of, m + inverse)), shape=(m + n_facets, m + n_facets))
+    n_pieces, label = connected_components(graph, directed=False)
+    label = label[:m]
+    first = np.full(n_pieces, m, dtype=np.int64)
+    np.minimum.at(first, label, np.arange(m))
+    order = np.empty(n_pieces, dtype=np.int64)
+    order[np.argsort(first, kind="stable")] = np.arange(n_pieces)
+    return int(n_pieces), order[label]

@@ -1,0 +1,122 @@
+"""Where the numbers point to a mistake, a run ends in one line that names it, not in a solver
+failure: a body whose pieces meet only at a vertex or an edge (a hinge: a mechanism that the
+rigid-body check of the whole part does not see), loads far above what Young's modulus can carry
+(E given in MPa with loads in Pa), and a sliver cell that stalls Newton's method."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yaml
+
+from msslib import mesh as M
+from msslib.cli import main
+from msslib.scene import load_scene, prepare, run_scene
+
+MAT = {"E": 1.0e6, "nu": 0.3}
+CUBE = M.hex_grid(0.1, 0.1, 0.1, 1, 1, 1)  # node 7 at (0.1, 0.1, 0.1), nodes 5 and 7 on the edge x = z = 0.1
+
+
+def _two_cubes(offset) -> M.Mesh:
+    """The unit cube of edge 0.1 m and a copy moved by ``offset``, the nodes they share numbered once."""
+    moved = CUBE.points + np.asarray(offset, dtype=float)
+    points = list(CUBE.points)
+    index = []
+    for p in moved:
+        same = np.flatnonzero(np.all(np.isclose(CUBE.points, p), axis=1))
+        if len(same):
+            index.append(int(same[0]))
+        else:
+            index.append(len(points))
+            points.append(p)
+    return M.Mesh(np.array(points), np.vstack([CUBE.cells, np.array(index)[CUBE.cells]]), "hexahedron")
+
+
+def _scene(geometry, *, E=MAT["E"], loads=None, model="golec_cube", **changes) -> dict:
+    scene = {
+        "geometry": geometry,
+        "materials": [{"E": E, "nu": MAT["nu"]}],
+        "model": model,
+        "boundary": [{"select": {"plane": ["x", 0.0]}, "fix": "all"}],
+        "loads": loads if loads is not None else
+        [{"type": "traction", "select": {"plane": ["x", 0.2]}, "traction": [5.0e4, 0.0, 0.0]}],
+        "solver": {"type": "static", "load_steps": 1, "tol": 1.0e-10},
+    }
+    scene.update(changes)
+    return scene
+
+
+def _cli_error(tmp_path, capsys, scene: dict) -> str:
+    """Run the scene through the command line: it must fail with exactly one line."""
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(scene, sort_keys=False))
+    out = tmp_path / "out.nc"
+    assert main(["run", str(path), "--out", str(out), "--quiet"]) == 1
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("msslib: error: "), captured.err
+    assert not out.exists()
+    return lines[0]
+
+
+# --------------------------------------------------------------------------------------------
+# hinges: pieces that meet at a vertex or an edge
+# --------------------------------------------------------------------------------------------
+
+
+def test_pieces_joined_through_facets_vertices_and_edges():
+    face, edge, vertex = _two_cubes([0.1, 0, 0]), _two_cubes([0.1, 0, 0.1]), _two_cubes([0.1, 0.1, 0.1])
+    assert (face.n_nodes, edge.n_nodes, vertex.n_nodes) == (12, 14, 15)
+    for mesh, n in ((face, 1), (edge, 2), (vertex, 2)):
+        assert M.connected_parts(mesh)[0] == 1  # one part by shared nodes in every case
+        n_pieces, piece = M.topology.facet_connected_cells(mesh)
+        assert n_pieces == n and list(piece) == [0, n - 1]
+    grid = M.tet_grid(0.1, 0.1, 0.1, 2, 2, 2)
+    assert M.topology.facet_connected_cells(grid)[0] == 1
+
+
+def test_cube_hanging_on_a_corner_is_refused_naming_the_hinge(tmp_path, capsys):
+    M.write_vtu(tmp_path / "corner.vtu", _two_cubes([0.1, 0.1, 0.1]))
+    scene = _scene({"file": "corner.vtu"})
+    with pytest.raises(ValueError, match=r"scene\.boundary: the mesh \(2 hexahedron cells, node 0 at \(0, 0, 0\)\) is "
+                                         r"a mechanism: 1 hexahedron cell\(s\) hang on the rest only at node 7 at "
+                                         r"\(0\.1, 0\.1, 0\.1\), a hinge \(the cells there share no face\), and can "
+                                         r"turn about it \(3 free mode\(s\)\)"):
+        prepare(load_scene(scene, base_dir=tmp_path))
+    line = _cli_error(tmp_path, capsys, scene | {"geometry": {"file": str(tmp_path / "corner.vtu")}})
+    assert "node 7 at (0.1, 0.1, 0.1)" in line and "hinge" in line
+    # the hanging cube held too: no mechanism
+    mesh = M.read(tmp_path / "corner.vtu")
+    fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
+    fixed[np.isclose(mesh.points[:, 0], 0.0)] = True
+    (hinged,) = M.loose_parts(mesh, fixed)
+    assert (hinged.hinges, hinged.hanging_cells, hinged.n_free, hinged.floating) == ((7,), 1, 3, False)
+    fixed[np.isclose(mesh.points[:, 0], 0.2)] = True
+    assert M.loose_parts(mesh, fixed) == []
+
+
+def test_cube_hanging_on_an_edge_turns_about_it(tmp_path):
+    M.write_vtu(tmp_path / "edge.vtu", _two_cubes([0.1, 0, 0.1]))
+    with pytest.raises(ValueError, match=r"only at the edge from node 5 at \(0\.1, 0, 0\.1\) to node 7 at "
+                                         r"\(0\.1, 0\.1, 0\.1\), a hinge .*\(1 free mode\(s\)\)"):
+        prepare(load_scene(_scene({"file": "edge.vtu"}), base_dir=tmp_path))
+
+
+def test_triangles_meeting_at_a_vertex_in_2d():
+    points = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.2, 0.1], [0.2, 0.2], [0.0, 0.1]])
+    mesh = M.Mesh(points, np.array([[0, 1, 2], [0, 2, 5], [2, 3, 4]]), "triangle")
+    fixed = np.zeros((6, 2), dtype=bool)
+    fixed[[0, 5]] = True
+    (hinged,) = M.loose_parts(mesh, fixed)
+    assert (hinged.hinges, hinged.hanging_cells, hinged.n_free) == ((2,), 1, 1)
+    assert "share no edge" in hinged.describe(mesh)
+    fixed[4] = True
+    assert M.loose_parts(mesh, fixed) == []
+
+
+def test_cubes_sharing_a_face_solve_and_the_reaction_is_the_load(tmp_path):
+    M.write_vtu(tmp_path / "face.vtu", _two_cubes([0.1, 0, 0]))
+    ds = run_scene(load_scene(_scene({"file": "face.vtu"}), base_dir=tmp_path), progress=False)
+    reaction = ds["reaction_force"].values.sum(axis=0)
+    np.testing.assert_allclose(reaction, [-5.0e4 * 0.01, 0.0, 0.0], atol=1e-8 * 5.0e2)
+    assert 0 < ds["displacement"].values[:, 0].max() < 0.1 * 0.2
