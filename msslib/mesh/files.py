@@ -77,26 +77,33 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
          coincident_rtol: float = COINCIDENT_RTOL) -> Mesh:
     """Read any mesh file meshio can read.
 
-    The cells are the blocks of the highest-dimensional supported type (``tetra`` or
-    ``hexahedron`` before ``triangle`` or ``quad``; between two types of the same dimension the
-    one with more cells); blocks of that type are concatenated.  Nodes no chosen cell uses are
-    dropped (the others keep their order).  For 2D cells the z coordinate must be constant and is
+    The cells are the elements of the highest dimension in the file, which must all be of one
+    supported type (``tetra`` or ``hexahedron`` in 3D, ``triangle`` or ``quad`` in 2D); blocks of
+    that type are concatenated.  A mixed mesh (hexahedra with wedges or tetrahedra, triangles
+    with quads) or cells of another type (wedges, pyramids, quadratic cells) are refused, naming
+    the types, their counts and the cells that would be dropped; lower-dimensional elements
+    (facets, lines, vertices) are not cells of the mesh: they carry groups.  Nodes no chosen cell
+    uses are dropped (the others keep their order).  For 2D cells the z coordinate must be constant and is
     dropped.  ``cell_data[material_key]`` (one integer per cell), when present, becomes
     ``material``; otherwise every cell has material 0, also when the file has groups (the scenes
     assign materials by group, :func:`materials_from_groups`).  Two cells on the same nodes are
     an error (a gmsh 2 file repeats an element for every physical group it belongs to).
 
     Groups (:class:`Mesh`): the gmsh physical groups (``cell_data["gmsh:physical"]``, named by
-    ``field_data`` ``{name: [tag, dim]}``; a group without a name is known by its tag, ``"3"``;
-    meshio keeps one physical tag per element, the first) and meshio's ``cell_sets`` (gmsh 4
-    named groups, Abaqus ELSET, ...; sets named ``gmsh:...`` are meshio's bookkeeping and are
+    the file's ``$PhysicalNames`` with their dimension, since meshio's ``field_data``
+    ``{name: [tag, dim]}`` keeps one group of each name; a group without a name is known by its
+    tag, ``"3"``; meshio keeps one physical tag per element, the first) and meshio's
+    ``cell_sets`` (gmsh 4 named groups, Abaqus ELSET, ...; sets named ``gmsh:...`` are meshio's bookkeeping and are
     skipped) become ``cell_groups`` for elements of the chosen cell type, ``facet_groups`` for
     elements of its facet type (lines in 2D, triangles for tetra, quads for hexahedron cells) and
     ``node_groups`` (the nodes of the elements) for other lower-dimensional elements (gmsh
     physical points and curves of a 3D mesh, triangles of a hexahedron mesh); meshio's
     ``point_sets`` (Abaqus NSET, Exodus node sets) become ``node_groups``.  A group of the same
-    name from both sources is their union.  Elements of other types of the cells' dimension and
-    of higher dimensions are ignored, with their groups.  A facet or node group on a node no chosen
+    name from both sources is their union.  Groups of different dimensions with one name (a
+    physical surface and a physical volume both called ``body``) are kept apart, one group of each
+    kind: a scene's ``select: {group: body}`` (boundary conditions, tractions) takes the facet
+    group, else the node group, with a :class:`msslib.errors.MsslibWarning` naming the ambiguity,
+    and materials keyed by ``body`` take the cell group.  A facet or node group on a node no chosen
     cell uses is dropped with a :class:`msslib.errors.MsslibWarning` naming it (it could not carry
     its load or support).  VTU files hold no sets (meshio writes them as cell data it cannot split
     back reliably): their groups come from a ``gmsh:physical`` cell data array, by number.
@@ -108,9 +115,9 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
 
     Raises FileNotFoundError for a missing file, and a one-line ValueError naming the file for
     everything else: a directory, an unknown suffix (listing the suffixes meshio knows), an empty
-    or unreadable file (whatever meshio raises, :class:`SystemExit` included), no cells or no
-    supported cell type (naming the types found), cells referring to nodes that do not exist,
-    non-finite coordinates, material values that are not integers, duplicate cells, a cell
+    or unreadable file (whatever meshio raises, :class:`SystemExit` included), no cells, no
+    supported cell type or cells of several types (naming the types found), cells referring to
+    nodes that do not exist, non-finite coordinates, material values that are not integers, duplicate cells, a cell
     collapsed by merging.
     """
     if coincident_nodes not in COINCIDENT_POLICIES:
@@ -162,11 +169,7 @@ def _mesh_from_meshio(path: Path, m, material_key: str):
     supported = [t for t in CELL_TYPES if t in found]
     if not supported:
         raise ValueError(f"{path}: no supported cell type; found {sorted(set(found))}, supported {sorted(CELL_TYPES)}")
-
-    def rank(t):
-        return CELL_TYPES[t][0], sum(len(b.data) for b in m.cells if b.type == t)
-
-    cell_type = max(supported, key=rank)
+    cell_type = _one_cell_type(path, blocks_all)
     dim = CELL_TYPES[cell_type][0]
     blocks = [k for k, b in enumerate(m.cells) if b.type == cell_type and len(b.data)]
     cells = np.concatenate([np.asarray(m.cells[k].data).reshape(len(m.cells[k].data), -1) for k in blocks])
@@ -198,7 +201,7 @@ def _mesh_from_meshio(path: Path, m, material_key: str):
         material = np.rint(values).astype(np.int64)
     _check_duplicate_cells(path, cells, cell_type)
     used = np.unique(cells)  # file numbers of the nodes the cells use, ascending
-    groups, notes = _file_groups(m, cell_type, blocks, used)
+    groups, notes = _file_groups(m, cell_type, blocks, used, _gmsh_physical_names(path))
     points = points[used]
     cells = np.searchsorted(used, cells)
     bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
@@ -216,6 +219,41 @@ def _mesh_from_meshio(path: Path, m, material_key: str):
     return Mesh(points, cells, cell_type, material, **groups), used, notes
 
 
+#: plural of the cell types in messages
+_PLURAL = {"tetra": "tetrahedra", "hexahedron": "hexahedra", "wedge": "wedges", "pyramid": "pyramids",
+           "triangle": "triangles", "quad": "quads", "polygon": "polygons"}
+
+
+def _one_cell_type(path: Path, blocks) -> str:
+    """The cell type of the mesh: the type of the cells of the highest dimension in the file (the
+    lower-dimensional elements carry groups).  Cells of that dimension of two or more types (a
+    mixed mesh: hexahedra with wedges or tetrahedra, triangles with quads), or of a type msslib
+    has no model for (wedges, pyramids, quadratic cells), are a ValueError naming the types, how
+    many cells of each there are and how many would be dropped."""
+    counts = {}
+    for block in blocks:
+        bdim = _block_dim(block.type)
+        if bdim is not None:
+            counts.setdefault(bdim, {})
+            counts[bdim][block.type] = counts[bdim].get(block.type, 0) + len(block.data)
+    dim = max(counts)
+    of_dim = sorted(counts[dim].items(), key=lambda item: (-item[1], item[0]))
+    kept = [t for t, _ in of_dim if t in CELL_TYPES]
+    if len(of_dim) == 1 and kept:
+        return kept[0]
+    shown = " and ".join(f"{n} {_PLURAL.get(t, t + ' cells') if n != 1 else t}" for t, n in of_dim)
+    allowed = " or all ".join(t for t in CELL_TYPES if CELL_TYPES[t][0] == dim) if dim in (2, 3) else "one type"
+    if kept:
+        dropped = " and ".join(f"{n} {_PLURAL.get(t, t + ' cells') if n != 1 else t}" for t, n in of_dim
+                               if t != kept[0])
+        what = (f"its {dim}D cells are of {len(of_dim)} types; msslib's meshes and models have cells of one type, "
+                f"so keeping the {kept[0]} cells would drop {dropped}")
+    else:
+        what = f"msslib has no model for {' or '.join(t for t, _ in of_dim)} cells"
+    raise ValueError(f"{path}: the mesh has {shown}: {what}; allowed: {dim}D cells all {allowed} (lower-dimensional "
+                     f"elements carry groups)")
+
+
 def _check_duplicate_cells(path: Path, cells: np.ndarray, cell_type: str) -> None:
     """Two cells on the same nodes (in any order) are a ValueError naming both."""
     if len(cells) < 2:
@@ -230,6 +268,40 @@ def _check_duplicate_cells(path: Path, cells: np.ndarray, cell_type: str) -> Non
         raise ValueError(f"{path}: {cell_type} cells {int(first[inverse[c]])} and {c} have the same nodes ({len(dup)} "
                          f"duplicate cell(s)); allowed: each cell once (a gmsh 2 file repeats an element for every "
                          f"physical group it belongs to: save it in gmsh format 4 or put each element in one group)")
+
+
+#: the sections of a gmsh file that follow $PhysicalNames (where the search for it stops)
+_GMSH_LATER_SECTIONS = (b"$Entities", b"$PartitionedEntities", b"$Nodes", b"$Elements")
+
+
+def _gmsh_physical_names(path: Path) -> dict | None:
+    """``{(dim, tag): name}`` of every physical group in the ``$PhysicalNames`` section of a gmsh
+    file (text in ASCII and binary files alike), or None for a file that is not a gmsh file.
+
+    meshio keeps these names in ``field_data``, a dict keyed by name: of a physical surface and a
+    physical volume of one name it keeps only one, and the elements of the other would lose their
+    name (and be known by their number).  Only the start of the file is read."""
+    try:
+        with open(path, "rb") as f:
+            if f.readline().strip() != b"$MeshFormat":
+                return None
+            for line in f:
+                line = line.strip()
+                if line == b"$PhysicalNames":
+                    break
+                if line in _GMSH_LATER_SECTIONS:
+                    return {}
+            else:
+                return {}
+            names = {}
+            for _ in range(int(f.readline())):
+                dim, tag, name = f.readline().decode("utf-8").strip().split(maxsplit=2)
+                if len(name) >= 2 and name[0] == name[-1] == '"':
+                    name = name[1:-1]
+                names[(int(dim), int(tag))] = name
+            return names
+    except (OSError, ValueError):  # meshio has read the file: keep its names
+        return None
 
 
 #: topological dimension of meshio cell types that may carry groups (others are looked up in meshio)
@@ -251,10 +323,13 @@ def _block_dim(cell_type: str) -> int | None:
     return topological_dimension.get(cell_type)
 
 
-def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray) -> tuple[dict, list]:
+def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray,
+                 physical_names: dict | None = None) -> tuple[dict, list]:
     """The groups of a meshio mesh (see :func:`read`) as keyword arguments of :class:`Mesh` (cell
     indices into the concatenated ``blocks``, node indices into ``used``), and the notes on the
-    groups dropped because they touch nodes no chosen cell uses."""
+    groups dropped because they touch nodes no chosen cell uses.  ``physical_names``: the
+    ``{(dim, tag): name}`` of a gmsh file (:func:`_gmsh_physical_names`), which name the physical
+    groups that meshio's ``field_data`` lost."""
     dim = CELL_TYPES[cell_type][0]
     offsets = {}
     start = 0
@@ -266,6 +341,7 @@ def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray) -> tuple[dic
         value = np.asarray(value).ravel()
         if value.size == 2 and value.dtype.kind in "iu":
             names[(int(value[1]), int(value[0]))] = str(name)
+    names.update(physical_names or {})  # the file's own list: meshio keeps one group of each name
     physical = (m.cell_data or {}).get("gmsh:physical")
     cell_sets = {str(k): v for k, v in (m.cell_sets or {}).items() if not str(k).startswith("gmsh:")}
     cells_acc, facets_acc, nodes_acc = {}, {}, {}

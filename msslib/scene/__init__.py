@@ -129,8 +129,10 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     ``all``, or a mapping with ``plane: [axis, value]`` (axis ``x``, ``y`` or ``z``),
     ``box: [[xmin, ...], [xmax, ...]]`` (``null`` = unbounded, either corner may be ``null``)
     and/or ``group: NAME`` (a group of the mesh file: the nodes of its facets, or its nodes, or
-    for a group of cells the nodes of those cells; a name that is a group of cells and also of
-    facets or nodes selects the latter, with a warning); with several, the intersection, e.g.
+    for a group of cells the nodes of those cells; a name that is a group of more than one kind,
+    such as a gmsh physical surface and a physical volume both called ``body``, selects its
+    facets, else its nodes, with a warning, while ``materials`` keyed by it take its cells); with
+    several, the intersection, e.g.
     ``{group: top, box: [[0.0, null, null], [0.05, null, null]]}``.  ``tol`` (m) widens the
     bounds; default ``1e-8`` times the diagonal of the mesh's bounding box.  Selecting no node is
     an error, and so is a group the mesh lacks (naming the groups it has).

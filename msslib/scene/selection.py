@@ -93,21 +93,27 @@ def _no_group(mesh, key, kind=None) -> str:
 
 def _group_members(path, mesh, key):
     """``(kind, members, nodes)`` of the group ``key`` for a selection: its boundary facets
-    (``kind`` "facets", ``members`` the facets) or nodes ("nodes", None) when it is a group of
-    facets or nodes, else its cells ("cells", the cell indices); ``nodes`` the sorted nodes."""
-    in_facets, in_nodes, in_cells = (key in g for g in (mesh.facet_groups, mesh.node_groups, mesh.cell_groups))
-    if not (in_facets or in_nodes or in_cells):
+    (``kind`` "facets", ``members`` the facets), else its nodes ("nodes", None), else its cells
+    ("cells", the cell indices); ``nodes`` the sorted nodes.  A name that is a group of more than
+    one kind (gmsh physical groups of different dimensions with one name) takes the first of
+    facets, nodes, cells, with a warning naming the kinds (materials take the group of cells)."""
+    kinds = [kind for kind, groups in (("boundary facets", mesh.facet_groups), ("nodes", mesh.node_groups),
+                                       ("cells", mesh.cell_groups)) if key in groups]
+    if not kinds:
         _fail(path, _no_group(mesh, key))
-    if in_facets or in_nodes:
-        if in_cells:
-            from msslib.errors import MsslibWarning
+    if len(kinds) > 1:
+        from msslib.errors import MsslibWarning
 
-            used = "boundary facets" if in_facets else "nodes"
-            warnings.warn(f"{path}: {key!r} names a group of cells and a group of {used} of the mesh; the group of "
-                          f"{used} is selected", MsslibWarning, stacklevel=3)
-        facets = mesh.facet_groups.get(key)
-        parts = ([facets.ravel()] if in_facets else []) + ([mesh.node_groups[key]] if in_nodes else [])
-        return ("facets" if in_facets else "nodes"), facets, np.unique(np.concatenate(parts))
+        named = [kind for kind in ("cells", "boundary facets", "nodes") if kind in kinds]
+        cells = ", materials take the group of cells" if "cells" in kinds else ""
+        warnings.warn(f"{path}: {key!r} names a group of {' and a group of '.join(named)} of the mesh (groups of "
+                      f"different dimensions with one name); the group of {kinds[0]} is selected{cells}",
+                      MsslibWarning, stacklevel=3)
+    if kinds[0] == "boundary facets":
+        facets = mesh.facet_groups[key]
+        return "facets", facets, np.unique(facets.ravel())
+    if kinds[0] == "nodes":
+        return "nodes", None, mesh.node_groups[key]
     cells = mesh.cell_groups[key]
     return "cells", cells, np.unique(mesh.cells[cells])
 
