@@ -54,6 +54,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .mesh import CELL_TYPES, Mesh, check_cells
+from .models.fem import warn_locking
 
 __all__ = [
     "FemResult",
@@ -336,6 +337,7 @@ def solve_linear(
     if thickness <= 0:
         raise ValueError(f"thickness={thickness!r} must be > 0")
     E_c, nu_c = _cell_materials(mesh, E, nu)
+    warn_locking(mesh, nu_c, plane)
     lam_c, mu_c = lame(E_c, nu_c, plane if mesh.dim == 2 else None)
     geo = _Geometry(mesh)
     w = thickness if mesh.dim == 2 else 1.0
@@ -555,6 +557,7 @@ def solve_nonlinear(
     if thickness <= 0:
         raise ValueError(f"thickness={thickness!r} must be > 0")
     E_c, nu_c = _cell_materials(mesh, E, nu)
+    warn_locking(mesh, nu_c, plane)
     lam_c, mu_c = lame(E_c, nu_c)  # 3D constants; plane stress handled inside the law
     geo = _Geometry(mesh)
     w = thickness if d == 2 else 1.0

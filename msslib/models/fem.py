@@ -4,9 +4,13 @@ and neo-Hookean, on every cell type.  They build no force terms: scenes solve th
 
 from __future__ import annotations
 
+import warnings
+
+import numpy as np
+
 from msslib.models.spec import ModelSpec, Option, choice
 
-__all__: list = []
+__all__: list = []  # no spring-constant formulas (msslib.parameters gathers the families' __all__)
 
 #: place in the registry's order
 RANK = 0
@@ -29,3 +33,26 @@ SPECS = (
     _spec("fem_svk", "svk", "St Venant-Kirchhoff"),
     _spec("fem_neohookean", "neohookean", "compressible neo-Hookean"),
 )
+
+
+#: at and above this Poisson's ratio a FEM solve warns that its linear elements lock
+LOCKING_NU = 0.45
+_ELEMENT_NAMES = {"triangle": "P1 triangles", "quad": "Q1 quadrilaterals with full 2x2 integration",
+                  "tetra": "P1 tetrahedra", "hexahedron": "Q1 hexahedra with full 2x2x2 integration"}
+
+
+def warn_locking(mesh, nu_c, plane) -> None:
+    """One :class:`msslib.errors.MsslibWarning` (called once per solve of :mod:`msslib.fem`) when a
+    cell's nu ``nu_c`` is at least :data:`LOCKING_NU`: the displacement-only linear elements lock
+    as nu -> 1/2 (volumetric locking; not in 2D plane stress, ``plane="stress"``, whose in-plane
+    response stays compressible)."""
+    from msslib.errors import MsslibWarning
+
+    nu_max = float(np.max(nu_c)) if np.size(nu_c) else 0.0
+    if nu_max < LOCKING_NU or (mesh.dim == 2 and plane == "stress"):
+        return
+    warnings.warn(f"linear-element FEM locks near nu = 1/2 (nu = {nu_max:.6g}, {_ELEMENT_NAMES[mesh.cell_type]}): "
+                  f"its displacements are too small, by a factor that depends on the mesh (a clamped cube of "
+                  f"3^3 hexahedra at nu = 0.4999 settles 3.7 times less than one of 6^3); use nu < {LOCKING_NU} "
+                  f"where the material allows, check that refining the mesh no longer changes the result, or use "
+                  f"mixed (u-p) or higher-order elements outside msslib", MsslibWarning, stacklevel=3)
