@@ -12,7 +12,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .core import COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _compact, _fmt_point
+from .core import _LOCAL_EDGES, _LOCAL_FACETS, COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _compact, _fmt_point
+from .geometry import cell_measures
 from .groups import _renumbered_groups
 from .topology import facet_connected_cells
 
@@ -377,3 +378,39 @@ def _mechanism(mesh: Mesh, fixed: np.ndarray, in_part: np.ndarray, rtol: float):
     on_moving = np.isin(node_piece[:, 1], moving)
     hinge_nodes = np.intersect1d(shared_nodes[counts > 1], node_piece[on_moving, 0])
     return a.shape[1] - rank, tuple(int(i) for i in hinge_nodes), int(np.isin(piece, moving).sum())
+
+
+def cell_shapes(mesh: Mesh) -> tuple[np.ndarray, np.ndarray | None]:
+    """The shape of each cell: ``(aspect, angle)``.
+
+    ``aspect`` is the longest edge over the smallest height, the height over a facet being the
+    cell's measure over the facet's (simplices: ``dim`` times it): 1 for a square or a cube, 1.15
+    for an equilateral triangle, 1.22 for a regular tetrahedron, about ``1 / sin(a)`` for a
+    triangle of smallest angle ``a`` (of the order of it for any triangle); infinite for a cell of zero measure.  ``angle`` is the
+    smallest angle of each triangle in degrees (None for other cells).  A sliver has a large
+    aspect ratio: its stiffness across the short side dwarfs that of its neighbours.
+    """
+    x = mesh.points[mesh.cells]
+    edges = x[:, _LOCAL_EDGES[mesh.cell_type][:, 1]] - x[:, _LOCAL_EDGES[mesh.cell_type][:, 0]]
+    longest = np.linalg.norm(edges, axis=2).max(axis=1, initial=0.0)
+    facets = x[:, _LOCAL_FACETS[mesh.cell_type]]  # (m, n_facets, nodes per facet, dim)
+    if mesh.dim == 2:
+        facet = np.linalg.norm(facets[:, :, 1] - facets[:, :, 0], axis=2)
+    elif facets.shape[2] == 3:
+        facet = 0.5 * np.linalg.norm(np.cross(facets[:, :, 1] - facets[:, :, 0], facets[:, :, 2] - facets[:, :, 0]),
+                                     axis=2)
+    else:
+        facet = 0.5 * np.linalg.norm(np.cross(facets[:, :, 2] - facets[:, :, 0], facets[:, :, 3] - facets[:, :, 1]),
+                                     axis=2)
+    simplex = mesh.cell_type in ("triangle", "tetra")
+    measure = np.abs(cell_measures(mesh)) * (mesh.dim if simplex else 1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        aspect = np.where(measure > 0, longest * facet.max(axis=1, initial=0.0) / measure, np.inf)
+    if mesh.cell_type != "triangle":
+        return aspect, None
+    angles = []
+    for k in range(3):
+        a, b = x[:, (k + 1) % 3] - x[:, k], x[:, (k + 2) % 3] - x[:, k]
+        cross = np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
+        angles.append(np.degrees(np.arctan2(cross, np.einsum("ij,ij->i", a, b))))
+    return aspect, np.min(angles, axis=0)
