@@ -126,6 +126,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         exc = _NewtonFailure(reason)
         exc.iteration = it
         exc.residual = rnorm
+        exc.x, exc.r = x, r  # the failing iterate and its free residual, for the hint of the message
         return exc
 
     def target():
@@ -305,13 +306,17 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
                 dlam = 0.5 * (target - lam)
                 if cuts_this_step >= max_cuts or dlam < nominal * 0.5**max_cuts * (1.0 - 1e-12):
                     k = int(np.floor(lam / nominal + 1e-9)) + 1  # the nominal step it belongs to
+                    from msslib.hints import failure_hint
+
+                    hint = failure_hint(problem, getattr(exc, "x", x), getattr(exc, "r", None), free)
                     raise ConvergenceError(
                         f"static_solve did not converge: load step {step_index} (nominal step {k} of {load_steps}), "
                         f"load factor {target:.6g} "
                         f"(last converged load factor {lam:.6g}, increment {target - lam:.3g} after "
                         f"{cuts_this_step} halvings), iteration {exc.iteration}, residual {exc.residual:.3e} "
                         f"(threshold {convergence_threshold(tol, scale, scales['floor']):.3e} = max(tol {tol:.1e} "
-                        f"x F_ref {scale:.3e}, round-off floor {_floor_text(scales['floor'])})): {exc}",
+                        f"x F_ref {scale:.3e}, round-off floor {_floor_text(scales['floor'])})): {exc}"
+                        + (f"; {hint}" if hint else ""),
                         load_step=step_index, load=target, iteration=exc.iteration, residual=exc.residual,
                         x_last=x.copy(),
                     ) from None
