@@ -120,3 +120,52 @@ def test_cubes_sharing_a_face_solve_and_the_reaction_is_the_load(tmp_path):
     reaction = ds["reaction_force"].values.sum(axis=0)
     np.testing.assert_allclose(reaction, [-5.0e4 * 0.01, 0.0, 0.0], atol=1e-8 * 5.0e2)
     assert 0 < ds["displacement"].values[:, 0].max() < 0.1 * 0.2
+
+
+# --------------------------------------------------------------------------------------------
+# a sliver that stalls Newton's method (Delingette's triangle)
+# --------------------------------------------------------------------------------------------
+
+
+def _plate_with_sliver(height: float) -> M.Mesh:
+    """A 4 x 2 plate of right triangles (0.04 x 0.02 m) and one more triangle on its lower edge,
+    cell 16 (nodes 1, 15, 2): the apex, node 15, ``height`` below the midpoint of that edge."""
+    plate = M.triangle_grid_right(0.04, 0.02, 4, 2)
+    points = np.vstack([plate.points, [[0.015, -height]]])
+    return M.Mesh(points, np.vstack([plate.cells, [[1, 15, 2]]]), "triangle")
+
+
+def _plate_scene(path) -> dict:
+    return {"model": "delingette_triangle", "geometry": {"file": str(path)},
+            "materials": [{"E": 1.0e4, "nu": 0.3}], "thickness": 0.01,
+            "boundary": [{"select": {"plane": ["x", 0.0]}, "fix": "all"}],
+            "loads": [{"type": "traction", "select": {"plane": ["x", 0.04]}, "traction": [1000.0, 0.0]}],
+            "solver": {"type": "static", "load_steps": 1, "tol": 1.0e-10}}
+
+
+def test_cell_shapes_of_regular_cells_and_a_sliver():
+    aspect, angle = M.hygiene.cell_shapes(_plate_with_sliver(1e-6))
+    assert aspect[:16] == pytest.approx(2.0) and angle[:16] == pytest.approx(45.0)  # right isosceles
+    # the sliver: base 0.01 m, height 1e-6 m: longest edge / height = 1e4, base angles atan(1e-6 / 0.005)
+    assert aspect[16] == pytest.approx(1.0e4, rel=1e-6)
+    assert angle[16] == pytest.approx(np.degrees(np.arctan(2.0e-4)), rel=1e-6)
+    cube, _ = M.hygiene.cell_shapes(M.hex_grid(0.1, 0.2, 0.1, 1, 1, 1))
+    assert cube == pytest.approx([2.0])  # 0.2 / 0.1
+
+
+def test_sliver_that_stalls_delingette_is_named(tmp_path, capsys):
+    from msslib.errors import ConvergenceError
+
+    M.write_vtu(tmp_path / "sliver.vtu", _plate_with_sliver(1e-6))
+    scene = _plate_scene(tmp_path / "sliver.vtu")
+    with pytest.raises(ConvergenceError, match=r"line search failed.*triangle cell 16 \(nodes 1, 15, 2\), a sliver "
+                                               r"\(smallest angle 0\.0115 deg, aspect ratio 1e\+04\)"):
+        run_scene(load_scene(scene), progress=False)
+    assert "triangle cell 16 (nodes 1, 15, 2), a sliver" in _cli_error(tmp_path, capsys, scene)
+
+
+def test_well_shaped_extra_triangle_solves_and_the_reaction_is_the_load(tmp_path):
+    M.write_vtu(tmp_path / "plate.vtu", _plate_with_sliver(0.005))
+    ds = run_scene(load_scene(_plate_scene(tmp_path / "plate.vtu")), progress=False)
+    # traction 1000 Pa on the edge x = 0.04 (0.02 m long, 0.01 m thick): 0.2 N
+    np.testing.assert_allclose(ds["reaction_force"].values.sum(axis=0), [-0.2, 0.0], atol=1e-9)
