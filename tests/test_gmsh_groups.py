@@ -1,0 +1,189 @@
+"""gmsh physical groups of different dimensions with one name: msslib.mesh.read keeps each (meshio
+keys the names by name and keeps one), and a scene selects the facet group for boundary conditions
+and tractions (with a warning naming the ambiguity) and the cell group for materials.  The loads
+are checked against the traction times the area of the loaded face."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from msslib import mesh as M
+from msslib.errors import MsslibWarning
+from msslib.scene import load_scene, prepare, run_scene
+
+gmsh = pytest.importorskip("gmsh")
+
+MAT = {"E": 1.0e6, "nu": 0.3}
+LX, LY, LZ = 2.0, 1.0, 1.0  # the box; its top face z = LZ has the area LX * LY = 2 m^2
+TRACTION = np.array([300.0, -200.0, -1.0e3])
+
+
+def _start(name):
+    gmsh.initialize(readConfigFiles=False, interruptible=False)
+    for option, value in (("General.Terminal", 0), ("General.NumThreads", 1), ("Mesh.RandomSeed", 0)):
+        gmsh.option.setNumber(option, value)
+    gmsh.model.add(name)
+
+
+def _entities_at(dim, axis, value):
+    """Tags of the entities of dimension ``dim`` whose centre of mass has coordinate ``value``."""
+    return [t for _, t in gmsh.model.getEntities(dim)
+            if abs(gmsh.model.occ.getCenterOfMass(dim, t)[axis] - value) < 1e-9]
+
+
+def _write(path: Path, version: float, binary: bool) -> Path:
+    gmsh.option.setNumber("Mesh.MshFileVersion", version)
+    gmsh.option.setNumber("Mesh.Binary", int(binary))
+    gmsh.write(str(path))
+    return path
+
+
+def _box(path: Path, version: float = 4.1, binary: bool = False, all_dims: bool = False) -> Path:
+    """The box [0, LX] x [0, LY] x [0, LZ] in tetrahedra: the physical volume "body", the physical
+    surface "body" (the top face z = LZ) and the physical surface "base" (z = 0); with
+    ``all_dims`` also the physical curve "body" (the top edge y = 0, z = LZ) and the physical
+    point "body" (the corner (LX, LY, LZ))."""
+    _start("box")
+    try:
+        occ = gmsh.model.occ
+        volume = occ.addBox(0, 0, 0, LX, LY, LZ)
+        occ.synchronize()
+        gmsh.model.addPhysicalGroup(3, [volume], name="body")
+        gmsh.model.addPhysicalGroup(2, _entities_at(2, 2, LZ), name="body")
+        gmsh.model.addPhysicalGroup(2, _entities_at(2, 2, 0.0), name="base")
+        if all_dims:
+            edge = [t for t in _entities_at(1, 2, LZ) if abs(occ.getCenterOfMass(1, t)[1]) < 1e-9]
+            gmsh.model.addPhysicalGroup(1, edge, name="body")
+            corner = [t for _, t in gmsh.model.getEntities(0)
+                      if np.allclose(gmsh.model.getValue(0, t, []), [LX, LY, LZ])]
+            gmsh.model.addPhysicalGroup(0, corner, name="body")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.5)
+        gmsh.model.mesh.generate(3)
+        return _write(path, version, binary)
+    finally:
+        gmsh.finalize()
+
+
+def _plate(path: Path) -> Path:
+    """The 2D plate [0, 2] x [0, 1] in triangles: the physical surface "plate", the physical
+    curve "plate" (the right edge x = 2, length 1) and the physical curve "left" (x = 0)."""
+    _start("plate")
+    try:
+        occ = gmsh.model.occ
+        surface = occ.addRectangle(0, 0, 0, 2.0, 1.0)
+        occ.synchronize()
+        gmsh.model.addPhysicalGroup(2, [surface], name="plate")
+        gmsh.model.addPhysicalGroup(1, _entities_at(1, 0, 2.0), name="plate")
+        gmsh.model.addPhysicalGroup(1, _entities_at(1, 0, 0.0), name="left")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.25)
+        gmsh.model.mesh.generate(2)
+        return _write(path, 4.1, False)
+    finally:
+        gmsh.finalize()
+
+
+def _scene_file(tmp_path: Path, mesh_file: str, select: str = "body") -> Path:
+    data = {"geometry": {"file": mesh_file}, "materials": {"body": MAT}, "model": "fem_linear",
+            "boundary": [{"select": {"group": "base"}, "fix": "all"}],
+            "loads": [{"type": "traction", "select": {"group": select}, "traction": TRACTION.tolist()}]}
+    out = tmp_path / "scene.yaml"
+    out.write_text(yaml.safe_dump(data, sort_keys=False))
+    return out
+
+
+@pytest.mark.parametrize("version, binary", [(4.1, False), (4.1, True), (2.2, False)])
+def test_surface_and_volume_of_one_name_are_both_kept(tmp_path, version, binary):
+    mesh = M.read(_box(tmp_path / "box.msh", version, binary))
+    assert mesh.cell_type == "tetra"
+    assert set(mesh.cell_groups) == {"body"} and set(mesh.facet_groups) == {"body", "base"}
+    np.testing.assert_array_equal(mesh.cell_groups["body"], np.arange(mesh.n_cells))
+    top = mesh.facet_groups["body"]
+    np.testing.assert_allclose(mesh.points[top][..., 2], LZ, atol=1e-12)
+    assert M.facet_areas(mesh, top).sum() == pytest.approx(LX * LY, rel=1e-12)
+    assert M.cell_measures(mesh).sum() == pytest.approx(LX * LY * LZ, rel=1e-12)
+
+
+def test_traction_on_the_surface_of_a_shared_name_loads_that_face_alone(tmp_path):
+    """The reaction at the clamped base balances the traction on the top face (2 m^2), not on the
+    whole boundary of the volume of the same name (10 m^2)."""
+    _box(tmp_path / "box.msh")
+    scene = load_scene(_scene_file(tmp_path, "box.msh"))
+    with pytest.warns(MsslibWarning, match=r"loads\[0\]\.select\.group: 'body' names a group of cells and a group "
+                                           r"of boundary facets of the mesh .*the group of boundary facets is "
+                                           r"selected, materials take the group of cells"):
+        setup = prepare(scene)
+    np.testing.assert_allclose(setup.surface_forces.sum(axis=0), TRACTION * LX * LY, rtol=1e-12)
+    loaded = np.flatnonzero(np.abs(setup.surface_forces).sum(axis=1) > 0)
+    np.testing.assert_allclose(setup.mesh.points[loaded, 2], LZ, atol=1e-12)
+    np.testing.assert_array_equal(setup.mesh.material, 0)  # materials: the cell group, every cell
+
+    with pytest.warns(MsslibWarning, match="'body' names a group of cells and a group of boundary facets"):
+        ds = run_scene(scene, progress=False)
+    z = setup.mesh.points[:, 2]
+    reaction = ds["reaction_force"].values
+    np.testing.assert_allclose(reaction[np.abs(z) < 1e-12].sum(axis=0), -TRACTION * LX * LY, rtol=1e-6,
+                               atol=1e-6 * np.abs(TRACTION).max())
+    np.testing.assert_allclose(reaction[np.abs(z) > 1e-12], 0.0, atol=1e-9)
+
+
+def test_groups_of_dimension_0_to_3_of_one_name(tmp_path):
+    """A point, a curve, a surface and a volume all called "body": the cells, the facets of the
+    surface and the nodes of the point and the curve; a selection takes the facets."""
+    mesh = M.read(_box(tmp_path / "box.msh", all_dims=True))
+    assert set(mesh.cell_groups) == {"body"} and set(mesh.facet_groups) == {"body", "base"}
+    assert set(mesh.node_groups) == {"body"}
+    nodes = mesh.points[mesh.node_groups["body"]]
+    np.testing.assert_allclose(nodes[:, 2], LZ, atol=1e-12)  # the top edge y = 0 and the corner (LX, LY)
+    assert np.all((np.abs(nodes[:, 1]) < 1e-12) | np.all(np.abs(nodes - [LX, LY, LZ]) < 1e-12, axis=1))
+    assert np.any(np.all(np.abs(nodes - [LX, LY, LZ]) < 1e-12, axis=1))
+    assert M.facet_areas(mesh, mesh.facet_groups["body"]).sum() == pytest.approx(LX * LY, rel=1e-12)
+
+    scene = load_scene(_scene_file(tmp_path, "box.msh"))
+    with pytest.warns(MsslibWarning, match=r"'body' names a group of cells and a group of boundary facets and a "
+                                           r"group of nodes of the mesh .*the group of boundary facets is selected"):
+        setup = prepare(scene)
+    np.testing.assert_allclose(setup.surface_forces.sum(axis=0), TRACTION * LX * LY, rtol=1e-12)
+
+    data = yaml.safe_load((tmp_path / "scene.yaml").read_text())
+    data["boundary"].append({"select": {"group": "body"}, "fix": ["x"]})
+    with pytest.warns(MsslibWarning) as record:
+        fixed = prepare(load_scene(data, base_dir=tmp_path)).fixed
+    said = [str(w.message) for w in record]
+    assert any(re.search(r"boundary\[1\]\.select\.group: 'body' names .*boundary facets is selected", s) for s in said)
+    top_nodes = np.unique(mesh.facet_groups["body"])
+    base_nodes = np.unique(mesh.facet_groups["base"])
+    np.testing.assert_array_equal(np.flatnonzero(fixed[:, 0]), np.union1d(top_nodes, base_nodes))
+
+
+def test_2d_surface_and_curve_of_one_name(tmp_path):
+    """The traction on the curve "plate" (length 1 m, thickness 0.01 m), not on the whole outline of
+    the surface "plate" (6 m)."""
+    _plate(tmp_path / "plate.msh")
+    data = {"geometry": {"file": "plate.msh"}, "thickness": 0.01, "materials": {"plate": MAT}, "model": "fem_linear",
+            "boundary": [{"select": {"group": "left"}}],
+            "loads": [{"type": "traction", "select": {"group": "plate"}, "traction": [1.0e4, 500.0]}]}
+    scene = load_scene(data, base_dir=tmp_path)
+    with pytest.warns(MsslibWarning, match="'plate' names a group of cells and a group of boundary facets"):
+        setup = prepare(scene)
+    np.testing.assert_allclose(setup.surface_forces.sum(axis=0), [1.0e4 * 0.01, 500.0 * 0.01], rtol=1e-12)
+    loaded = np.flatnonzero(np.abs(setup.surface_forces).sum(axis=1) > 0)
+    np.testing.assert_allclose(setup.mesh.points[loaded, 0], 2.0, atol=1e-12)
+    with pytest.warns(MsslibWarning, match="'plate' names"):
+        ds = run_scene(scene, progress=False)
+    x = setup.mesh.points[:, 0]
+    np.testing.assert_allclose(ds["reaction_force"].values[np.abs(x) < 1e-12].sum(axis=0), [-100.0, -5.0],
+                               rtol=1e-6)
+
+
+def test_materials_of_a_name_that_is_only_a_facet_group_are_refused(tmp_path):
+    """Materials take cell groups only: "base" is a surface, not a group of cells."""
+    _box(tmp_path / "box.msh")
+    data = yaml.safe_load(_scene_file(tmp_path, "box.msh").read_text())
+    data["materials"] = {"base": MAT}
+    with pytest.raises(ValueError, match=r"scene\.materials\.base: the mesh has no cell group 'base'"):
+        prepare(load_scene(data, base_dir=tmp_path))
