@@ -128,6 +128,9 @@ def prepare(scene: Scene) -> Setup:
             traction = _check_dim(f"{p}.traction", load["traction"], dim)
             loaded = _loaded_facets(f"{p}.select", mesh, load["select"], default_tol, facet_cache)
             surface += Traction(mesh, loaded, traction, thickness if dim == 2 else 1.0).nodal
+    from msslib.hints import check_load_scale  # a load far above E (E in MPa, loads in Pa) is refused
+
+    check_load_scale(mesh, scene.loads, [m.E for m in scene.materials], cell_density, thickness, fixed.any())
 
     setup = Setup(scene=scene, mesh=mesh, fixed=fixed, prescribed=prescribed, surface_forces=surface,
                   gravity=gravity, cell_density=cell_density, masses=masses)
