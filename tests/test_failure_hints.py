@@ -11,6 +11,7 @@ import yaml
 
 from msslib import mesh as M
 from msslib.cli import main
+from msslib.errors import MsslibWarning
 from msslib.scene import load_scene, prepare, run_scene
 
 MAT = {"E": 1.0e6, "nu": 0.3}
@@ -120,6 +121,75 @@ def test_cubes_sharing_a_face_solve_and_the_reaction_is_the_load(tmp_path):
     reaction = ds["reaction_force"].values.sum(axis=0)
     np.testing.assert_allclose(reaction, [-5.0e4 * 0.01, 0.0, 0.0], atol=1e-8 * 5.0e2)
     assert 0 < ds["displacement"].values[:, 0].max() < 0.1 * 0.2
+
+
+# --------------------------------------------------------------------------------------------
+# loads far above Young's modulus: E in MPa, loads in Pa
+# --------------------------------------------------------------------------------------------
+
+
+def _cube_scene(E, loads, **changes) -> dict:
+    grid = {"generator": "hex_grid", "args": {"lx": 0.1, "ly": 0.1, "lz": 0.1, "nx": 2, "ny": 2, "nz": 2}}
+    scene = _scene(grid, E=E, loads=loads, **changes)
+    scene["materials"][0]["density"] = 1000.0
+    return scene
+
+
+PULL = [{"type": "traction", "select": {"plane": ["x", 0.1]}, "traction": [5.0e4, 0.0, 0.0]}]
+
+
+def test_modulus_in_mpa_with_a_load_in_pa_is_refused_naming_the_ratio(tmp_path, capsys):
+    scene = _cube_scene(1.0, PULL)  # 1 MPa meant, 1 Pa read: 5e4 Pa / 1 Pa
+    with pytest.raises(ValueError, match=r"^scene\.loads\[0\]: the load is 5 x 10\^4 E \(traction \|t\| = 5e\+04 Pa "
+                                         r"against the smallest Young's modulus E = 1 Pa, scene\.materials\[0\]\): "
+                                         r"strains of order 5 x 10\^4.*E is in Pa \(an E given in MPa"):
+        prepare(load_scene(scene))
+    line = _cli_error(tmp_path, capsys, scene)
+    assert "the load is 5 x 10^4 E" in line and "E is in Pa" in line
+
+
+def test_the_same_scene_with_e_in_pa_solves_and_the_reaction_is_the_load():
+    ds = run_scene(load_scene(_cube_scene(1.0e6, PULL)), progress=False)
+    np.testing.assert_allclose(ds["reaction_force"].values.sum(axis=0), [-5.0e4 * 0.01, 0.0, 0.0], atol=1e-8 * 5.0e2)
+    # 5 % strain: the mean stretch of the loaded face is of that order
+    u = ds["displacement"].values[np.isclose(ds["rest_position"].values[:, 0], 0.1), 0].mean()
+    assert 0.02 * 0.1 < u < 0.1 * 0.1
+
+
+def test_gravity_and_nodal_force_ratios():
+    hang = [{"type": "gravity", "g": [0.0, 0.0, -9.81]}]  # rho g L = 1000 x 9.81 x 0.1 = 981 Pa
+    boundary = [{"select": {"plane": ["z", 0.1]}, "fix": "all"}]
+    with pytest.raises(ValueError, match=r"the load is 9\.81 x 10\^2 E \(gravity rho g L = 1e\+03 kg/m\^3 x 9\.81 "
+                                         r"m/s\^2 x 0\.1 m = 981 Pa"):
+        prepare(load_scene(_cube_scene(1.0, hang, boundary=boundary)))
+    assert prepare(load_scene(_cube_scene(1.0e6, hang, boundary=boundary))).gravity is not None
+    # a body nothing holds falls freely under gravity: no stress to compare
+    free_fall = _cube_scene(1.0, hang, boundary=[], solver={"type": "dynamic", "dt": 1e-3, "t_end": 1e-2})
+    assert prepare(load_scene(free_fall)).model is not None
+    # 100 N over the cross-section 0.01 m^2 across it: 1e4 Pa
+    push = [{"type": "nodal_force", "select": {"plane": ["x", 0.1]}, "total": [100.0, 0.0, 0.0]}]
+    with pytest.raises(ValueError, match=r"the load is 1 x 10\^2 E \(nodal force \|F\| = 100 N over the mean "
+                                         r"cross-section 0\.01 m\^2 across it = 1e\+04 Pa"):
+        prepare(load_scene(_cube_scene(100.0, push)))
+    with pytest.raises(ValueError, match=r"the load is 10 E"):
+        prepare(load_scene(_cube_scene(1.0e3, push)))
+
+
+def test_a_load_above_e_but_within_ten_times_is_a_warning_not_a_refusal():
+    push = [{"type": "nodal_force", "select": {"plane": ["x", 0.1]}, "total": [100.0, 0.0, 0.0]}]
+    with pytest.warns(MsslibWarning, match=r"scene\.loads\[0\]: the load is 2 E .*strains above 1 ahead"):
+        setup = prepare(load_scene(_cube_scene(5.0e3, push)))
+    assert setup.model is not None
+
+
+def test_the_softest_material_is_named(tmp_path):
+    two = _two_cubes([0.1, 0, 0])
+    M.write_vtu(tmp_path / "two.vtu", M.Mesh(two.points, two.cells, two.cell_type, [0, 1]))
+    scene = _scene({"file": "two.vtu"}, loads=[{"type": "traction", "select": {"plane": ["x", 0.2]},
+                                                "traction": [0.0, 3.0e4, 0.0]}])
+    scene["materials"] = [{"E": 2.0e8, "nu": 0.3}, {"E": 2.0e3, "nu": 0.3}]
+    with pytest.raises(ValueError, match=r"the load is 15 E \(traction .* E = 2000 Pa, scene\.materials\[1\]\)"):
+        prepare(load_scene(scene, base_dir=tmp_path))
 
 
 # --------------------------------------------------------------------------------------------
