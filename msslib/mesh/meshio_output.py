@@ -30,7 +30,10 @@ def _routed(original, label):
         messages = _COLLECTOR.get()
         if messages is None:
             return original(*args, **kwargs)
-        text = " ".join(str(a) for a in args) if label is None else f"{label}: {args[0] if args else ''}"
+        if label is None:
+            text = " ".join(str(a) for a in args)
+        else:
+            text = f"{label}: {args[0] if args else kwargs.get('string', '')}"
         messages.append(text)
         return None
 
@@ -44,7 +47,12 @@ def _install() -> None:
     if _installed:
         return
     import meshio  # noqa: F401 - loads every format module
-    from meshio import _common
+
+    try:
+        from meshio import _common
+    except ImportError:  # pragma: no cover - a meshio without these helpers: nothing to route
+        _installed = True
+        return
 
     with _LOCK:
         if _installed:
