@@ -385,10 +385,11 @@ def cell_shapes(mesh: Mesh) -> tuple[np.ndarray, np.ndarray | None]:
 
     ``aspect`` is the longest edge over the smallest height, the height over a facet being the
     cell's measure over the facet's (simplices: ``dim`` times it): 1 for a square or a cube, 1.15
-    for an equilateral triangle, 1.22 for a regular tetrahedron, about ``1 / sin(a)`` for a
-    triangle of smallest angle ``a`` (of the order of it for any triangle); infinite for a cell of zero measure.  ``angle`` is the
-    smallest angle of each triangle in degrees (None for other cells).  A sliver has a large
-    aspect ratio: its stiffness across the short side dwarfs that of its neighbours.
+    for an equilateral triangle, 1.22 for a regular tetrahedron, ``1 / sin(a)`` for a needle of
+    apex angle ``a`` and about ``2 / a`` for a flat triangle of base angles ``a``; infinite for a
+    cell of zero measure.  ``angle`` is the smallest angle of each triangle in degrees (None for
+    other cells).  A sliver has a large aspect ratio: its stiffness across the short side dwarfs
+    that of its neighbours.
     """
     x = mesh.points[mesh.cells]
     edges = x[:, _LOCAL_EDGES[mesh.cell_type][:, 1]] - x[:, _LOCAL_EDGES[mesh.cell_type][:, 0]]
