@@ -1,0 +1,60 @@
+"""FEM references (scikit-fem) on the same :class:`~msslib.mesh.Mesh` objects the mass-spring models use.
+
+Public functions
+----------------
+* :func:`solve_linear` -- small-strain isotropic linear elasticity (2D plane stress/strain, 3D).
+* :func:`solve_nonlinear` -- total-Lagrangian finite-strain reference (St Venant-Kirchhoff or
+  compressible neo-Hookean), dead loads, Newton with load stepping and step halving.
+* :func:`element_stiffness` -- numeric stiffness matrix of one element, dofs interleaved by node
+  ``(n0_x, n0_y, [n0_z], n1_x, ...)`` in the VTK node order of the given coordinates.
+
+Conventions
+-----------
+Displacements, forces and reactions are ``(n_nodes, dim)`` arrays. Internally the global dof of
+node ``a``, component ``i`` is ``a * dim + i`` (interleaved by node).
+
+Elements: triangle P1 (``ElementTriP1``), quad Q1 (``ElementQuad1``), tetra P1 (``ElementTetP1``),
+hexahedron Q1 (``ElementHex1``). Quadrature: one point for simplices (exact for the constant
+strains and for the linear load integrands), 2x2 / 2x2x2 Gauss for Q1.
+
+Assembly: scikit-fem provides the meshes, reference mappings, quadrature and basis functions.
+:func:`element_stiffness` and ``solve_linear(..., assembly="skfem")`` assemble with a scikit-fem
+``BilinearForm`` on ``ElementVector``; the default ``assembly="fast"`` and the non-linear solver
+build the element matrices with vectorised ``numpy.einsum`` from the scalar basis gradients (about
+10x faster on large meshes; the two agree to round-off, see the tests). Linear systems are solved
+with SuperLU (``scipy.sparse.linalg.spsolve``) after removing the constrained dofs.
+
+Node orders (checked against the volumes of a unit square/box in the tests):
+
+* triangle, tetra, quad: scikit-fem accepts the VTK order as is (``MeshTri`` sorts the node
+  indices of each triangle, which does not change P1 results; ``MeshQuad1`` numbers its corners
+  counter-clockwise 0-1-2-3 like VTK).
+* hexahedron: ``MeshHex1`` numbers the corners of the unit cube
+  (0,0,0), (0,0,1), (0,1,0), (1,0,0), (0,1,1), (1,0,1), (1,1,0), (1,1,1); the VTK order is
+  (0,0,0), (1,0,0), (1,1,0), (0,1,0), (0,0,1), (1,0,1), (1,1,1), (0,1,1). Hence
+  ``skfem_cells = vtk_cells[:, [0, 4, 3, 1, 7, 5, 2, 6]]`` (:data:`HEX_VTK_TO_SKFEM`).
+
+2D finite strain: ``plane="strain"`` keeps ``F33 = 1``. ``plane="stress"`` is the exact plane
+stress of the 3D law: at every quadrature point the out-of-plane stretch ``F33`` is solved from
+``P33 = 0`` (closed form for St Venant-Kirchhoff, a local Newton iteration for neo-Hookean) and the
+tangent is statically condensed. For St Venant-Kirchhoff this is identical to the 2D SVK law with
+the plane-stress Lame constant ``lambda* = 2 lambda mu / (lambda + 2 mu)``. Integrals are taken
+over the reference thickness (nominal quantities), so thickness changes are accounted for exactly.
+Modules: :mod:`~msslib.fem.materials` (Lame constants, per-cell materials, the finite-strain
+laws), :mod:`~msslib.fem.space` (scikit-fem conversion, the element basis, assembly, boundary
+conditions and loads), :mod:`~msslib.fem.solve` (the solves).
+"""
+
+from msslib.fem.materials import _cell_materials, _check_plane, _det1m, _law, _law3d, lame  # noqa: F401
+from msslib.fem.solve import FemResult, _solve_sparse, element_stiffness, solve_linear, solve_nonlinear  # noqa: F401
+from msslib.fem.space import HEX_VTK_TO_SKFEM, _Geometry, _linear_stiffness, _skfem_linear_stiffness, to_skfem  # noqa: F401
+
+__all__ = [
+    "FemResult",
+    "HEX_VTK_TO_SKFEM",
+    "element_stiffness",
+    "lame",
+    "solve_linear",
+    "solve_nonlinear",
+    "to_skfem",
+]
