@@ -28,7 +28,10 @@ displacements, the loads and gravity. The writers turn it into
     ``k (|x_j - x_i| - L)`` along the spring, exactly msslib's spring; gravity in ``<option>``;
     surface loads and Baudet's correction (constant at load factor 1) as ``<general>`` actuators
     with a constant affine bias on the joints; mass-proportional damping ``alpha`` as joint damping
-    ``alpha m``. Volume terms cannot be expressed: an XML comment and the command say so.
+    ``alpha m``. Volume terms cannot be expressed: an XML comment and the command say so. MuJoCo
+    integrates tendon springs explicitly, so the model steps at most at half their stability limit
+    ``2/omega_max`` (a dynamic scene's ``dt`` when below it, else half the limit, with a warning and
+    a comment in the file: :func:`msslib.export_simulators.mjcf_time_step`).
 ``sofa``
     A SOFA scene (:func:`msslib.export_simulators.sofa_text`, ``.scn`` XML) made only of the components and attributes of
     :data:`SOFA_COMPONENTS`: MechanicalObject, DiagonalMass (``vertexMass``), SpringForceField
@@ -163,7 +166,7 @@ class MssExport:
     gravity: np.ndarray | None = None
     damping: tuple = (0.0, 0.0)
     _tables: dict | None = field(default=None, repr=False)
-    _time_step: float | None = field(default=None, repr=False)
+    _stability_limit: float | None = field(default=None, repr=False)
 
     @property
     def points(self) -> np.ndarray:

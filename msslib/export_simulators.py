@@ -8,13 +8,17 @@ carry a volume term, and both files say so in a comment when the model has one.
 from __future__ import annotations
 
 import math
+import warnings
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 
 import numpy as np
 
+from .errors import MsslibWarning
 from .export import AXES, MssExport, _pad3, _safe_name, _version, not_carried
 
-__all__ = ["SOFA_COMPONENTS", "SOFA_TARGET", "time_step", "mjcf_text", "sofa_text"]
+__all__ = ["SOFA_COMPONENTS", "SOFA_TARGET", "MJCF_SAFETY", "MjcfStep", "time_step", "stability_limit",
+           "mjcf_time_step", "mjcf_text", "sofa_text"]
 
 #: SOFA components and the attributes the scene uses, for SOFA v24.06 and later: for each component
 #: class the plugin that registers it, its Data names (the XML attributes, as declared by
@@ -95,24 +99,73 @@ def _springs_only_model(exp: MssExport):
                  fixed=exp.fixed, masses=exp.masses)
 
 
+#: the MuJoCo model steps at this fraction of the stability limit 2/omega_max of its springs
+MJCF_SAFETY = 0.5
+
+
+@dataclass(frozen=True)
+class MjcfStep:
+    """The time step written in the MuJoCo model: ``step`` (s), ``limit`` the stability limit
+    ``2/omega_max`` (s) of its springs at rest with the node masses (inf without springs or free
+    dofs), ``scene_dt`` the scene's step (None for a static scene), ``note`` one sentence saying
+    which step was written and why (in the file; a warning when it is not the scene's)."""
+
+    step: float
+    limit: float
+    scene_dt: float | None
+    note: str
+
+    @property
+    def reduced(self) -> bool:
+        """Whether the scene's own step was replaced by a smaller one."""
+        return self.scene_dt is not None and self.step < self.scene_dt
+
+
 def time_step(exp: MssExport) -> float:
     """The scene's time step (dynamic scenes), else half the explicit stability limit ``2/omega_max``
-    of the springs with the node masses at rest (:func:`msslib.solvers.explicit_stability_limit`)."""
-    if exp._time_step is None:
-        exp._time_step = _time_step(exp)
-    return exp._time_step
-
-
-def _time_step(exp: MssExport) -> float:
+    of the springs with the node masses at rest (:func:`msslib.solvers.explicit_stability_limit`):
+    the SOFA scene's ``dt`` (its dynamic solver, EulerImplicitSolver, is implicit)."""
     if exp.scene.is_dynamic:
         return float(exp.scene.solver["dt"])
-    from msslib.solvers import explicit_stability_limit
+    return mjcf_time_step(exp).step
 
-    if len(exp.pairs) == 0 or not (~exp.fixed).any():
-        return 1e-3
-    model = _springs_only_model(exp)
-    limit = explicit_stability_limit(model, model.apply_prescribed(model.x0, 1.0))
-    return 0.5 * limit if math.isfinite(limit) else 1e-3
+
+def stability_limit(exp: MssExport) -> float:
+    """``2/omega_max`` (s) of the springs with the node masses at rest and the prescribed
+    displacements applied (:func:`msslib.solvers.explicit_stability_limit`); inf without springs
+    or free dofs."""
+    if exp._stability_limit is None:
+        from msslib.solvers import explicit_stability_limit
+
+        if len(exp.pairs) == 0 or not (~exp.fixed).any():
+            exp._stability_limit = math.inf
+        else:
+            model = _springs_only_model(exp)
+            exp._stability_limit = float(explicit_stability_limit(model, model.apply_prescribed(model.x0, 1.0)))
+    return exp._stability_limit
+
+
+def mjcf_time_step(exp: MssExport) -> MjcfStep:
+    """The MuJoCo model's step. MuJoCo integrates tendon spring forces explicitly (its implicit
+    integrators take only velocity derivatives, here the joint damping, implicitly), so it is
+    stable only below ``2/omega_max`` of the springs: the scene's ``dt`` when it is at most
+    :data:`MJCF_SAFETY` times that limit, else that fraction of the limit (the same for static
+    scenes, which have no step; 1 ms without springs or free dofs)."""
+    limit = stability_limit(exp)
+    safe = MJCF_SAFETY * limit if math.isfinite(limit) and limit > 0 else 1e-3
+    why = (f"MuJoCo integrates the tendon springs explicitly and is stable only below 2/omega_max = {limit:.4g} s "
+           f"(omega_max^2 the largest eigenvalue of M^-1 K of the springs at rest)")
+    if not exp.scene.is_dynamic:
+        note = (f"timestep {safe:.4g} s = {MJCF_SAFETY} x the stability limit: {why}" if math.isfinite(limit)
+                else f"timestep {safe:.4g} s: the model has no springs between free nodes (no stability limit)")
+        return MjcfStep(safe, limit, None, note)
+    dt = float(exp.scene.solver["dt"])
+    if dt <= safe:
+        return MjcfStep(dt, limit, dt, f"timestep {dt:.4g} s, the scene's dt, at most {MJCF_SAFETY} x the stability "
+                                       f"limit: {why}")
+    return MjcfStep(safe, limit, dt, f"timestep {safe:.4g} s = {MJCF_SAFETY} x the stability limit, NOT the scene's "
+                                     f"dt = {dt:.4g} s ({dt / limit:.3g} times the limit; msslib's "
+                                     f"{exp.scene.solver.get('method')} steps it stably, MuJoCo would blow up): {why}")
 
 
 def _header_lines(exp: MssExport, fmt: str) -> list[str]:
@@ -152,7 +205,15 @@ def mjcf_text(exp: MssExport) -> str:
     g = np.zeros(3)
     if exp.gravity is not None:
         g[:dim] = exp.gravity
-    option = ET.SubElement(root, "option", timestep=_f(time_step(exp)), gravity=_vec(g), integrator="implicitfast")
+    step = mjcf_time_step(exp)
+    root.append(ET.Comment(f" Time step: {_xml_comment(step.note)}. Integrator implicitfast: the joint damping "
+                           f"is implicit, the springs are not. "))
+    if step.reduced:
+        warnings.warn(f"{exp.scene.name}: the mjcf output steps at {step.step:.4g} s instead of the scene's dt = "
+                      f"{step.scene_dt:.4g} s: MuJoCo integrates the tendon springs explicitly and is stable only "
+                      f"below 2/omega_max = {step.limit:.4g} s, {step.scene_dt / step.limit:.3g} times smaller than "
+                      f"dt (said in the file)", MsslibWarning, stacklevel=2)
+    option = ET.SubElement(root, "option", timestep=_f(step.step), gravity=_vec(g), integrator="implicitfast")
     ET.SubElement(option, "flag", contact="disable")
     world = ET.SubElement(root, "worldbody")
     pos = _pad3(exp.points + exp.prescribed)
