@@ -22,7 +22,21 @@ Assembly: scikit-fem provides the meshes, reference mappings, quadrature and bas
 ``BilinearForm`` on ``ElementVector``; the default ``assembly="fast"`` and the non-linear solver
 build the element matrices with vectorised ``numpy.einsum`` from the scalar basis gradients (about
 10x faster on large meshes; the two agree to round-off, see the tests). Linear systems are solved
-with SuperLU (``scipy.sparse.linalg.spsolve``) after removing the constrained dofs.
+by the linear-solver policy of the mass-spring models (:mod:`msslib.fem.newton`: banded
+Cholesky, SuperLU or AMG-preconditioned CG, :func:`msslib.solvers.choose_linear_solver`), the
+finite-strain ones by their Newton iteration (:func:`msslib.solvers.static_solve`).
+
+Element order: ``order=1`` (the elements above) or ``order=2``: quadratic Lagrange elements
+(``ElementTriP2``, ``ElementTetP2``, ``ElementQuad2``, ``ElementHex2``; degree-2
+rules on simplices, 3x3(x3) Gauss on Q2), the references of the speed-against-error studies (:mod:`msslib.planning`).  Near
+nu = 1/2 displacement-only elements lock (linear ones by a factor of 10 on a clamped cube at
+nu = 0.4999; quadratic ones by a few per cent that shrink slowly under refinement);
+``volumetric="reduced"`` integrates the volumetric part of the energy (the ``lambda`` terms) with
+one point on quadratic simplices and 2x2(x2) points on Q2: on simplices the penalty form of the
+inf-sup stable P2-P0 pair, on Q2 the classical selective reduced integration, so it does not lock.
+It is chosen over a mixed u-p formulation because it keeps one displacement field (the same
+Newton, solver and laws) and over reduced integration of linear elements because that leaves P1
+simplices locked.
 
 Node orders (checked against the volumes of a unit square/box in the tests):
 
@@ -41,8 +55,9 @@ tangent is statically condensed. For St Venant-Kirchhoff this is identical to th
 the plane-stress Lame constant ``lambda* = 2 lambda mu / (lambda + 2 mu)``. Integrals are taken
 over the reference thickness (nominal quantities), so thickness changes are accounted for exactly.
 Modules: :mod:`~msslib.fem.materials` (Lame constants, per-cell materials, the finite-strain
-laws), :mod:`~msslib.fem.space` (scikit-fem conversion, the element basis, assembly, boundary
-conditions and loads), :mod:`~msslib.fem.solve` (the solves).
+laws), :mod:`~msslib.fem.space` (scikit-fem conversion, the element basis of either order,
+assembly, boundary conditions and loads), :mod:`~msslib.fem.newton` (the solves on
+:mod:`msslib.solvers`), :mod:`~msslib.fem.solve` (the solves).
 """
 
 from msslib.fem.materials import _cell_materials, _check_plane, _det1m, _law, _law3d, lame  # noqa: F401

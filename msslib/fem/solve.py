@@ -31,6 +31,10 @@ class FemResult:
     reaction: np.ndarray
     strain_energy: float
     stats: dict = field(default_factory=dict)
+    #: the location ``(n_scalar, dim)`` and displacement of every scalar dof: the nodes first (as
+    #: ``displacement``), then, with quadratic elements, the edge, face and cell dofs
+    dof_points: np.ndarray | None = None
+    dof_displacement: np.ndarray | None = None
 
 
 _SOLVER = "scipy.sparse.linalg.spsolve (SuperLU, MMD_AT_PLUS_A ordering)"
@@ -67,6 +71,10 @@ def solve_linear(
     thickness: float = 1.0,
     plane: str = "stress",
     assembly: str = "fast",
+    order: int = 1,
+    tractions=(),
+    linear_solver="auto",
+    volumetric: str = "full",
 ) -> FemResult:
     """Small-strain isotropic linear elasticity on ``mesh``.
 
@@ -77,31 +85,47 @@ def solve_linear(
     ``assembly="fast"`` (default) assembles the stiffness with vectorised element matrices built from
     scikit-fem's scalar basis; ``"skfem"`` uses a scikit-fem ``BilinearForm`` on ``ElementVector``
     (same matrix, several times slower on large meshes).
+
+    ``order``: 1 (linear elements, default) or 2 (quadratic: ``ElementTriP2``, ``ElementTetP2``,
+    ``ElementQuad2``, ``ElementHex2``; locking-free enough near nu = 1/2 for a reference, see
+    :mod:`msslib.fem`); ``displacement`` and ``reaction`` are then given at the mesh's nodes (the
+    reaction of the edge, face and cell dofs carried to them by the linear interpolant's
+    transpose, which keeps the total). ``tractions``: pairs ``(facets, traction)`` of boundary
+    facets (node indices, ``(k, nodes per facet)``) and a traction (Pa), integrated with the
+    element's shape functions. ``linear_solver``: ``"auto"`` (the policy of
+    :mod:`msslib.solvers`: banded Cholesky, SuperLU or AMG-preconditioned CG), ``"direct"`` or
+    ``"cg"``.
     """
+    from msslib.fem.newton import SOLVER, linear_solve
+
     t0 = time.perf_counter()
     _check_plane(plane, mesh.dim)
     if thickness <= 0:
         raise ValueError(f"thickness={thickness!r} must be > 0")
     E_c, nu_c = _cell_materials(mesh, E, nu)
-    warn_locking(mesh, nu_c, plane)
+    if order == 1:
+        warn_locking(mesh, nu_c, plane)
     lam_c, mu_c = lame(E_c, nu_c, plane if mesh.dim == 2 else None)
-    geo = _Geometry(mesh)
+    geo = _Geometry(mesh, order)
     w = thickness if mesh.dim == 2 else 1.0
+    if assembly == "skfem" and (order != 1 or volumetric != "full"):
+        raise ValueError("assembly='skfem' is for linear elements (order=1) with volumetric='full'")
     if assembly == "fast":
-        K = _linear_stiffness(geo, lam_c, mu_c) * w
+        K = sum(_linear_stiffness(g, lam_q[:, 0], mu_q[:, 0])
+                for g, lam_q, mu_q in _parts(mesh, geo, lam_c, mu_c, volumetric, plane if mesh.dim == 2 else None)) * w
     elif assembly == "skfem":
         K = _skfem_linear_stiffness(geo, lam_c, mu_c) * w
     else:
         raise ValueError(f"assembly must be 'fast' or 'skfem', got {assembly!r}")
-    cons, presc, f = _boundary(mesh, fixed, prescribed, nodal_forces, body_force, geo, thickness)
+    cons, presc, f = _boundary(mesh, fixed, prescribed, nodal_forces, body_force, geo, thickness, tractions)
     t1 = time.perf_counter()
 
     u = presc.copy()
     free = ~cons
+    how = "none (no free dof)"
     if free.any():
-        Kff = K[free][:, free]
         rhs = f[free] - K[free][:, cons] @ presc[cons]
-        u[free] = _solve_sparse(Kff, rhs)
+        u[free], how = linear_solve(K, rhs, free, geo.points, mesh.dim, linear_solver)
     t2 = time.perf_counter()
 
     Ku = K @ u
@@ -113,16 +137,49 @@ def solve_linear(
         "assembly_time": t1 - t0,
         "solve_time": t2 - t1,
         "wall_time": time.perf_counter() - t0,
-        "solver": _SOLVER,
+        "solver": f"{SOLVER}: {how}",
         "assembly": assembly,
         "plane": plane if d == 2 else None,
+        "order": order,
     }
-    return FemResult(
-        displacement=u.reshape(-1, d),
-        reaction=reaction.reshape(-1, d),
-        strain_energy=float(0.5 * u @ Ku),
-        stats=stats,
-    )
+    return _result(geo, u, reaction, float(0.5 * u @ Ku), stats)
+
+
+#: quadrature of the volumetric term with volumetric="reduced": one point on P2 simplices (the
+#: volumetric strain's cell mean: the penalty form of the inf-sup stable P2-P0 pair), 2x2(x2) Gauss
+#: on Q2 (selective reduced integration)
+_REDUCED_INTORDER = {"triangle": 1, "tetra": 1, "quad": 3, "hexahedron": 3}
+VOLUMETRIC = ("full", "reduced")
+
+
+def _parts(mesh, geo, lam_c, mu_c, volumetric, plane):
+    """``(geometry, lam_q, mu_q)`` of the terms of the energy: the whole law at full quadrature,
+    or with ``volumetric="reduced"`` the shear part (``lam = 0``) at full quadrature and the
+    volumetric part (``mu = 0``) at the reduced one."""
+    if volumetric not in VOLUMETRIC:
+        raise ValueError(f"volumetric must be 'full' or 'reduced', got {volumetric!r}")
+
+    def q(g, v):
+        return np.repeat(np.asarray(v, dtype=float)[:, None], g.dx.shape[1], axis=1)
+
+    if volumetric == "full":
+        return [(geo, q(geo, lam_c), q(geo, mu_c))]
+    if geo.order != 2:
+        raise ValueError("volumetric='reduced' needs quadratic elements (order=2): with linear ones it does not "
+                         "stop the locking of simplices")
+    if plane == "stress":
+        raise ValueError("volumetric='reduced' is for 3D and plane strain: plane stress does not lock")
+    red = _Geometry(mesh, 2, intorder=_REDUCED_INTORDER[mesh.cell_type])
+    zero = np.zeros_like(np.asarray(lam_c, dtype=float))
+    return [(geo, q(geo, zero), q(geo, mu_c)), (red, q(red, lam_c), q(red, zero))]
+
+
+def _result(geo, u, reaction, energy, stats) -> FemResult:
+    """The result at the mesh's nodes (reactions of higher-order dofs carried to them)."""
+    d, n = geo.dim, geo.mesh.n_nodes
+    U, R = u.reshape(-1, d), reaction.reshape(-1, d)
+    return FemResult(displacement=U[:n].copy(), reaction=np.asarray(geo.interp.T @ R), strain_energy=energy,
+                     stats=stats, dof_points=geo.points, dof_displacement=U)
 
 
 def element_stiffness(cell_type: str, coords, E: float, nu: float, thickness: float = 1.0, plane: str = "stress") -> np.ndarray:
@@ -162,6 +219,10 @@ def solve_nonlinear(
     plane: str = "stress",
     progress: Callable[[int, int], None] | None = None,
     max_halvings: int = 8,
+    order: int = 1,
+    tractions=(),
+    linear_solver="auto",
+    volumetric: str = "full",
 ) -> FemResult:
     """Geometrically non-linear (total Lagrangian) reference solution with dead loads.
 
@@ -191,7 +252,7 @@ def solve_nonlinear(
     last converged increment, absolute), ``roundoff_steps`` (increments accepted at the floor,
     1-based) and ``messages``.
     """
-    from msslib.solvers.displacement import SOLVER, DisplacementProblem, solve_displacement
+    from msslib.fem.newton import NEWTON, newton_solve
 
     t0 = time.perf_counter()
     d = mesh.dim
@@ -204,38 +265,38 @@ def solve_nonlinear(
     if thickness <= 0:
         raise ValueError(f"thickness={thickness!r} must be > 0")
     E_c, nu_c = _cell_materials(mesh, E, nu)
-    warn_locking(mesh, nu_c, plane)
+    if order == 1:
+        warn_locking(mesh, nu_c, plane)
     lam_c, mu_c = lame(E_c, nu_c)  # 3D constants; plane stress handled inside the law
-    geo = _Geometry(mesh)
+    geo = _Geometry(mesh, order)
     w = thickness if d == 2 else 1.0
-    cons, presc, f_ext = _boundary(mesh, fixed, prescribed, nodal_forces, body_force, geo, thickness)
+    cons, presc, f_ext = _boundary(mesh, fixed, prescribed, nodal_forces, body_force, geo, thickness, tractions)
     free = ~cons
-    nq = geo.dx.shape[1]
-    lam_q = np.repeat(lam_c[:, None], nq, axis=1)
-    mu_q = np.repeat(mu_c[:, None], nq, axis=1)
     pl = plane if d == 2 else None
-    m, nb = geo.dphi.shape[2], geo.dphi.shape[0]
+    parts = _parts(mesh, geo, lam_c, mu_c, volumetric, pl)
 
     def internal(u, tangent=True):
-        H = geo.displacement_gradient(u.reshape(-1, d))
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # divergence is detected by the caller
-            P, A, W = _law(H, lam_q, mu_q, law, pl, tangent)
-        fe = np.einsum("iJmq,aJmq,mq->mai", P, geo.dphi, geo.dx).reshape(m, nb * d) * w
-        fint = geo.assemble_vector(fe)
-        energy = float(np.sum(W * geo.dx) * w)
-        if not tangent:
-            return fint, None, energy, None
-        fabs = geo.assemble_vector(np.abs(fe))  # the size of what fint sums: its round-off scale
-        ke = np.einsum("aJmq,iJkLmq,bLmq,mq->maibk", geo.dphi, A, geo.dphi, geo.dx, optimize=True)
-        K = geo.assemble_matrix(ke.reshape(m, nb * d, nb * d) * w)
-        return fint, K, energy, fabs
+        fint, energy, K, fabs = 0.0, 0.0, None, 0.0
+        for g, lam_q, mu_q in parts:
+            m, nb = g.dphi.shape[2], g.dphi.shape[0]
+            H = g.displacement_gradient(u.reshape(-1, d))
+            with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # divergence is detected by the caller
+                P, A, W = _law(H, lam_q, mu_q, law, pl, tangent)
+            fe = np.einsum("iJmq,aJmq,mq->mai", P, g.dphi, g.dx).reshape(m, nb * d) * w
+            fint = fint + g.assemble_vector(fe)
+            energy += float(np.sum(W * g.dx) * w)
+            if tangent:
+                fabs = fabs + g.assemble_vector(np.abs(fe))  # the size of what fint sums: its round-off scale
+                ke = np.einsum("aJmq,iJkLmq,bLmq,mq->maibk", g.dphi, A, g.dphi, g.dx, optimize=True)
+                Kp = g.assemble_matrix(ke.reshape(m, nb * d, nb * d) * w)
+                K = Kp if K is None else K + Kp
+        return fint, K, energy, (fabs if tangent else None)
 
-    problem = DisplacementProblem(internal, f_ext, cons, presc)
-    u, newton = solve_displacement(problem, steps=steps, tol=tol, max_iter=max_iter, max_halvings=max_halvings,
-                                   progress=progress)
+    u, newton = newton_solve(internal, f_ext, cons, presc, geo.points, steps=steps, tol=tol, max_iter=max_iter,
+                             max_halvings=max_halvings, progress=progress, linear_solver=linear_solver)
     fint, _, energy, _ = internal(u, tangent=False)
     r = fint - f_ext
     reaction = np.where(cons, r, 0.0)
     stats = {"n_dofs": int(u.size), "n_free_dofs": int(free.sum()), **newton, "law": law, "plane": pl,
-             "wall_time": time.perf_counter() - t0, "solver": SOLVER}
-    return FemResult(displacement=u.reshape(-1, d), reaction=reaction.reshape(-1, d), strain_energy=energy, stats=stats)
+             "wall_time": time.perf_counter() - t0, "solver": NEWTON, "order": order, "volumetric": volumetric}
+    return _result(geo, u, reaction, energy, stats)

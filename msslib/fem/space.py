@@ -11,8 +11,14 @@ from msslib.mesh import Mesh, check_cells
 #: column permutation taking a VTK hexahedron to scikit-fem's ``MeshHex1`` node order.
 HEX_VTK_TO_SKFEM = np.array([0, 4, 3, 1, 7, 5, 2, 6])
 
-# quadrature order per cell type: 1 point for P1 simplices, 2x2(x2) Gauss for Q1.
+# quadrature order per cell type: 1 point for P1 simplices, 2x2(x2) Gauss for Q1; for quadratic
+# elements exact for the linear-elastic stiffness on straight-sided simplices (degree 2), and 3x3(x3)
+# Gauss for Q2.
 _INTORDER = {"triangle": 1, "tetra": 1, "quad": 2, "hexahedron": 2}
+_INTORDER_ORDER = {1: _INTORDER, 2: {"triangle": 2, "tetra": 2, "quad": 4, "hexahedron": 4}}
+#: element orders: 1 linear (P1/Q1), 2 quadratic (P2/Q2, scikit-fem's ElementTriP2 ... ElementHex2)
+ORDERS = (1, 2)
+_ORDER2 = {"triangle": "ElementTriP2", "tetra": "ElementTetP2", "quad": "ElementQuad2", "hexahedron": "ElementHex2"}
 
 
 def to_skfem(mesh: Mesh):
@@ -38,29 +44,86 @@ def to_skfem(mesh: Mesh):
 
 
 class _Geometry:
-    """Scalar basis data of a mesh: shape functions and gradients at the quadrature points."""
+    """Scalar basis data of a mesh with Lagrange elements of ``order`` 1 (P1/Q1) or 2 (P2, Q2):
+    shape functions and gradients at the quadrature points, the scalar dofs (``nodes``, shape
+    ``(nb, m)``: the mesh's nodes come first, with their numbers, then the edge, face and cell
+    dofs of quadratic elements), where they sit (``points``) and ``interp``, the sparse
+    ``(n_scalar, n_nodes)`` matrix of the linear (P1/Q1) interpolant at them (identity for
+    order 1): prescribed nodal values are carried to every dof by it, and dof forces back to the
+    nodes by its transpose (which keeps their sum)."""
 
-    def __init__(self, mesh: Mesh):
+    def __init__(self, mesh: Mesh, order: int = 1, intorder: int | None = None):
         import skfem
 
+        if order not in ORDERS:
+            raise ValueError(f"order must be 1 (linear elements) or 2 (quadratic elements), got {order!r}")
         check_cells(mesh)  # ValueError naming inverted or degenerate cells (else a singular matrix)
-        self.mesh = mesh
+        self.mesh, self.order = mesh, order
         self.dim = mesh.dim
-        self.skmesh, self.elem = to_skfem(mesh)
-        self.basis = skfem.Basis(self.skmesh, self.elem, intorder=_INTORDER[mesh.cell_type])
+        self.skmesh, elem1 = to_skfem(mesh)
+        self.elem = elem1 if order == 1 else getattr(skfem, _ORDER2[mesh.cell_type])()
+        if intorder is None:
+            intorder = _INTORDER_ORDER[order][mesh.cell_type]
+        self.basis = skfem.Basis(self.skmesh, self.elem, intorder=intorder)
         nb = self.basis.Nbfun
-        # global node of local basis function a in cell e (skfem's local order)
-        self.nodes = np.asarray(self.basis.element_dofs)  # (nb, m); scalar P1/Q1 dofs == nodes
-        n_sk = np.asarray(self.basis.nodal_dofs).size  # scikit-fem drops trailing unused nodes
-        if n_sk > mesh.n_nodes or not np.array_equal(np.asarray(self.basis.nodal_dofs).ravel(), np.arange(n_sk)):
+        nodal = np.asarray(self.basis.nodal_dofs).ravel()
+        n_sk = nodal.size  # scikit-fem drops trailing unused nodes
+        if n_sk > mesh.n_nodes or not np.array_equal(nodal, np.arange(n_sk)):
             raise RuntimeError("unexpected scikit-fem dof numbering: scalar dofs are not the node indices")
+        gap = mesh.n_nodes - n_sk  # our numbering: every node first, then the higher-order dofs
+        sk = np.asarray(self.basis.element_dofs)
+        self.nodes = np.where(sk < n_sk, sk, sk + gap)  # (nb, m)
+        self.n_scalar = int(self.basis.N) + gap
+        self._sk_to_ours = np.concatenate([np.arange(n_sk), np.arange(n_sk, int(self.basis.N)) + gap])
+        self.points = np.empty((self.n_scalar, self.dim))
+        self.points[: mesh.n_nodes] = mesh.points
+        self.points[self._sk_to_ours] = np.asarray(self.basis.doflocs).T
         self.phi = np.stack([np.asarray(self.basis.basis[a][0]) for a in range(nb)])  # (nb, m, q)
         self.dphi = np.stack([np.asarray(self.basis.basis[a][0].grad) for a in range(nb)])  # (nb, d, m, q)
         self.dx = np.asarray(self.basis.dx)  # (m, q), includes quadrature weights
         d = self.dim
         # interleaved global dofs of the local (node, component) pairs, shape (m, nb*d)
         self.edofs = (self.nodes.T[:, :, None] * d + np.arange(d)[None, None, :]).reshape(len(mesh.cells), nb * d)
-        self.n_dofs = mesh.n_nodes * d
+        self.n_dofs = self.n_scalar * d
+        if order == 1:
+            self.interp = sp.identity(mesh.n_nodes, format="csr")
+        else:  # the linear shape functions at the reference locations of the quadratic dofs
+            local = np.stack([elem1.lbasis(self.elem.doflocs.T, a)[0] for a in range(len(mesh.cells[0]))], axis=1)
+            vertices = np.asarray(self.skmesh.t)  # (nv, m) mesh nodes in scikit-fem's local order
+            dofs, first = np.unique(self.nodes.ravel(), return_index=True)  # one cell per dof
+            j, cell = np.unravel_index(first, self.nodes.shape)
+            rows = np.repeat(dofs, local.shape[1])
+            cols = vertices[:, cell].T.ravel()
+            vals = local[j].ravel()
+            keep = vals != 0.0
+            self.interp = sp.csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(self.n_scalar, mesh.n_nodes))
+
+    def to_ours(self, v_sk: np.ndarray) -> np.ndarray:
+        """A scalar vector in scikit-fem's dof numbering, in ours."""
+        out = np.zeros(self.n_scalar)
+        out[self._sk_to_ours] = v_sk
+        return out
+
+    def traction_load(self, facets, traction, thickness: float) -> np.ndarray:
+        """Consistent dof loads ``(n_scalar, d)`` of a dead ``traction`` (Pa) on the boundary
+        ``facets`` (``(k, nodes per facet)`` node indices), integrated with the element's own
+        shape functions (2D: times ``thickness``)."""
+        import skfem
+
+        facets = np.asarray(facets, dtype=np.int64)
+        index = {tuple(sorted(r)): i for i, r in enumerate(np.asarray(self.skmesh.facets).T.tolist())}
+        try:
+            ids = np.array([index[tuple(sorted(r))] for r in facets.tolist()], dtype=np.int64)
+        except KeyError as exc:
+            raise ValueError(f"a loaded facet of nodes {list(exc.args[0])} is no facet of the mesh") from None
+        fb = skfem.FacetBasis(self.skmesh, self.elem, facets=ids, intorder=2 * self.order)
+
+        @skfem.LinearForm
+        def ones(v, _w):
+            return v
+
+        s = self.to_ours(ones.assemble(fb)) * (thickness if self.dim == 2 else 1.0)
+        return s[:, None] * np.asarray(traction, dtype=float)[None, :]
 
     def assemble_matrix(self, ke: np.ndarray) -> sp.csr_matrix:
         """Assemble element matrices ``(m, nb*d, nb*d)`` into a sparse (interleaved) matrix."""
@@ -78,7 +141,7 @@ class _Geometry:
         return np.einsum("ami,aJmq->iJmq", ue, self.dphi)
 
     def body_load(self, body_force, thickness: float) -> np.ndarray:
-        """Consistent nodal loads ``(n_nodes, d)`` of a body force per unit (reference) volume."""
+        """Consistent dof loads ``(n_scalar, d)`` of a body force per unit (reference) volume."""
         d, m = self.dim, len(self.mesh.cells)
         b = np.asarray(body_force, dtype=float)
         if b.shape == (d,):
@@ -139,7 +202,15 @@ def _skfem_linear_stiffness(geo: _Geometry, lam_c: np.ndarray, mu_c: np.ndarray)
 # --------------------------------------------------------------------------------------------
 
 
-def _boundary(mesh: Mesh, fixed, prescribed, nodal_forces, body_force, geo: _Geometry, thickness: float):
+def _boundary(mesh: Mesh, fixed, prescribed, nodal_forces, body_force, geo: _Geometry, thickness: float,
+              tractions=()):
+    """Constrained dofs, prescribed values and external forces on the dofs of ``geo``.
+
+    ``fixed``, ``prescribed`` and ``nodal_forces`` are given at the mesh's nodes. With quadratic
+    elements a higher-order dof is held in a component when it lies on a boundary facet all of
+    whose nodes are held in it, at the linear interpolant of the nodes' prescribed values; nodal
+    forces act at the nodes (point loads); body forces and ``tractions`` (pairs of boundary
+    facets and traction vector) are integrated with the element's shape functions."""
     n, d = mesh.n_nodes, mesh.dim
     fixed = np.asarray(fixed, dtype=bool)
     if fixed.shape != (n, d):
@@ -148,14 +219,30 @@ def _boundary(mesh: Mesh, fixed, prescribed, nodal_forces, body_force, geo: _Geo
     if presc.shape != (n, d):
         raise ValueError(f"prescribed must have shape ({n}, {d}), got {presc.shape}")
     presc = np.where(fixed, presc, 0.0)
-    f = np.zeros((n, d)) if nodal_forces is None else np.array(nodal_forces, dtype=float)
-    if f.shape != (n, d):
-        raise ValueError(f"nodal_forces must have shape ({n}, {d}), got {f.shape}")
+    fn = np.zeros((n, d)) if nodal_forces is None else np.array(nodal_forces, dtype=float)
+    if fn.shape != (n, d):
+        raise ValueError(f"nodal_forces must have shape ({n}, {d}), got {fn.shape}")
+    f = np.zeros((geo.n_scalar, d))
+    f[:n] = fn
     if body_force is not None:
         f = f + geo.body_load(body_force, thickness)
+    for facets, traction in tractions:
+        f = f + geo.traction_load(facets, traction, thickness)
     # nodes used by no cell carry no stiffness: hold them at their prescribed value (0 by default)
     used = np.zeros(n, dtype=bool)
     used[mesh.cells.ravel()] = True
-    constrained = fixed | ~used[:, None]
-    return constrained.ravel(), presc.ravel(), f.ravel()
+    constrained = np.zeros((geo.n_scalar, d), dtype=bool)
+    constrained[:n] = fixed | ~used[:, None]
+    if geo.order > 1:
+        from msslib.mesh import boundary_facets
 
+        bf = boundary_facets(mesh)
+        index = {tuple(sorted(r)): i for i, r in enumerate(np.asarray(geo.skmesh.facets).T.tolist())}
+        for i in range(d):
+            held = bf[fixed[bf, i].all(axis=1)]
+            if len(held):
+                ids = np.array([index[tuple(sorted(r))] for r in held.tolist()], dtype=np.int64)
+                sk = np.asarray(geo.basis.get_dofs(facets=ids).all()).ravel()
+                constrained[geo._sk_to_ours[sk], i] = True
+    presc_all = np.where(constrained, geo.interp @ presc, 0.0)
+    return constrained.ravel(), presc_all.ravel(), f.ravel()

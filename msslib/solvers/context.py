@@ -54,7 +54,8 @@ def _keep_context(problem, ctx) -> bool:
 
 def _solver_context(problem, x, free, plans: PlanCache | None = None):
     """Context of :func:`msslib.solvers.linear._linear_solve`: spatial dimension and coordinates
-    of the free nodes when the free dofs are whole nodes (all or none of a node's dofs free).
+    of the free nodes when the free dofs are whole nodes (all or none of a node's dofs free); the
+    coordinates are ``x``, or the problem's ``coordinates`` attribute when it has one.
     ``plans``: a plan cache to share (default: the one of the context the problem keeps, if
     any; plans depend only on the sparsity pattern)."""
     if plans is None:
@@ -72,7 +73,9 @@ def _solver_context(problem, x, free, plans: PlanCache | None = None):
         if np.array_equal(whole, f.any(axis=1)):
             ctx["dim"] = dim
             ctx["node_free"] = whole
-            ctx["coords"] = np.asarray(x, dtype=float).reshape(-1, dim)[whole]
+            # a problem whose state is no position (FEM displacements) names its dofs' locations
+            where = getattr(problem, "coordinates", None)
+            ctx["coords"] = np.asarray(x if where is None else where, dtype=float).reshape(-1, dim)[whole]
     return ctx
 
 

@@ -1,0 +1,97 @@
+"""The FEM references on the solver stack of the mass-spring models (:mod:`msslib.solvers`).
+
+A linear solve (:func:`linear_solve`) goes through the same policy as a Newton system of an MSS
+model (:func:`msslib.solvers.choose_linear_solver`): up to ``ITERATIVE_THRESHOLD`` free dofs the
+direct solver (banded Cholesky when a narrow band exists, else SuperLU), above it banded
+Cholesky while it is cheap, else conjugate gradients preconditioned by the library's
+smoothed-aggregation AMG with the rigid-body modes of the dofs' locations as near-null space.
+
+A finite-strain solve (:func:`newton_solve`) is :func:`msslib.solvers.static_solve` on a
+:class:`~msslib.solvers.displacement.DisplacementProblem` (the state is the displacement ``u``,
+the round-off floor from ``|K| |u| + sum_e |f_e| + |f_ext|``) that also names where its dofs sit,
+so that the solver context has the AMG near-null space and the band orderings of the dofs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from types import SimpleNamespace
+
+import numpy as np
+
+#: what the FEM solves run on
+SOLVER = ("msslib.solvers (the policy of the mass-spring models: banded Cholesky, SuperLU or "
+          "AMG-preconditioned CG)")
+NEWTON = "Newton (msslib.solvers.static_solve, no line search), linear solves by " + SOLVER
+#: relative residual of an iterative linear solve of linear elasticity
+LINEAR_RTOL = 1e-12
+
+
+def linear_solve(K, rhs, free, points, dim: int, linear_solver="auto"):
+    """``K[free][:, free]^-1 rhs`` by the linear-solver policy of :mod:`msslib.solvers`.
+
+    ``points`` ``(n_scalar, dim)``: the location of every scalar dof (for the AMG near-null
+    space). Returns ``(x, how)``, ``how`` naming the solver taken (``"direct"`` or ``"cg"``).
+    Raises :class:`numpy.linalg.LinAlgError` for a singular matrix."""
+    from msslib.solvers import context as _context
+    from msslib.solvers.linear import _linear_solve
+    from msslib.solvers.plans import _submatrix
+    from msslib.solvers.policy import _band_is_cheap, choose_linear_solver
+    from msslib.solvers.protocol import _NewtonFailure
+
+    ctx = _context._solver_context(SimpleNamespace(dim=dim), np.asarray(points, dtype=float).ravel(), free)
+    A = _submatrix(K.tocsr(), free, plans=ctx)
+    how = choose_linear_solver(linear_solver, A.shape[0], True, lambda: _band_is_cheap(A, ctx))
+    messages: list = []
+    try:
+        x = _linear_solve(A, np.asarray(rhs, dtype=float), linear_solver, True, messages, ctx, rtol=LINEAR_RTOL)
+    except _NewtonFailure as exc:
+        raise np.linalg.LinAlgError(f"singular stiffness matrix (are rigid-body modes constrained?): {exc}") from None
+    if not np.all(np.isfinite(x)):
+        raise np.linalg.LinAlgError("singular stiffness matrix (are rigid-body modes constrained?)")
+    if how == "cg" and any("falling back" in m for m in messages):
+        how = "direct (after CG failed)"
+    return x, how
+
+
+def _problem_class():
+    from msslib.solvers.displacement import DisplacementProblem
+
+    class LocatedProblem(DisplacementProblem):
+        """A :class:`~msslib.solvers.displacement.DisplacementProblem` that names where its dofs
+        sit (``coordinates``, ``(n_scalar, dim)``) and its dimension, for the AMG near-null space
+        and the band orderings of the solver context; the state stays the displacement (a
+        position ``X + u`` would round a small ``u`` to the precision of ``X``)."""
+
+        def __init__(self, internal: Callable, f_ext, constrained, prescribed, points):
+            super().__init__(internal, f_ext, constrained, prescribed)
+            self.coordinates = np.asarray(points, dtype=float)
+            self.dim = int(self.coordinates.shape[1])
+
+    return LocatedProblem
+
+
+def newton_solve(internal, f_ext, constrained, prescribed, points, *, steps: int, tol: float, max_iter: int,
+                 max_halvings: int, progress: Callable[[int, int], None] | None = None, linear_solver="auto"):
+    """Solve ``f_int(u) = f_ext`` from ``u = 0`` by :func:`msslib.solvers.static_solve` (Newton
+    without line search, ``steps`` load increments each halved at most ``max_halvings`` times in a
+    row, the convergence test of the mass-spring models) with the linear solver chosen by the
+    policy of :mod:`msslib.solvers`. ``internal(u, tangent)`` -> ``(f_int, K, energy, f_abs)``.
+    Returns ``(u, stats)`` as :func:`msslib.solvers.displacement.solve_displacement`."""
+    from msslib.solvers import static_solve
+
+    problem = _problem_class()(internal, f_ext, constrained, prescribed, points)
+    reported = [1]
+
+    def on_load_step(_count, lam):
+        while progress is not None and reported[0] <= steps and lam >= reported[0] / steps - 1e-12:
+            progress(reported[0], steps)
+            reported[0] += 1
+
+    res = static_solve(problem, np.zeros(problem.n_dof), load_steps=steps, tol=tol, max_iter=max_iter, line_search=False,
+                       linear_solver=linear_solver, max_cuts=max_halvings, on_load_step=on_load_step)
+    stats = {"iterations": list(res.iterations), "residuals": [[r / res.force_scale for r in h] for h in res.residuals],
+             "load_factors": list(res.loads), "n_halvings": res.n_cuts, "force_scale": res.force_scale,
+             "tol": float(tol), "roundoff_floor": float(res.roundoff_floor), "threshold": float(res.threshold),
+             "roundoff_steps": list(res.roundoff_steps), "messages": list(res.messages)}
+    return res.x, stats
