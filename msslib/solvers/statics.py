@@ -36,10 +36,22 @@ _ARMIJO_C = 1e-4
 _MAX_BACKTRACKS = 20
 
 
-def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy):
-    """Backtracking (halving) line search. Returns (x_new, r_new, rnorm_new, e_new, alpha)."""
+def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy, resolve=None):
+    """Backtracking (halving) line search. Returns (x_new, r_new, rnorm_new, e_new, alpha).
+
+    Without an energy, a step ``alpha`` is accepted when it decreases ``||r||^2`` (Armijo) or,
+    failing that, when it passes the natural monotonicity test (Deuflhard): the simplified Newton
+    correction ``resolve(r_new)`` (the same tangent solved with the trial residual) is at most
+    ``(1 - alpha / 2) ||dx||``.  The residual norm alone is a badly scaled merit for slender
+    bodies: the full Newton step of a bending problem leaves a residual, quadratic in the
+    rotation, in the stiff stretching directions that is far larger than the bending residual it
+    removes, although the step is right to within a small correction; halving then creeps
+    towards the solution by tiny steps (hundreds of iterations and load-step halvings where the
+    energy line search takes three iterations).  The displacement correction measures the error
+    in the units of the unknowns and accepts such a step."""
     slope = -float(r @ dx)  # d/dalpha energy(x + alpha dx) at alpha = 0 (grad energy = -force)
     energy_merit = use_energy and e0 is not None and slope < 0.0
+    dx_norm = float(np.linalg.norm(dx))
     alpha = 1.0
     for _ in range(_MAX_BACKTRACKS + 1):
         xt = x.copy()
@@ -59,11 +71,26 @@ def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy):
                         return xt, rt, rtn, et, alpha
             else:
                 # merit 0.5 ||r||^2, whose slope along the exact Newton direction is -||r||^2
-                if rtn**2 <= (1.0 - 2.0 * _ARMIJO_C * alpha) * rnorm**2:
+                if rtn**2 <= (1.0 - 2.0 * _ARMIJO_C * alpha) * rnorm**2 or _natural_monotone(
+                        resolve, rt, alpha, dx_norm):
                     et = _energy_or_none(problem, xt, load) if use_energy else None
                     return xt, rt, rtn, et, alpha
         alpha *= 0.5
     raise _NewtonFailure(f"line search failed (no sufficient decrease down to step length {2 * alpha:.1e})")
+
+
+def _natural_monotone(resolve, r_trial, alpha, dx_norm) -> bool:
+    """Deuflhard's natural monotonicity test of a damped Newton step ``alpha dx``: the simplified
+    Newton correction ``resolve(r_trial)`` (the step's tangent, the trial residual) is at most
+    ``(1 - alpha / 2) ||dx||`` (for a linear problem it is ``(1 - alpha) ||dx||``)."""
+    if resolve is None or not dx_norm > 0.0:
+        return False
+    try:
+        dx_bar = resolve(r_trial)
+    except _NewtonFailure:
+        return False
+    bar = float(np.linalg.norm(dx_bar))
+    return bool(np.isfinite(bar) and bar <= (1.0 - 0.5 * alpha) * dx_norm)
 
 
 _ETA_MAX = 0.1  # loosest relative tolerance of the iterative linear solves (first iterations)
@@ -190,7 +217,9 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
             raise fail(str(exc)) from None
         if line_search:
             try:
-                x, r, rnorm, e, _ = _line_search(problem, x, dx, free, load, r, rnorm, e, use_energy)
+                resolve = None if use_energy else (  # the same tangent, for the natural monotonicity test
+                    lambda b, K=K, rtol=rtol: _linear_solve(K, b, linear_solver, symmetric, messages, context, rtol))
+                x, r, rnorm, e, _ = _line_search(problem, x, dx, free, load, r, rnorm, e, use_energy, resolve)
             except _NewtonFailure as exc:
                 raise fail(str(exc)) from None
         else:
@@ -229,7 +258,10 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
         floor being the round-off level of the forces (module docstring).
     max_iter : Newton iterations allowed per load step before the step counts as failed.
     line_search : backtracking with the Armijo condition on the energy when ``problem.energy``
-        returns a number and the Newton direction descends it, otherwise on ``||force[free]||^2``.
+        returns a number and the Newton direction descends it, otherwise on ``||force[free]||^2``
+        or, where that fails, Deuflhard's natural monotonicity test (the simplified Newton
+        correction with the same tangent at most ``(1 - alpha / 2)`` times the step; one more
+        linear solve per such trial).
     linear_solver : ``"auto"``, ``"direct"``, ``"cg"``, or a callable ``(K_free, rhs) -> dx``.
         ``"direct"``: for symmetric systems a banded Cholesky in a bandwidth-reducing ordering
         (computed once per sparsity pattern) when it is cheap, banded LU when the tangent is
