@@ -53,6 +53,7 @@ def warn_locking(mesh, nu_c, plane) -> None:
         return
     warnings.warn(f"linear-element FEM locks near nu = 1/2 (nu = {nu_max:.6g}, {_ELEMENT_NAMES[mesh.cell_type]}): "
                   f"its displacements are too small, by a factor that depends on the mesh (a clamped cube of "
-                  f"3^3 hexahedra at nu = 0.4999 settles 3.7 times less than one of 6^3); use nu < {LOCKING_NU} "
-                  f"where the material allows, check that refining the mesh no longer changes the result, or use "
-                  f"mixed (u-p) or higher-order elements outside msslib", MsslibWarning, stacklevel=3)
+                  f"3^3 hexahedra at nu = 0.4999 settles 3.7 times less than one of 6^3); use quadratic elements with "
+                  f"the volumetric part reduced (msslib.fem: order=2, volumetric='reduced'), or nu < {LOCKING_NU} "
+                  f"where the material allows, and check that refining the mesh no longer changes the result",
+                  MsslibWarning, stacklevel=3)
