@@ -457,7 +457,6 @@ def _cmd_export(args) -> int:
 
     from msslib import export, export_files
     from msslib.errors import MsslibWarning
-    from msslib.io import StagedOutputs
 
     try:
         formats = export_files.parse_formats(args.formats)
@@ -495,11 +494,8 @@ def _cmd_export(args) -> int:
         if missing:
             warnings.warn(f"{scene.name}: the {fmt} output does not carry {'; '.join(missing)} (said in the file; "
                           f"the csv and json outputs carry everything)", MsslibWarning, stacklevel=2)
-    if directory:
-        out.mkdir(parents=True, exist_ok=True)
-    with StagedOutputs() as staged:  # every file, or none
-        for fmt, what, path, table in planned:
-            staged.write(path, export_files.file_writer(exp, fmt, table), what=what)
+    # every file or none, with a manifest; a new folder appears whole; never over a file not the export's
+    export_files.write_outputs(exp, stem, planned)
     if not args.quiet:
         extra = f", {'; '.join(exp.volume_terms)}" if exp.volume_terms else ""
         print(f"{scene.name}: {scene.model}, {exp.n_nodes} nodes, {len(exp.pairs)} springs{extra} -> "

@@ -45,7 +45,10 @@ displacements, the loads and gravity. The writers turn it into
 
 Units are SI throughout. The writers are in :mod:`msslib.export_text` (CSV, JSON, VTU) and
 :mod:`msslib.export_simulators` (MuJoCo, SOFA); :mod:`msslib.export_files` chooses formats and
-file names and hands each output its writer.
+file names, hands each output its writer and writes them all or none (a folder it creates appears
+whole), with a manifest ``STEM.export-manifest.json`` of the files the export owns: the next export
+to the same stem removes those it no longer writes, and nothing else; it never overwrites a file
+that is not the export's.
 """
 
 from __future__ import annotations

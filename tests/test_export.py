@@ -85,7 +85,7 @@ def test_csv_and_json_round_trip_equal_the_model(tmp_path, capsys):
     csv_tables = {name: export_text.read_csv(out / f"golec_beam_{name}.csv", name)
                   for name in ("nodes", "springs", "fixed", "loads", "gravity", "hex_volume")}
     assert sorted(p.name for p in out.iterdir()) == sorted(
-        [f"golec_beam_{n}.csv" for n in csv_tables] + ["golec_beam.json"])
+        [f"golec_beam_{n}.csv" for n in csv_tables] + ["golec_beam.json", "golec_beam.export-manifest.json"])
     doc, json_tables = export_text.read_json(out / "golec_beam.json")
     assert doc["schema"] == export.SCHEMA and doc["schema_version"] == export.SCHEMA_VERSION
     assert doc["units"]["stiffness"] == "N/m" and doc["index_base"] == 0 and doc["dim"] == 3
@@ -476,7 +476,7 @@ def test_all_outputs_or_none(tmp_path, capsys, monkeypatch):
     code, err = _cli(capsys, "export", scene, "--out", f"{out}/", "--format", "csv,json,sofa")
     assert code == 0, err
     before = _snapshot(out)
-    assert len(before) == 9  # 7 tables, JSON, SOFA
+    assert len(before) == 10  # 7 tables, JSON, SOFA, the export manifest
 
     def fail(_exp):
         raise OSError(errno.ENOSPC, "No space left on device")
