@@ -44,6 +44,23 @@ wildcard_constraints:
     name=r"[A-Za-z0-9_\-]+",
 
 
+# What a job needs beyond a default cluster job (profiles/slurm: 1 core, mem_mb 2000, runtime 30
+# minutes), declared by the rules below so that a scheduler reserves it: peak memory (resident set)
+# measured on full builds, with headroom; quick builds fit the defaults. Measured full builds within
+# the defaults: the Baudet cantilever experiment (0.83 GB, 1.5 min), the speed-against-error front of
+# the cantilever (0.49 GB, 47 s). Local runs (`snakemake -j2`) ignore mem_mb and runtime.
+NEEDS = {} if QUICK else {
+    # the dense Baudet cantilever: Q2 continuum on 16x4x4 and the Q1 48x12x12 reference, 3.7 GB, 67 s
+    ("baudet", "cantilever_floor"): {"mem_mb": 6000},
+}
+DEFAULT_NEEDS = {"mem_mb": 2000, "runtime": 30}  # the profile's default-resources (a test checks they agree)
+
+
+def need(paper, name, resource):
+    """What job <paper>/<name> (an experiment or a study) asks the scheduler for (NEEDS, else the default)."""
+    return NEEDS.get((paper, name), {}).get(resource, DEFAULT_NEEDS[resource])
+
+
 def experiments():
     return {(p.parent.name, p.stem): p for paper in PAPERS for p in sorted(Path("experiments", paper).glob("*.yaml"))}
 
@@ -146,6 +163,9 @@ for (_paper, _exp), _path in experiments().items():
         params:
             quick=QFLAG,
             outdir=f"results/{_paper}/{_exp}",
+        resources:
+            mem_mb=need(_paper, _exp, "mem_mb"),
+            runtime=need(_paper, _exp, "runtime"),
         log:
             f"logs/{_paper}/{_exp}/runs.log",
         shell:
@@ -186,6 +206,9 @@ rule study:
         "results/{paper}/studies/{name}.nc",
     params:
         quick=QFLAG,
+    resources:
+        mem_mb=lambda wc: need(wc.paper, wc.name, "mem_mb"),
+        runtime=lambda wc: need(wc.paper, wc.name, "runtime"),
     log:
         "logs/{paper}/studies/{name}.log",
     shell:
@@ -237,6 +260,15 @@ rule stability:
         "python -m experiments.stability --out {output} {params.quick} > {log} 2>&1"
 
 
+def all_cores():
+    """Every core of a local run (--cores); 1 where no total is given (a cluster executor: the
+    benchmarks job then reserves its node with --exclusive instead)."""
+    try:
+        return workflow.cores
+    except WorkflowError:
+        return 1
+
+
 rule benchmarks:
     """Speed figures with their baselines: full sizes, with the machine to itself (all cores are
     reserved for it, so that no other job of the workflow runs beside the timings); reduced sizes
@@ -245,7 +277,10 @@ rule benchmarks:
         code=MSSLIB + sorted(str(p) for p in Path("benchmarks").glob("*.py")),
     output:
         "results/benchmarks.json",
-    threads: lambda wildcards: workflow.cores  # evaluated per job: `snakemake --report` needs no --cores
+    threads: lambda wildcards: all_cores()  # evaluated per job: `snakemake --report` needs no --cores
+    resources:
+        # on a cluster the job asks for a whole node (one core for itself, none for other jobs)
+        slurm_extra="--exclusive",
     params:
         size="--quick" if QUICK or config.get("benchmarks") == "quick" else "",
     log:

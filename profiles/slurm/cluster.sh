@@ -1,0 +1,168 @@
+#!/usr/bin/env bash
+# A one-node SLURM cluster on this machine, for trying the slurm profile (and for tests/test_slurm.py).
+#
+#   profiles/slurm/cluster.sh up [DIR]    start munged, slurmctld and slurmd with everything in DIR
+#                                         (a new temporary folder if not given); prints DIR, then the
+#                                         line `export SLURM_CONF=DIR/slurm.conf PATH=DIR/bin:$PATH` that
+#                                         points sbatch, squeue, srun (and snakemake) at it
+#   profiles/slurm/cluster.sh down DIR    cancel its jobs and stop its daemons (DIR and its logs stay)
+#
+# Needs root (the daemons run as root and so do the jobs) and Debian's packages slurmctld, slurmd,
+# slurm-client and munge; missing packages are installed with apt-get. Nothing outside DIR is
+# written or read besides that: its own munge key and socket, free TCP ports, and no accounting
+# database (the executor reads job states from squeue, so MinJobAge keeps finished jobs for an hour;
+# the job completion log DIR/jobcomp.log records every job). The node is this machine, with the CPUs
+# and memory `slurmd -C` finds. Any failure is one line `cluster.sh: error: ...` and exit status 1.
+set -euo pipefail
+
+die() { echo "cluster.sh: error: $*" >&2; exit 1; }
+
+need_packages() {
+    local missing=()
+    for cmd in munged slurmctld slurmd sbatch squeue scontrol sinfo; do
+        command -v "$cmd" > /dev/null 2>&1 || missing+=("$cmd")
+    done
+    [ ${#missing[@]} -eq 0 ] && return 0
+    command -v apt-get > /dev/null 2>&1 \
+        || die "missing ${missing[*]} and no apt-get to install Debian's slurmctld slurmd slurm-client munge"
+    local log
+    log=$(mktemp)
+    if ! { DEBIAN_FRONTEND=noninteractive apt-get install -y -q slurmctld slurmd slurm-client munge > "$log" 2>&1 \
+           || { apt-get update -q > "$log" 2>&1 \
+                && DEBIAN_FRONTEND=noninteractive apt-get install -y -q slurmctld slurmd slurm-client munge > "$log" 2>&1; }; }; then
+        local last
+        last=$(grep -E '^(E|W):' "$log" | tail -n 1 || true)
+        rm -f "$log"
+        die "apt-get could not install slurmctld slurmd slurm-client munge: ${last:-see apt-get output}"
+    fi
+    rm -f "$log"
+    for cmd in "${missing[@]}"; do
+        command -v "$cmd" > /dev/null 2>&1 || die "apt-get installed the packages but $cmd is still missing"
+    done
+}
+
+free_port() {
+    python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
+}
+
+# last line of a daemon's log, for the error message
+last_log() { [ -s "$1" ] && tail -n 1 "$1" | cut -c1-200 || echo "no log written"; }
+
+wait_pid_file() {  # FILE NAME LOG: the daemon wrote its pid and is alive
+    for _ in $(seq 1 100); do
+        if [ -s "$1" ] && kill -0 "$(cat "$1")" 2> /dev/null; then return 0; fi
+        sleep 0.1
+    done
+    die "$2 did not start: $(last_log "$3")"
+}
+
+up() {
+    [ "$(id -u)" -eq 0 ] || die "needs root to run munged, slurmctld and slurmd (running as uid $(id -u))"
+    need_packages
+    local dir=${1:-}
+    if [ -z "$dir" ]; then dir=$(mktemp -d "${TMPDIR:-/tmp}/slurm-cluster.XXXXXX"); fi
+    mkdir -p "$dir"
+    dir=$(cd "$dir" && pwd)
+    [ ! -e "$dir/slurm.conf" ] || die "$dir already holds a cluster (run: $0 down $dir)"
+    chmod 755 "$dir"  # munged wants its socket's folders searchable by all
+    mkdir -p "$dir/state" "$dir/spool"
+
+    # munge with its own key and socket: nothing shared with a system munged or another cluster
+    head -c 1024 /dev/urandom > "$dir/munge.key"
+    chmod 400 "$dir/munge.key"
+    munged --socket="$dir/munge.socket" --key-file="$dir/munge.key" --pid-file="$dir/munged.pid" \
+        --log-file="$dir/munged.log" --seed-file="$dir/munged.seed" 2> "$dir/munged.err" \
+        || die "munged did not start: $(last_log "$dir/munged.err")"
+    wait_pid_file "$dir/munged.pid" munged "$dir/munged.log"
+
+    local node host ctld_port slurmd_port
+    node=$(slurmd -C | head -n 1)
+    [[ $node == NodeName=* ]] || die "slurmd -C did not describe this machine: $node"
+    host=${node%% *}
+    host=${host#NodeName=}
+    ctld_port=$(free_port)
+    slurmd_port=$(free_port)
+    while [ "$slurmd_port" = "$ctld_port" ]; do slurmd_port=$(free_port); done
+    cat > "$dir/slurm.conf" << EOF
+ClusterName=msslib
+SlurmctldHost=$host(127.0.0.1)
+SlurmctldPort=$ctld_port
+SlurmdPort=$slurmd_port
+AuthType=auth/munge
+CredType=cred/munge
+AuthInfo=socket=$dir/munge.socket
+SlurmUser=root
+SlurmdUser=root
+StateSaveLocation=$dir/state
+SlurmdSpoolDir=$dir/spool
+SlurmctldPidFile=$dir/slurmctld.pid
+SlurmdPidFile=$dir/slurmd.pid
+SlurmctldLogFile=$dir/slurmctld.log
+SlurmdLogFile=$dir/slurmd.log
+SlurmctldDebug=info
+SlurmdDebug=info
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+JobCompType=jobcomp/filetxt
+JobCompLoc=$dir/jobcomp.log
+SchedulerType=sched/backfill
+SelectType=select/cons_tres
+SelectTypeParameters=CR_CPU_Memory
+MpiDefault=none
+ReturnToService=2
+MinJobAge=3600
+MailProg=/bin/true
+${node%% UpTime=*} NodeAddr=127.0.0.1 State=UNKNOWN
+PartitionName=main Nodes=ALL Default=YES MaxTime=INFINITE State=UP
+EOF
+    export SLURM_CONF="$dir/slurm.conf"
+    # The executor's job step starts its srun without SLURM_* variables (SLURM_CONF included), so that
+    # srun would look for the machine's own configuration: DIR/bin/srun (first on PATH) points it here.
+    mkdir -p "$dir/bin"
+    printf '#!/bin/sh\nexport SLURM_CONF=%s\nexec %s "$@"\n' "$SLURM_CONF" "$(command -v srun)" > "$dir/bin/srun"
+    chmod 755 "$dir/bin/srun"
+    slurmctld -f "$SLURM_CONF" -c 2> "$dir/slurmctld.err" || die "slurmctld did not start: $(last_log "$dir/slurmctld.err")"
+    wait_pid_file "$dir/slurmctld.pid" slurmctld "$dir/slurmctld.log"
+    slurmd -f "$SLURM_CONF" -N "$host" 2> "$dir/slurmd.err" || die "slurmd did not start: $(last_log "$dir/slurmd.err")"
+    wait_pid_file "$dir/slurmd.pid" slurmd "$dir/slurmd.log"
+
+    local state=""
+    for _ in $(seq 1 150); do
+        state=$(sinfo -h -N -n "$host" -o %T 2> /dev/null || true)
+        [ "$state" = idle ] && break
+        sleep 0.2
+    done
+    [ "$state" = idle ] || die "node $host is '${state:-not reported}', not idle, after 30 s: $(last_log "$dir/slurmctld.log")"
+    echo "$dir"
+    echo "export SLURM_CONF=$SLURM_CONF PATH=$dir/bin:\$PATH"
+}
+
+stop_pid_file() {  # FILE: SIGTERM, then SIGKILL after 10 s
+    [ -s "$1" ] || return 0
+    local pid
+    pid=$(cat "$1")
+    kill "$pid" 2> /dev/null || return 0
+    for _ in $(seq 1 100); do
+        kill -0 "$pid" 2> /dev/null || return 0
+        sleep 0.1
+    done
+    kill -9 "$pid" 2> /dev/null || true
+}
+
+down() {
+    local dir=${1:?usage: $0 down DIR}
+    [ -f "$dir/slurm.conf" ] || die "$dir holds no cluster (no slurm.conf)"
+    export SLURM_CONF="$dir/slurm.conf"
+    scancel --full --quiet --user=root 2> /dev/null || true
+    stop_pid_file "$dir/slurmd.pid"
+    stop_pid_file "$dir/slurmctld.pid"
+    stop_pid_file "$dir/munged.pid"
+}
+
+case "${1:-}" in
+    up) up "${2:-}" ;;
+    down) down "${2:-}" ;;
+    *) die "usage: $0 up [DIR] | down DIR" ;;
+esac
