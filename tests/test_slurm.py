@@ -203,3 +203,11 @@ def test_rules_ask_the_scheduler_for_what_they_need(tmp_path):
     assert int(dense["mem_mb"]) >= 3700 > defaults["mem_mb"]  # its measured peak: 3.7 GB
     assert quick["results/baudet/studies/cantilever_floor.nc"]["mem_mb"] == str(defaults["mem_mb"])
     assert full["results/benchmarks.json"]["slurm_extra"] == "--exclusive"
+
+
+def test_readme_shows_the_tested_profile():
+    """The README's cluster section shows the profile this test runs, setting for setting."""
+    section = (ROOT / "README.md").read_text().split("### On a cluster", 1)[1].split("\n## ", 1)[0]
+    shown = re.findall(r"```yaml\n(.*?)```", section, re.S)
+    assert len(shown) == 1
+    assert yaml.safe_load(shown[0]) == yaml.safe_load((ROOT / PROFILE / "config.yaml").read_text())
