@@ -201,10 +201,10 @@ def test_plan_rejects_bad_arguments(tmp_path, capsys, no_measuring, args, names)
     ("  \n# only a comment\n", ["scene.yaml", "is empty"]),
     ("- a list\n", ["scene.yaml", "expected a mapping"]),
     ("geometry: [unclosed\n", ["scene.yaml", "invalid YAML"]),
-    (yaml.safe_dump({**SCENE, "geometry": {"file": "mesh.vtu"}}), ["scene.geometry", "planning needs a generator"]),
+    (yaml.safe_dump({**SCENE, "geometry": {"file": "missing.vtu"}}), ["scene.geometry.file", "missing.vtu"]),
     (yaml.safe_dump({**SCENE, "materials": [{"E": "abc", "nu": 0.3}]}), ["scene.materials[0].E", "'abc'"]),
     (yaml.safe_dump({**SCENE, "geometry": {"generator": "hex_grid", "args": {
-        "lx": 0.1, "ly": 0.1, "lz": 0.1, "nx": 2.5, "ny": 2, "nz": 2}}}), ["scene.geometry.args.nx", "2.5"]),
+        "lx": 0.1, "ly": 0.1, "lz": 0.1, "nx": 2.5, "ny": 2, "nz": 2}}}), ["scene.geometry", "nx", "2.5"]),
     (yaml.safe_dump({**SCENE, "solver": {"type": "dynamic", "dt": 1e-4, "t_end": 1e-3}, "materials": [
         {"E": 1e6, "nu": 0.3, "density": 1000.0}]}), ["scene.solver", "dynamic"]),
 ], ids=["empty", "comment only", "a list", "invalid YAML", "mesh file", "bad E", "fractional nx", "dynamic"])

@@ -1,15 +1,18 @@
 """Speed against error: measure the front of (model, resolution) for a scene, and choose from it.
 
-:func:`measure_front` runs a scene at several resolutions with every model that fits its cells
-(mass-spring variants, linear FEM, non-linear FEM), records the wall time (median of repeats, same
-machine, same run) and the displacement error against a converged non-linear FEM reference computed
-one level finer than the finest tested resolution, and returns an xarray Dataset. :func:`choose`
-returns the cheapest measured (model, resolution) whose error is within a budget; the command line
-``python -m msslib plan SCENE.yaml --max-error 0.05`` prints it with the numbers it rests on.
+:func:`measure_front` (:mod:`msslib.planning.front`, the engine of ``python -m msslib plan`` and
+of the paper's speed-against-error study) runs a scene on nested levels (level ``k``: its mesh,
+generated or read from a file, refined uniformly ``k - 1`` times) with every model that fits its
+cells (mass-spring models, linear FEM, non-linear FEM), records the time and the displacement
+error against a quadratic-element FEM reference (:mod:`msslib.planning.reference`: its own error
+estimated from its coarser levels, locking-free near nu = 1/2), and returns an xarray Dataset.
+:func:`choose` returns the cheapest measured (model, level) whose error is within a budget, and
+refuses a budget below what the reference resolves; :func:`report` gives the lines ``plan``
+prints, the reference's own error beside the choice.  Errors are relative to the largest
+reference displacement (maximum over nodes of the Euclidean error); a budget is a fraction
+(0.05 = 5 %), and one above 1 is refused as a likely percentage.
 
-Resolution levels scale the scene's generator arguments: ``nx``, ``ny``, ``nz`` and ``n`` are
-multiplied by the level, ``h`` (gmsh size) divided by it. Errors are relative to the largest
-reference displacement (maximum over nodes of the Euclidean error).
+:func:`refine` (generator arguments scaled by a level) remains for the benchmarks' scenes.
 """
 
 from __future__ import annotations
@@ -18,7 +21,6 @@ import copy
 import math
 import numbers
 import os
-import time
 from pathlib import Path
 
 import numpy as np
@@ -161,6 +163,9 @@ def _max_error(value):
             math.isfinite(value) and value > 0):
         raise ValueError(f"max_error must be a finite number > 0 (a fraction of the largest reference "
                          f"displacement), got {value!r}")
+    if value > 1:
+        raise ValueError(f"max error {value:g} is {100 * value:g} % of the largest reference displacement; it is a "
+                         f"fraction: did you mean {value:g} % (max error {value / 100:g})?")
     return float(value)
 
 
@@ -217,23 +222,24 @@ def _run(raw, base_dir, budget=None):
 
 
 def check_scene(scene, *, levels=(1, 2, 3), models=None):
-    """Validate a scene for planning without solving anything: a mapping or a scene file with a
-    mesh generator and a resolution argument, valid (:func:`msslib.scene.load_scene`) at every
-    level with every model, a mesh that can be built at the first level, a static solver.
-    Returns ``(raw, base_dir, cell_type, models, reference_model)``; ValueError (or
-    FileNotFoundError) naming what is wrong."""
+    """Validate a scene for planning without solving anything: a mapping or a scene file (a
+    generated mesh or a mesh file), valid (:func:`msslib.scene.load_scene`) at every level with
+    every model, a mesh that can be built at the first level, a static solver.  Returns
+    ``(raw, base_dir, cell_type, models, reference_model)``; ValueError (or FileNotFoundError)
+    naming what is wrong."""
     from msslib import models as registry
+    from msslib.planning.front import at_level, check_scene_levels
     from msslib.scene import load_scene, prepare
 
     levels = check_arguments(levels=levels, models=models)
     raw, base_dir = _raw(scene)
-    load_scene(raw, base_dir=base_dir)  # every key and value, with the usual messages
-    setup = prepare(load_scene(refine(raw, levels[0]), base_dir=base_dir))  # builds the mesh, no solve
+    scene_ = load_scene(raw, base_dir=base_dir)  # every key and value, with the usual messages
+    if scene_.is_dynamic:
+        raise ValueError("scene.solver: planning compares static solves; the scene is dynamic")
+    setup = prepare(load_scene(at_level(raw, min(levels), "fem_linear"), base_dir=base_dir))  # the mesh, no solve
     cell_type = setup.mesh.cell_type
     if cell_type not in MODELS:
         raise ValueError(f"scene.geometry: planning knows no models for {cell_type} cells")
-    if setup.scene.is_dynamic:
-        raise ValueError("scene.solver: planning compares static solves; the scene is dynamic")
     models = list(models or MODELS[cell_type])
     fitting = list(registry.for_cells(cell_type))
     wrong = [m for m in models if m not in fitting]
@@ -241,80 +247,11 @@ def check_scene(scene, *, levels=(1, 2, 3), models=None):
         raise ValueError(f"models: {', '.join(wrong)} cannot run on {cell_type} cells; expected some of "
                          f"{', '.join(fitting)}")
     ref_model = REFERENCE[cell_type]
-    for level in (*levels, max(levels) + 1):
-        for model in dict.fromkeys([*models, ref_model]):
-            load_scene(_with_model(refine(raw, level), model), base_dir=base_dir)
+    check_scene_levels(raw, base_dir, levels, models, ref_model)
     return raw, base_dir, cell_type, models, ref_model
 
 
-def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.0, progress=print):
-    """Measure time and error of every (model, level); returns an xarray Dataset.
-
-    Every argument and the scene are checked before anything is run (:func:`check_arguments`,
-    :func:`check_scene`). A run that fails or exceeds ``budget`` seconds (None: no limit) is
-    recorded in ``status`` (with NaN time and error) instead of stopping the sweep: that a model
-    breaks on a scene is a result too."""
-    import xarray as xr
-
-    from msslib.compare import interpolate
-    from msslib.io import mesh_from_result
-    from msslib.metrics import displacement_error
-
-    levels = check_arguments(levels=levels, models=models, repeats=repeats, budget=budget)
-    raw, base_dir, cell_type, models, ref_model = check_scene(scene, levels=levels, models=models)
-    repeats = int(repeats)
-    ref_level = max(levels) + 1
-    t0 = time.perf_counter()
-    ref = _run(_with_model(refine(raw, ref_level), ref_model), base_dir)
-    if progress:
-        progress(f"reference {ref_model} at level {ref_level}: {ref.sizes['node']} nodes, {time.perf_counter() - t0:.1f} s")
-    ref_mesh = mesh_from_result(ref)
-    u_ref = ref["displacement"].transpose("node", "axis").values
-    scale = float(np.linalg.norm(u_ref, axis=1).max())
-    if not (math.isfinite(scale) and scale > 0):
-        raise ValueError(f"the reference ({ref_model} at level {ref_level}) does not move (largest displacement "
-                         f"{scale:g} m): errors relative to it mean nothing; give the scene a load or a "
-                         f"prescribed displacement")
-    shape = (len(models), len(levels))
-    wall = np.full(shape, np.nan)
-    err_max = np.full(shape, np.nan)
-    err_mean = np.full(shape, np.nan)
-    dofs = np.zeros(shape, dtype=np.int64)
-    status = np.full(shape, "ok", dtype=object)
-    for i, model in enumerate(models):
-        for j, level in enumerate(levels):
-            sc = _with_model(refine(raw, level), model)
-            times = []
-            try:
-                for _ in range(repeats):
-                    ds = _run(sc, base_dir, budget)
-                    times.append(float(ds.attrs["wall_time_s"]))
-            except (Exception, RunTimeout) as exc:  # a model that fails on a scene is a measured outcome
-                status[i, j] = f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}"
-                if progress:
-                    progress(f"{model} level {level}: failed ({status[i, j]})")
-                continue
-            X = ds["rest_position"].transpose("node", "axis").values
-            u = ds["displacement"].transpose("node", "axis").values
-            e = displacement_error(u, interpolate(ref_mesh, u_ref, X), relative_to=scale)
-            wall[i, j], err_max[i, j], err_mean[i, j] = np.median(times), e.rel_max, e.rel_mean
-            dofs[i, j] = u.size
-            if progress:
-                progress(f"{model} level {level}: {u.size} dofs, {wall[i, j]:.3g} s, max error {100 * e.rel_max:.3g} %")
-    out = xr.Dataset(
-        {
-            "wall_time": (("model", "level"), wall, {"units": "s", "long_name": f"median wall time of {repeats} runs"}),
-            "error_max": (("model", "level"), err_max, {"units": "1", "long_name": "max node error / max reference displacement"}),
-            "error_mean": (("model", "level"), err_mean, {"units": "1", "long_name": "mean node error / max reference displacement"}),
-            "n_dofs": (("model", "level"), dofs, {"units": "1", "long_name": "degrees of freedom"}),
-            "status": (("model", "level"), status.astype(str), {"units": "1", "long_name": "ok or the error raised"}),
-        },
-        coords={"model": models, "level": list(levels)},
-        attrs={"reference_model": ref_model, "reference_level": ref_level, "reference_max_displacement": scale,
-               "scene": yaml.safe_dump(raw, sort_keys=False), "repeats": repeats},
-    )
-    return out
-
+from msslib.planning.front import measure_front  # noqa: E402 - the engine, after what it uses
 
 FRONT_VARIABLES = ("wall_time", "error_max", "error_mean", "n_dofs", "status")
 FRONT_ATTRS = ("reference_model", "reference_level")
@@ -333,10 +270,26 @@ def check_front(front, name="front"):
     return front
 
 
+def reference_error(front) -> float:
+    """The reference's own error estimate of a front (NaN when it has none)."""
+    try:
+        return float(front.attrs.get("reference_error", math.nan))
+    except (TypeError, ValueError):
+        return math.nan
+
+
 def choose(front, max_error: float):
-    """The cheapest measured (model, level) with ``error_max <= max_error``, or None."""
+    """The cheapest measured (model, level) with ``error_max <= max_error``, or None.  A budget
+    below the reference's own error estimate is refused (ValueError): the reference cannot tell
+    which model meets it."""
     check_front(front)
     max_error = _max_error(max_error)
+    ref_err = reference_error(front)
+    if math.isfinite(ref_err) and max_error < ref_err:
+        raise ValueError(f"max error {100 * max_error:.3g} % is below the reference's own error, about "
+                         f"{100 * ref_err:.2g} % (its change under the last refinement, levels "
+                         f"{front.attrs.get('reference_levels', '?')}): it cannot tell which model meets that budget; "
+                         f"allowed: a budget of at least {100 * ref_err:.2g} %, or measure finer levels (--levels)")
     best = None
     for m in front.model.values:
         for lv in front.level.values:
@@ -345,6 +298,34 @@ def choose(front, max_error: float):
             if np.isfinite(e) and e <= max_error and (best is None or t < best[2]):
                 best = (str(m), int(lv), t, e)
     return best
+
+
+def report(front, max_error: float) -> list[str]:
+    """The lines ``plan`` prints: the reference with its own error, the Pareto front and the
+    choice, the reference's error beside it (flagged when the choice's margin is within it).
+    ValueError when no measured point is within the budget, or the budget is below what the
+    reference resolves."""
+    best = choose(front, max_error)
+    ref_err = reference_error(front)
+    own = (f"own error about {100 * ref_err:.2g} % (change under its last refinement "
+           f"{100 * float(front.attrs.get('reference_step_change', math.nan)):.2g} %)"
+           if math.isfinite(ref_err) else "own error not estimated (one level only)")
+    lines = [f"reference: {front.attrs['reference_model']} on level {front.attrs['reference_level']}, {own}"]
+    for m, lv, t, e in pareto(front):
+        lines.append(f"  front: {m:26s} level {lv}: {t:.3g} s, max error {100 * e:.3g} %")
+    if best is None:
+        smallest = float(front.error_max.min())
+        shown = f"{100 * smallest:.3g} %" if math.isfinite(smallest) else "none (every run failed)"
+        raise ValueError(f"no measured model/resolution reaches max error {max_error:g}; smallest measured: {shown}")
+    m, lv, t, e = best
+    note = ""
+    if math.isfinite(ref_err):
+        note = f" (reference's own error about {100 * ref_err:.2g} %"
+        note += ", within the margin: the choice is uncertain)" if e + ref_err > max_error else ")"
+    timing = "best CPU time" if front.attrs.get("timing") == "cpu" else "median wall time"
+    lines.append(f"choice: {m} at resolution level {lv}: max error {100 * e:.3g} % <= {100 * max_error:.3g} %"
+                 f"{note}, {timing} {t:.3g} s")
+    return lines
 
 
 def pareto(front):
