@@ -334,8 +334,9 @@ def _add_plan(subparsers) -> None:
     p = subparsers.add_parser("plan", help="the cheapest model and resolution within an error budget",
                               description="Measure (or read) the speed/error front of a scene and pick the cheapest "
                                           "(model, resolution) whose error against converged non-linear FEM is within budget.")
-    p.add_argument("scene", help="scene file (YAML) with a mesh generator")
-    p.add_argument("--max-error", type=float, required=True, help="budget: max node error / max reference displacement")
+    p.add_argument("scene", help="scene file (YAML), with a mesh generator or a mesh file")
+    p.add_argument("--max-error", type=float, required=True,
+                   help="budget: max node error / max reference displacement, a fraction (0.05 = 5 %%)")
     p.add_argument("--front", help="a front measured before (NetCDF from `plan --save`) for this scene")
     p.add_argument("--save", help="write the front here (NetCDF)")
     p.add_argument("--levels", help=f"resolution levels to measure: {LEVELS_HELP} (default 1,2,3)")
@@ -392,6 +393,7 @@ def _cmd_plan(args) -> int:
 
     scene = Path(args.scene)
     max_error = _positive_number("--max-error", args.max_error, "a fraction of the largest reference displacement")
+    planning.check_arguments(max_error=max_error)  # above 1: "did you mean 5 %?"
     if args.front is not None:
         given = [o for o, v in (("--levels", args.levels), ("--repeats", args.repeats), ("--budget", args.budget))
                  if v is not None]
@@ -415,18 +417,8 @@ def _cmd_plan(args) -> int:
                                        progress=lambda s: print(s, file=sys.stderr))
     if save is not None:
         write_result(save, front)
-    best = planning.choose(front, max_error)
-    print(f"reference: {front.attrs['reference_model']} at level {front.attrs['reference_level']}")
-    for m, lv, t, e in planning.pareto(front):
-        print(f"  front: {m:26s} level {lv}: {t:.3g} s, max error {100 * e:.3g} %")
-    if best is None:
-        smallest = float(front.error_max.min())
-        shown = f"{100 * smallest:.3g} %" if math.isfinite(smallest) else "none (every run failed)"
-        raise CommandError(f"no measured model/resolution reaches max error {max_error:g}; "
-                           f"smallest measured: {shown}")
-    m, lv, t, e = best
-    print(f"choice: {m} at resolution level {lv}: max error {100 * e:.3g} % <= {100 * max_error:.3g} %, "
-          f"median wall time {t:.3g} s")
+    for line in planning.report(front, max_error):  # the reference's own error beside the choice
+        print(line)
     return 0
 
 
