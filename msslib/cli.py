@@ -17,6 +17,9 @@ Commands
     (:mod:`msslib.experiment`).
 ``plan SCENE.yaml --max-error E``
     The cheapest measured (model, resolution) within an error budget (:mod:`msslib.planning`).
+``compare RESULT.nc REFERENCE.nc [--out TABLE.md] [--vtu ERROR.vtu]``
+    The per-node error of a result against a reference on the same or another mesh of the same
+    body (:mod:`msslib.compare`), as a table and optionally as a field for ParaView.
 ``vtu RESULT.nc --out OUT.vtu|OUT.pvd``
     Export any result for ParaView: ``.vtu`` the final state, ``.pvd`` every saved state.
 ``export SCENE.yaml --out DIR/|STEM [--format csv,json,vtu,mjcf,sofa,c]``
@@ -293,6 +296,39 @@ def _cmd_vtu(args) -> int:
     return 0
 
 
+def _add_compare(subparsers) -> None:
+    p = subparsers.add_parser("compare", help="the per-node error of one result against another (msslib.compare)")
+    p.add_argument("result", help="result file (NetCDF)")
+    p.add_argument("reference", help="reference result file (NetCDF), same mesh or another mesh of the same body")
+    p.add_argument("--out", "-o", help="also write the table (Markdown)")
+    p.add_argument("--vtu", help="also write the error field on the result's mesh for ParaView (.vtu)")
+    p.set_defaults(func=_cmd_compare)
+
+
+def _cmd_compare(args) -> int:
+    from msslib.compare import compare_results, write_error_field
+    from msslib.io import StagedOutputs
+
+    src, ref = Path(args.result), Path(args.reference)
+    out, vtu = (Path(a) if a else None for a in (args.out, args.vtu))
+    if vtu and vtu.suffix.lower() != ".vtu":
+        raise CommandError(f"--vtu {str(vtu)!r}: the error field is one state; give a .vtu file")
+    outputs = [("table", out), ("error field", vtu)]
+    _check_distinct(outputs, [("result file", src), ("reference file", ref)])
+    for what, path in outputs:
+        if path is not None:
+            _check_writable(path, what)
+    comparison = compare_results(_read_result(src, "result file"), _read_result(ref, "reference file"),
+                                 result_name=str(src), reference_name=str(ref))
+    with StagedOutputs() as staged:  # both files, or neither
+        if out is not None:
+            staged.write_text(out, comparison.table(), what="table")
+        if vtu is not None:
+            staged.write(vtu, lambda tmp: write_error_field(tmp, comparison), what="error field")
+    print(comparison.table(), end="")
+    return 0
+
+
 def _add_paper(subparsers) -> None:
     p = subparsers.add_parser("paper", help="build the paper (Markdown with placeholders -> HTML)")
     p.add_argument("source", help="main source, e.g. paper/paper.md.in")
@@ -496,7 +532,7 @@ def _cmd_export(args) -> int:
 
 
 #: subparser builders, in the order of the help text
-COMMANDS = [_add_run, _add_validate, _add_experiment, _add_paper, _add_plan, _add_vtu, _add_export]
+COMMANDS = [_add_run, _add_validate, _add_experiment, _add_compare, _add_paper, _add_plan, _add_vtu, _add_export]
 
 
 def build_parser() -> argparse.ArgumentParser:

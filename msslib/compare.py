@@ -82,7 +82,7 @@ def interpolate(ref_mesh, ref_u, points):
 class Comparison:
     """The error of ``result`` against ``reference`` (see the module docstring).
 
-    ``relation`` is ``"same mesh"`` or ``"interpolated"``; ``n_outside`` result nodes lie outside
+    ``relation`` is ``"same mesh"`` or ``"interpolated"``; ``models`` the two results' model names; ``n_outside`` result nodes lie outside
     the reference mesh, the farthest ``outside_distance`` metres away.  ``u`` and ``u_ref`` are the
     result's displacement and the reference's at the result's nodes; ``error`` the per-node
     :class:`msslib.metrics.DisplacementError`.
@@ -91,6 +91,7 @@ class Comparison:
     result: str
     reference: str
     relation: str
+    models: tuple[str, str]
     mesh: object
     u: np.ndarray
     u_ref: np.ndarray
@@ -118,7 +119,9 @@ class Comparison:
         """The comparison as a Markdown table with a header saying what was compared how."""
         how = ("on the same mesh" if self.relation == "same mesh" else
                "at the result's nodes, the reference interpolated with its own shape functions")
-        lines = [f"error of {self.result} against {self.reference} ({self.n_nodes} nodes, {how})", ""]
+        (a, b), (ma, mb) = (self.result, self.reference), self.models
+        lines = [f"error of {a}{f' ({ma})' if ma else ''} against {b}{f' ({mb})' if mb else ''}: "
+                 f"{self.n_nodes} nodes, {how}", ""]
         if self.n_outside:
             lines += [f"{self.n_outside} result nodes lie outside the reference mesh (at most "
                       f"{self.outside_distance:.3g} m away) and take the nearest reference node's displacement", ""]
@@ -176,7 +179,8 @@ def compare_results(result, reference, *, result_name: str = "result",
                 f"(allowed: {MAX_OUTSIDE:g} of its size, {MAX_OUTSIDE * size:.3g} m)")
     reference_max = float(np.linalg.norm(u_ref, axis=1).max())
     error = displacement_error(u, ur, relative_to=reference_max if reference_max > 0 else None)
-    return Comparison(result=result_name, reference=reference_name, relation=relation, mesh=mesh, u=u,
+    models = (str(result.attrs.get("model", "")), str(reference.attrs.get("model", "")))
+    return Comparison(result=result_name, reference=reference_name, relation=relation, models=models, mesh=mesh, u=u,
                       u_ref=ur, error=error, reference_max=reference_max, n_outside=n_outside,
                       outside_distance=far)
 

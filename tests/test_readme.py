@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 
@@ -50,3 +51,38 @@ def test_quick_start_runs_as_written(tmp_path):
         return
     model = mujoco.MjModel.from_xml_path(str(mjcf))
     assert model.ntendon == ds.sizes["spring"]
+
+
+def _section_blocks(title):
+    text = README.read_text(encoding="utf-8")
+    section = text.split(f"## {title}", 1)[1].split("\n## ", 1)[0]
+    return re.findall(r"```(bash|python)\n(.*?)```", section, re.S)
+
+
+def test_model_against_fem_runs_as_written(tmp_path):
+    """The quick start's mesh, then the comparison section as written; the numbers behind the table
+    are checked from the two result files: each reaction carries the bar's weight, and the error field
+    is the distance between the two displacements."""
+    mesh_script = _quick_start_blocks()[0][1].split("python3 -m msslib export", 1)[0]
+    (kind, body), = _section_blocks("Your model against FEM, on your mesh")
+    env_python = Path(sys.executable).parent
+    proc = subprocess.run(["bash", "-ec", f'export PATH="{env_python}:$PATH"\n{mesh_script}\n{body}'],
+                          cwd=tmp_path, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    import meshio
+
+    from msslib.io import mesh_from_result, read_result
+    from msslib.metrics import cell_volumes
+
+    results = [read_result(tmp_path / name) for name in ("bar_mss.nc", "bar_fem.nc")]
+    for ds in results:
+        weight = 1000.0 * 9.81 * cell_volumes(mesh_from_result(ds)).sum()  # both materials: 1000 kg/m^3
+        reaction = ds["reaction_force"].transpose("node", "axis").values
+        assert reaction[:, 2].sum() == pytest.approx(weight, rel=1e-6)
+    u, u_ref = (ds["displacement"].transpose("node", "axis").values for ds in results)
+    distance = np.linalg.norm(u - u_ref, axis=1)
+    field = meshio.read(tmp_path / "bar_error.vtu").point_data["error_magnitude"]
+    np.testing.assert_allclose(field, distance, rtol=1e-12, atol=1e-15)
+    table = (tmp_path / "bar_error.md").read_text()
+    assert f"| max | {distance.max():.6g} m |" in table
+    assert "(lloyd_tetrahedron) against bar_fem.nc (fem_neohookean)" in table
