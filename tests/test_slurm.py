@@ -176,9 +176,9 @@ def test_subset_through_slurm_equals_local_run(cluster, tmp_path):
 
 
 def test_rules_ask_the_scheduler_for_what_they_need(tmp_path):
-    """The profile's defaults are what the Snakefile assumes for a default job; the dense Baudet
-    cantilever study asks for more memory in a full build (not in a quick one); the benchmarks ask
-    for a node of their own."""
+    """A study whose rule declares nothing gets the profile's defaults; the dense Baudet cantilever
+    study asks for more memory in a full build (not in a quick one); the benchmarks ask for a node of
+    their own."""
     repo = copy_repository(tmp_path / "repo")
     targets = ["results/baudet/studies/cantilever_floor.nc", "results/lloyd/studies/load_sweep.nc",
                "results/benchmarks.json"]
