@@ -1,5 +1,6 @@
-"""Speed-against-error study: the quadratic-element reference, the linear MSS solve, nested levels
-and the crossover budget (experiments/performance/front.py and reference.py)."""
+"""Speed-against-error study: the quadratic-element reference (msslib.planning.reference on
+msslib.fem's element order), the linear MSS solve, nested levels and the crossover budget
+(experiments/performance/front.py)."""
 
 import copy
 import math
@@ -9,8 +10,8 @@ import pytest
 import xarray as xr
 
 from experiments.performance import front
-from experiments.performance import reference as R
 from msslib import fem
+from msslib.planning.reference import at_points, solve_setup
 from msslib.scene import load_scene, prepare, run_scene
 
 MEMBRANE = {
@@ -29,6 +30,12 @@ def _bar(generator, args, g=(9.81, 0.0, 0.0)):
             "loads": [{"type": "gravity", "g": list(g)}], "solver": {"type": "static"}}
 
 
+def _solve(setup, **kw):
+    """The reference's displacement at the mesh's nodes, and the whole result."""
+    r = solve_setup(setup, **kw)
+    return r.displacement, r
+
+
 def _setup(raw):
     return prepare(load_scene(raw))
 
@@ -40,10 +47,10 @@ def test_order_one_reference_is_the_library_fem():
     s = _setup(raw)
     ds = run_scene(load_scene(raw), progress=False)
     u_fem = ds["displacement"].transpose("node", "axis").values
-    u1, _ = R.solve(s, order=1, law="svk", steps=4)
+    u1, _ = _solve(s, order=1, law="svk", steps=4)
     assert np.abs(u1 - u_fem).max() <= 1e-9 * np.abs(u_fem).max()
     lin = fem.solve_linear(s.mesh, 14630.0, 1 / 3, fixed=s.fixed, nodal_forces=s.surface_forces, thickness=0.01)
-    u1l, _ = R.solve(s, order=1, law=None)
+    u1l, _ = _solve(s, order=1, law=None)
     assert np.abs(u1l - lin.displacement).max() <= 1e-12 * np.abs(lin.displacement).max()
 
 
@@ -56,19 +63,19 @@ def test_quadratic_elements_reproduce_the_quadratic_bar_under_its_weight(generat
     """nu = 0, clamped at x = 0, gravity along x: u_x = rho g / E (L x - x^2 / 2) exactly."""
     raw = _bar(generator, args, g=(9.81, 0.0, 0.0) if "lz" in args else (9.81, 0.0))
     s = _setup(raw)
-    _, info = R.solve(s, order=2, law=None)
-    x = info["x_dofs"][:, 0]
+    _, info = _solve(s, order=2, law=None)
+    x = info.dof_points[:, 0]
     exact = 10.0 * 9.81 / 1000.0 * (1.0 * x - x**2 / 2)
-    np.testing.assert_allclose(info["u_dofs"][:, 0], exact, rtol=0, atol=1e-12 * exact.max())
-    assert np.abs(info["u_dofs"][:, 1:]).max() <= 1e-12 * exact.max()
+    np.testing.assert_allclose(info.dof_displacement[:, 0], exact, rtol=0, atol=1e-12 * exact.max())
+    assert np.abs(info.dof_displacement[:, 1:]).max() <= 1e-12 * exact.max()
 
 
 def test_nonlinear_quadratic_reference_tends_to_the_linear_one_at_small_load():
     raw = copy.deepcopy(MEMBRANE)
     raw["loads"][0]["traction"] = [0.0, 1755.6e-4]
     s = _setup(raw)
-    u_nl, _ = R.solve(s, order=2, law="svk", steps=1)
-    u_l, _ = R.solve(s, order=2, law=None)
+    u_nl, _ = _solve(s, order=2, law="svk", steps=1)
+    u_l, _ = _solve(s, order=2, law=None)
     assert np.abs(u_nl - u_l).max() / np.abs(u_l).max() < 1e-3  # relative difference ~ strain ~ 1e-5
     assert np.abs(u_nl - u_l).max() / np.abs(u_l).max() > 1e-8  # and not identical: a non-linear solve
 
@@ -80,9 +87,9 @@ def test_quadratic_dofs_are_the_nodes_of_the_refined_mesh(raw):
     fine = copy.deepcopy(raw)
     fine["geometry"]["refine"] = 1
     s1 = _setup(fine)
-    _, info = R.solve(s0, order=2, law=None)
-    assert len(info["x_dofs"]) == s1.mesh.n_nodes
-    R.at_points(info, s1.mesh.points)  # every node of the refined mesh is a dof location
+    _, info = _solve(s0, order=2, law=None)
+    assert len(info.dof_points) == s1.mesh.n_nodes
+    at_points(info, s1.mesh.points)  # every node of the refined mesh is a dof location
 
 
 def test_linear_mss_solve_is_one_solve_with_the_hessian_at_rest():

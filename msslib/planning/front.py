@@ -81,7 +81,7 @@ def _timed(raw, base_dir, repeats, budget, cpu, long_run):
 
 
 def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.0, progress=print, cpu=False,
-                  linear_variants=False, warmup=False, long_run=None):
+                  linear_variants=False, warmup=False, long_run=None, reference_level=None):
     """Measure time and error of every (variant, level); returns an xarray Dataset.
 
     Every argument and the scene are checked before anything is run
@@ -91,7 +91,9 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
     attributes hold the reference: ``reference_model``, ``reference_level``,
     ``reference_error`` (its own error estimate, :mod:`msslib.planning.reference`),
     ``reference_step_change``, ``reference_observed_order``, ``reference_dofs``,
-    ``reference_wall_time``, ``reference_max_displacement``, ``reference_locking_nu``."""
+    ``reference_wall_time``, ``reference_max_displacement``, ``reference_locking_nu``.
+    ``reference_level``: the level of the reference (default the finest measured; the level
+    below it also works, its quadratic dofs being the finest level's nodes)."""
     import xarray as xr
 
     from msslib.metrics import displacement_error
@@ -111,10 +113,13 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
     def prepare_level(lv):
         return prepare(load_scene(at_level(raw, lv, ref_model), base_dir=base_dir))
 
-    ref = reference(prepare_level, max(levels), law, say)
+    top = max(levels) if reference_level is None else int(reference_level)
+    if top not in (max(levels), max(levels) - 1) or top < 1:
+        raise ValueError(f"reference_level must be the finest level {max(levels)} or the one below it, got {top}")
+    ref = reference(prepare_level, top, law, say)
     scale = ref["scale"]
     if not (math.isfinite(scale) and scale > 0):
-        raise ValueError(f"the reference ({ref_model} on level {max(levels)}) does not move (largest displacement "
+        raise ValueError(f"the reference ({ref_model} on level {top}) does not move (largest displacement "
                          f"{scale:g} m): errors relative to it mean nothing; give the scene a load or a "
                          f"prescribed displacement")
     say(f"reference error estimate {100 * ref['error_estimate']:.2g} % of the largest displacement "
@@ -160,7 +165,7 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
             "status": (("model", "level"), status.astype(str), {"units": "1", "long_name": "ok or the error raised"}),
         },
         coords={"model": [n for n, _, _ in names], "level": list(levels)},
-        attrs={"reference_model": f"{ref_model} ({ref['formulation']})", "reference_level": max(levels),
+        attrs={"reference_model": f"{ref_model} ({ref['formulation']})", "reference_level": top,
                "reference_max_displacement": scale, "reference_error": ref["error_estimate"],
                "reference_step_change": ref["step_change"], "reference_observed_order": ref["observed_order"],
                "reference_levels": ",".join(map(str, ref["levels"])), "reference_dofs": ref["n_dofs"],
