@@ -195,7 +195,8 @@ rule study:
 # What a job needs beyond a default cluster job (profiles/slurm: one core, 2000 MB, 30 minutes) its
 # rule declares, so that a scheduler reserves it. Peak memory (resident set) and wall time measured on
 # full builds on one busy core; within the defaults: the Baudet cantilever experiment (0.83 GB, 1.5 min),
-# the speed-against-error fronts of the cantilever (0.49 GB, 47 s) and the cylinder (0.82 GB, 4.8 min).
+# the speed-against-error fronts of the cantilever (0.49 GB, 47 s), the cylinder (0.82 GB, 4.8 min) and
+# the membrane (0.49 GB, 3.6 min).
 # Quick builds fit the defaults. Local runs (`snakemake -j2`) ignore mem_mb.
 if not QUICK:
     # the dense Baudet cantilever: Q2 continuum on 16x4x4 and the Q1 48x12x12 reference, 3.7 GB, 67 s

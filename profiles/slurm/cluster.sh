@@ -15,7 +15,13 @@
 # and memory `slurmd -C` finds. Any failure is one line `cluster.sh: error: ...` and exit status 1.
 set -euo pipefail
 
-die() { echo "cluster.sh: error: $*" >&2; exit 1; }
+started=""  # the folder of a cluster being started: a failure stops what already runs there
+
+die() {
+    echo "cluster.sh: error: $*" >&2
+    if [ -n "$started" ]; then stop_daemons "$started"; fi
+    exit 1
+}
 
 need_packages() {
     local missing=()
@@ -67,6 +73,7 @@ up() {
     chmod 755 "$dir"  # munged wants its socket's folders searchable by all
     mkdir -p "$dir/state" "$dir/spool"
 
+    started=$dir
     # munge with its own key and socket: nothing shared with a system munged or another cluster
     head -c 1024 /dev/urandom > "$dir/munge.key"
     chmod 400 "$dir/munge.key"
@@ -135,6 +142,7 @@ EOF
         sleep 0.2
     done
     [ "$state" = idle ] || die "node $host is '${state:-not reported}', not idle, after 30 s: $(last_log "$dir/slurmctld.log")"
+    started=""
     echo "$dir"
     echo "export SLURM_CONF=$SLURM_CONF PATH=$dir/bin:\$PATH"
 }
@@ -151,14 +159,19 @@ stop_pid_file() {  # FILE: SIGTERM, then SIGKILL after 10 s
     kill -9 "$pid" 2> /dev/null || true
 }
 
+stop_daemons() {  # DIR: its jobs cancelled, its daemons stopped (those that were started)
+    if [ -f "$1/slurm.conf" ] && [ -s "$1/slurmctld.pid" ]; then
+        SLURM_CONF="$1/slurm.conf" scancel --full --quiet --user=root 2> /dev/null || true
+    fi
+    stop_pid_file "$1/slurmd.pid"
+    stop_pid_file "$1/slurmctld.pid"
+    stop_pid_file "$1/munged.pid"
+}
+
 down() {
     local dir=${1:?usage: $0 down DIR}
-    [ -f "$dir/slurm.conf" ] || die "$dir holds no cluster (no slurm.conf)"
-    export SLURM_CONF="$dir/slurm.conf"
-    scancel --full --quiet --user=root 2> /dev/null || true
-    stop_pid_file "$dir/slurmd.pid"
-    stop_pid_file "$dir/slurmctld.pid"
-    stop_pid_file "$dir/munged.pid"
+    [ -f "$dir/munge.key" ] || die "$dir holds no cluster (no munge.key)"
+    stop_daemons "$dir"
 }
 
 case "${1:-}" in
