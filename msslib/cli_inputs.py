@@ -39,19 +39,51 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
+def _file_keys(path: Path) -> list:
+    """What identifies the file ``path`` names: its resolved path and, for an existing file, its
+    device and inode (hard links, symbolic links, other spellings); two paths name one file when
+    they share a key (as :func:`_same_file` decides)."""
+    keys = []
+    try:
+        keys.append(("path", str(path.resolve())))
+    except (OSError, RuntimeError):  # a symlink loop
+        pass
+    try:
+        st = os.stat(path)
+        keys.append(("inode", st.st_dev, st.st_ino))
+    except (OSError, ValueError):
+        pass
+    return keys
+
+
 def _check_distinct(outputs, inputs=()) -> None:
-    """Refuse an output that is one of the inputs or another output (pairs ``(what, path)``)."""
-    outputs = [(what, Path(p)) for what, p in outputs if p is not None]
-    inputs = [(what, Path(p)) for what, p in inputs if p is not None]
-    for i, (what, out) in enumerate(outputs):
-        for what_in, src in inputs:
-            if _same_file(out, src):
+    """Refuse an output that is one of the inputs or another output (pairs ``(what, path)``).
+
+    Linear in the number of paths (a series of 10 000 files is checked in a fraction of a second):
+    each path is looked up by its keys (:func:`_file_keys`) in a dict."""
+    known_inputs: dict = {}
+    for what_in, src in inputs:
+        if src is not None:
+            for key in _file_keys(Path(src)):
+                known_inputs.setdefault(key, (what_in, Path(src)))
+    known_outputs: dict = {}
+    for what, out in outputs:
+        if out is None:
+            continue
+        out = Path(out)
+        keys = _file_keys(out)
+        for key in keys:
+            if key in known_inputs:
+                what_in, src = known_inputs[key]
                 raise CommandError(f"{what} {str(out)!r} is the {what_in} {str(src)!r}: refusing to overwrite "
                                    f"an input; give another {what}")
-        for what_other, other in outputs[:i]:
-            if _same_file(out, other):
+        for key in keys:
+            if key in known_outputs:
+                what_other, other = known_outputs[key]
                 raise CommandError(f"{what} {str(out)!r} and {what_other} {str(other)!r} are the same file; "
                                    f"give two different files")
+        for key in keys:
+            known_outputs.setdefault(key, (what, out))
 
 
 def _check_writable(path: Path, what: str) -> None:
@@ -200,6 +232,41 @@ def _check_paraview(path: Path, others) -> None:
                 raise CommandError(f"{what} {str(other)!r} would be overwritten by the ParaView series {str(path)!r} "
                                    f"(it writes {path.stem}_NNNN.vtu and {path.stem}_springs.vtu beside it); "
                                    f"give another .pvd name")
+        _check_series_members(path, others)
+
+
+def _check_series_members(pvd: Path, others) -> None:
+    """Refuse, before anything runs, a ParaView series at ``pvd`` when a file already beside it
+    with the name of one of its files (``STEM_NNNN.vtu``, ``STEM_springs.vtu``, whatever the number
+    of states) cannot be replaced (a directory, a device, a pipe) or is, through a link, one of
+    ``others`` (pairs ``(what, path)``).  One listing of the directory: linear in its size."""
+    import re
+
+    pattern = re.compile(re.escape(pvd.stem) + r"_(\d{4,}|springs)\.vtu")
+    directory = pvd.parent
+    try:
+        names = sorted(n for n in os.listdir(directory if str(directory) else ".") if pattern.fullmatch(n))
+    except OSError:
+        return  # a missing or unreadable directory is refused by _check_writable
+    if not names:
+        return
+    known = {}
+    for what, other in others:
+        if other is not None:
+            for key in _file_keys(Path(other)):
+                known.setdefault(key, (what, Path(other)))
+    for name in names:
+        member = directory / name
+        if member.is_dir() or (member.exists() and not member.is_file()):
+            kind = "a directory" if member.is_dir() else "not a regular file"
+            raise CommandError(f"ParaView series {str(pvd)!r}: {str(member)!r}, where it writes one of its files "
+                               f"({pvd.stem}_NNNN.vtu, {pvd.stem}_springs.vtu), is {kind}; move it away or give "
+                               f"another .pvd name")
+        for key in _file_keys(member):
+            if key in known:
+                what, other = known[key]
+                raise CommandError(f"{what} {str(other)!r} would be overwritten by the ParaView series {str(pvd)!r} "
+                                   f"(its file {str(member)!r} is a link to it); give another .pvd name")
 
 
 def _paraview_files(path: Path, ds) -> list:

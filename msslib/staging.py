@@ -15,6 +15,7 @@ import re
 import secrets
 import signal
 import threading
+import weakref
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -67,6 +68,35 @@ def terminate_raises():
         signal.signal(signal.SIGTERM, previous)
 
 
+@contextmanager
+def _interrupts_held():
+    """Within the block, SIGINT and SIGTERM are held and take effect when it ends (the previous
+    handlers are restored and the signals sent again): a file created in the block and registered
+    for removal in the same block cannot be left behind by an interrupt landing in between.  The
+    blocks are short (a file created, renamed or removed).  Outside the main thread (which
+    receives no signals in Python) it does nothing."""
+    if not _in_main_thread():
+        yield
+        return
+    held: list[int] = []
+
+    def hold(signum, frame):
+        held.append(signum)
+
+    previous = {}
+    try:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            handler = signal.getsignal(sig)
+            if handler is not None:  # None: a handler installed outside Python, left alone
+                previous[sig] = signal.signal(sig, hold)
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        for sig in dict.fromkeys(held):
+            os.kill(os.getpid(), sig)  # the restored handler acts on it now
+
+
 def _temp_path(dest: Path, tag: str = TEMP_TAG) -> Path:
     return dest.parent / f".{dest.name}.{tag}-{os.getpid()}-{secrets.token_hex(4)}"
 
@@ -91,19 +121,37 @@ def _pid_alive(pid: int) -> bool:
     return True
 
 
-def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
-    """Remove the temporary files that runs killed while writing ``path`` left beside it (those
-    whose process id is no longer alive); returns the paths removed. Errors are ignored."""
-    path = Path(path)
-    pattern = _temp_pattern(path.name)
-    removed = []
+#: any temporary file of msslib: (leading dots, the text before the tag, the process id)
+_ANY_TEMP = re.compile(rf"^(\.{{1,2}})(.*)\.(?:{TEMP_TAG}|{_BACKUP_TAG})-(\d+)-[0-9a-f]+(?:\..+)?$")
+
+
+def _stale_index(directory: Path) -> dict[str, list[str]]:
+    """The temporary files of runs no longer alive in ``directory``, by the name of their target
+    (one listing of the directory, however many targets are looked up)."""
+    index: dict[str, list[str]] = {}
     try:
-        names = os.listdir(path.parent if str(path.parent) else ".")
+        names = os.listdir(directory if str(directory) else ".")
     except OSError:
-        return removed
+        return index
     for name in names:
-        match = pattern.match(name)
-        if match is None or _pid_alive(int(match.group(1))):
+        match = _ANY_TEMP.match(name)
+        if match is None or _pid_alive(int(match.group(3))):
+            continue
+        dots, core = match.group(1), match.group(2)
+        for target in ({core, "." + core} if dots == ".." else {core}):
+            index.setdefault(target, []).append(name)
+    return index
+
+
+def _remove_stale(path: Path, names) -> list[Path]:
+    """Remove the entries ``names`` beside ``path`` that are temporaries of ``path`` (regular
+    files, not links); returns the paths removed. Errors are ignored."""
+    removed = []
+    if not names:
+        return removed
+    pattern = _temp_pattern(path.name)
+    for name in names:
+        if pattern.match(name) is None:
             continue
         stale = path.parent / name
         try:
@@ -115,11 +163,66 @@ def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
     return removed
 
 
+def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files that runs killed while writing ``path`` left beside it (those
+    whose process id is no longer alive); returns the paths removed. Errors are ignored."""
+    path = Path(path)
+    return _remove_stale(path, _stale_index(path.parent).get(path.name, []))
+
+
 def _unlink(path: Path) -> None:
     try:
         os.unlink(path)
     except FileNotFoundError:
         pass
+
+
+def _remove_all(staged: list) -> None:
+    """Remove the temporary files of ``staged`` (pairs ``(destination, temporary)``) and empty it."""
+    for _, tmp in staged:
+        _unlink(tmp)
+    staged.clear()
+
+
+def _replace_all(staged: list) -> list[Path]:
+    """Rename every temporary file of ``staged`` over its destination, or (on any error) none:
+    the files already replaced get their old content back from a hard link kept until the end.
+    Each step is registered before it is done, so an error raised by the step itself is undone
+    too. Returns the destinations."""
+    backups: dict[Path, Path | None] = {}
+    replaced: list[Path] = []
+    existed = {dest: os.path.lexists(dest) for dest, _ in staged}
+    try:
+        for dest, _ in staged:  # keep the files about to be replaced, to put them back on failure
+            backups[dest] = None
+            if existed[dest]:
+                backups[dest] = _temp_path(dest, _BACKUP_TAG)
+                try:
+                    os.link(dest, backups[dest], follow_symlinks=False)
+                except OSError:  # no hard links here: that file cannot be put back
+                    backups[dest] = None
+        for dest, tmp in staged:
+            replaced.append(dest)
+            try:
+                os.replace(tmp, dest)
+            except Exception as exc:
+                raise _rename_error(exc, tmp, dest, "output file") from exc
+    except BaseException:
+        for dest in reversed(replaced):  # put the old files back
+            try:
+                if backups.get(dest) is not None:
+                    os.replace(backups[dest], dest)
+                    backups[dest] = None  # it is the destination again: not to be removed
+                elif not existed[dest]:
+                    os.unlink(dest)
+            except OSError:
+                pass
+        raise
+    finally:
+        for backup in backups.values():
+            if backup is not None:
+                _unlink(backup)
+    return replaced
 
 
 def _fsync(path: Path, flags: int = os.O_RDONLY) -> None:
@@ -135,10 +238,43 @@ def _fsync(path: Path, flags: int = os.O_RDONLY) -> None:
         os.close(fd)
 
 
-def _rename_error(exc: BaseException, tmp: Path, dest: Path, what: str) -> BaseException:
-    """``exc`` raised while writing ``tmp``, re-made to name ``dest`` (not the temporary file)."""
+#: a directory with less free space than this (bytes) is full: a write that failed there failed for it
+FULL_BELOW = 1 << 20
+
+
+def _free_bytes(directory: Path) -> int | None:
+    """Bytes this process may still write in ``directory`` (the reserved blocks count for root),
+    None when unknown."""
+    try:
+        st = os.statvfs(directory if str(directory) else ".")
+    except (OSError, AttributeError, ValueError):  # no statvfs (Windows)
+        return None
+    if not st.f_blocks:  # a file system that reports no sizes
+        return None
+    blocks = st.f_bfree if hasattr(os, "geteuid") and os.geteuid() == 0 else st.f_bavail
+    return int(blocks) * int(st.f_frsize)
+
+
+def _disk_full(exc: BaseException, tmp: Path) -> bool:
+    """Whether the write of ``tmp`` that raised ``exc`` failed for want of space: ``ENOSPC`` or
+    ``EDQUOT``, or (libraries that report it otherwise, such as NetCDF's ``HDF error``) less than
+    :data:`FULL_BELOW` bytes left in its directory."""
+    if isinstance(exc, OSError) and exc.errno in (errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC)):
+        return True
+    free = _free_bytes(tmp.parent)
+    return free is not None and free < FULL_BELOW
+
+
+def _rename_error(exc: BaseException, tmp: Path, dest: Path, what: str, disk_full: bool = False) -> BaseException:
+    """``exc`` raised while writing ``tmp``, re-made to name ``dest`` (not the temporary file);
+    ``disk_full``: the device was full, said as ``no space left on device``."""
     pattern = re.compile(r"\.?" + re.escape(tmp.name) + r"(?:\.[0-9a-f]+\.tmp)?")
-    if isinstance(exc, OSError) and exc.errno is not None:  # shown as "[Errno N] message: 'dest'"
+    said = isinstance(exc, OSError) and exc.errno in (errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC))
+    if disk_full and not said:  # e.g. "NetCDF: HDF error": say what it means
+        detail = pattern.sub(dest.name, " ".join(str(exc).split())) or type(exc).__name__
+        new = OSError(errno.ENOSPC, f"cannot write {what}: no space left on device in {str(dest.parent)!r} "
+                                    f"(the writer said: {detail})", str(dest))
+    elif isinstance(exc, OSError) and exc.errno is not None:  # shown as "[Errno N] message: 'dest'"
         message = f"cannot write {what}: {pattern.sub(dest.name, str(exc.strerror or exc))}"
         try:
             new = type(exc)(exc.errno, message, str(dest))
@@ -184,19 +320,33 @@ class StagedOutputs:
     """
 
     def __init__(self):
-        self._staged: list[tuple[Path, Path]] = []  # (destination, temporary file)
+        self._staged: list[tuple[Path, Path]] = []  # (destination, temporary file), changed in place
+        # the last resort, alive while files are staged: temporary files still staged when the
+        # object goes (an interrupt that landed where no clean-up of ours could run, e.g. as the
+        # with block ends) are removed then
+        self._finalizer = weakref.finalize(self, _remove_all, self._staged)
+        self._finalizer.detach()
+        self._names: set[str] = set()  # the absolute destinations staged: a second one is refused
+        self._stale: dict[str, dict[str, list[str]]] = {}  # directory -> target -> temporaries of dead runs
         self._installed = False
         self._previous = None
 
     # -- staging
 
+    def _remove_stale(self, dest: Path) -> None:
+        """Remove the temporaries dead runs left for ``dest``; each directory is listed once."""
+        key = os.path.abspath(dest.parent)
+        if key not in self._stale:
+            self._stale[key] = _stale_index(dest.parent)
+        _remove_stale(dest, self._stale[key].pop(dest.name, []))
+
     def stage(self, dest: str | os.PathLike, what: str = "output file") -> Path:
         """Reserve (create, empty) a temporary file for ``dest`` and return its path; it becomes
         ``dest`` at :meth:`commit`."""
         dest = Path(dest)
-        for other, _ in self._staged:
-            if os.path.abspath(other) == os.path.abspath(dest):
-                raise ValueError(f"{what} {str(dest)!r} is staged twice")
+        name = os.path.abspath(dest)
+        if name in self._names:
+            raise ValueError(f"{what} {str(dest)!r} is staged twice")
         directory = dest.parent
         if not directory.is_dir():
             code = errno.ENOTDIR if directory.exists() else errno.ENOENT
@@ -206,29 +356,43 @@ class StagedOutputs:
             raise IsADirectoryError(errno.EISDIR, f"cannot write {what}, it is a directory", str(dest))
         if dest.exists() and not dest.is_file():  # a device or a pipe: os.replace would replace it
             raise OSError(errno.EINVAL, f"cannot write {what}, it exists and is not a regular file", str(dest))
-        remove_stale_temporaries(dest)
+        self._remove_stale(dest)
         tmp = _temp_path(dest)
-        try:
-            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # mode honours the umask
-        except OSError as exc:
-            raise type(exc)(exc.errno, f"cannot write {what}, no temporary file in {str(directory)!r}: "
-                                       f"{exc.strerror}", str(dest)) from exc
-        os.close(fd)
-        self._staged.append((dest, tmp))
+        # registered before it is created, with the interrupts held: it cannot be left behind
+        with _interrupts_held():
+            if not self._finalizer.alive:
+                self._finalizer = weakref.finalize(self, _remove_all, self._staged)
+            self._staged.append((dest, tmp))
+            self._names.add(name)
+            try:
+                fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # mode honours the umask
+            except OSError as exc:  # not created (or not ours): forgotten, never removed
+                self._staged.remove((dest, tmp))
+                self._names.discard(name)
+                raise type(exc)(exc.errno, f"cannot write {what}, no temporary file in {str(directory)!r}: "
+                                           f"{exc.strerror}", str(dest)) from exc
+            os.close(fd)
         return tmp
+
+    def _unstage(self, dest: Path, tmp: Path) -> None:
+        with _interrupts_held():  # removed and forgotten together
+            _unlink(tmp)
+            self._staged.remove((dest, tmp))
+            self._names.discard(os.path.abspath(dest))
 
     def write(self, dest: str | os.PathLike, writer, what: str = "output file") -> Path:
         """Stage ``dest`` and call ``writer(temporary_path)`` to fill it; an error of the writer
-        is re-raised naming ``dest``."""
+        is re-raised naming ``dest`` (a full disk is said to be one: ``no space left on device``,
+        also when the writer's library reports it otherwise, e.g. NetCDF's ``HDF error``)."""
         dest = Path(dest)
         tmp = self.stage(dest, what)
         try:
             writer(tmp)
         except BaseException as exc:
-            self._staged.remove((dest, tmp))
-            _unlink(tmp)
+            full = isinstance(exc, Exception) and _disk_full(exc, tmp)  # before the partial file is removed
+            self._unstage(dest, tmp)
             if isinstance(exc, Exception):
-                raise _rename_error(exc, tmp, dest, what) from exc
+                raise _rename_error(exc, tmp, dest, what, disk_full=full) from exc
             raise
         return dest
 
@@ -244,49 +408,23 @@ class StagedOutputs:
 
     def discard(self) -> None:
         """Remove every temporary file; no destination is touched."""
-        staged, self._staged = self._staged, []
-        for _, tmp in staged:
-            _unlink(tmp)
+        with _interrupts_held():  # an interrupt cannot stop the clean-up half-way
+            _remove_all(self._staged)
+            self._names.clear()
+            self._finalizer.detach()  # nothing left to remove
 
     def commit(self) -> list[Path]:
         """Rename every temporary file over its destination (all, or none); returns the
-        destinations."""
+        destinations.  The renames (and the links kept to put the replaced files back) run with
+        SIGINT and SIGTERM held: an interrupt lands before them (nothing is replaced) or after them
+        (everything is), never half-way; they take a moment even for thousands of files."""
         staged = self._staged
-        backups: dict[Path, Path | None] = {}
-        replaced: list[Path] = []
-        existed = {dest: os.path.lexists(dest) for dest, _ in staged}
         try:
             for _, tmp in staged:
                 _fsync(tmp)
-            for dest, _ in staged:  # keep the files about to be replaced, to put them back on failure
-                backups[dest] = None
-                if existed[dest]:
-                    backup = _temp_path(dest, _BACKUP_TAG)
-                    try:
-                        os.link(dest, backup, follow_symlinks=False)
-                        backups[dest] = backup
-                    except OSError:  # no hard links here: that file cannot be put back
-                        pass
-            for dest, tmp in staged:
-                try:
-                    os.replace(tmp, dest)
-                except Exception as exc:
-                    raise _rename_error(exc, tmp, dest, "output file") from exc
-                replaced.append(dest)
-        except BaseException:
-            for dest in reversed(replaced):  # put the old files back
-                try:
-                    if backups.get(dest) is not None:
-                        os.replace(backups.pop(dest), dest)
-                    elif not existed[dest]:
-                        os.unlink(dest)
-                except OSError:
-                    pass
-            raise
+            with _interrupts_held():
+                replaced = _replace_all(staged)
         finally:
-            for backup in backups.values():
-                if backup is not None:
-                    _unlink(backup)
             self.discard()
         for directory in {dest.parent for dest in replaced}:  # make the renames durable
             _fsync(directory)
@@ -301,7 +439,11 @@ class StagedOutputs:
     def __exit__(self, exc_type, exc, tb):
         try:
             if exc_type is None:
-                self.commit()
+                try:
+                    self.commit()
+                except BaseException:  # an interrupt before commit's own clean-up could run
+                    self.discard()
+                    raise
             else:
                 self.discard()
         finally:

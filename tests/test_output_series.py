@@ -1,0 +1,144 @@
+"""Long ParaView series (``run --vtu OUT.pvd``): every output check, the files of the series
+included, runs before the solve, and the checks take a time linear in the number of files (a
+series of 10 001 states is checked in a fraction of a second, not in half an hour)."""
+
+from __future__ import annotations
+
+import os
+import time
+import xml.etree.ElementTree as ET
+
+import meshio
+import numpy as np
+import pytest
+import yaml
+
+from msslib import cli
+from msslib.cli_inputs import _check_distinct
+from msslib.io import read_result
+from msslib.paraview import series_files
+from msslib.staging import StagedOutputs
+
+SWING = {
+    "name": "swing",
+    "geometry": {"generator": "hex_grid", "args": {"lx": 0.08, "ly": 0.02, "lz": 0.02, "nx": 4, "ny": 1, "nz": 1}},
+    "materials": [{"E": 1.0e5, "nu": 0.3, "density": 1000.0}],
+    "model": "golec_cube",
+    "boundary": [{"select": {"plane": ["x", 0.0]}}],
+    "loads": [{"type": "gravity", "g": [0.0, 0.0, -9.81]}],
+    "solver": {"type": "dynamic", "dt": 1.0e-4, "t_end": 2.0e-3, "save_every": 1},
+}
+
+
+def _cli(capsys, *argv):
+    code = cli.main([str(a) for a in argv])
+    return code, capsys.readouterr().err
+
+
+def _listing(directory):
+    return sorted((name, (directory / name).is_dir()) for name in os.listdir(directory))
+
+
+@pytest.fixture
+def no_solve(monkeypatch):
+    """The solve fails the test: every refusal here must come before it."""
+    monkeypatch.setattr("msslib.scene.run_scene", lambda *a, **k: pytest.fail("the scene was solved before refusing"))
+
+
+def _refused_before_solve(capsys, tmp_path, *names):
+    before = _listing(tmp_path)
+    code, err = _cli(capsys, "run", tmp_path / "swing.yaml", "--out", tmp_path / "r.nc", "--vtu", tmp_path / "r.pvd")
+    lines = err.splitlines()
+    assert code == 1 and len(lines) == 1 and lines[0].startswith("msslib: error:"), err
+    for name in names:
+        assert name in lines[0], (name, err)
+    assert _listing(tmp_path) == before  # nothing written, nothing removed
+
+
+def test_directory_in_the_way_of_a_series_file_is_refused_before_the_solve(tmp_path, capsys, no_solve):
+    (tmp_path / "swing.yaml").write_text(yaml.safe_dump(SWING))
+    (tmp_path / "r_0001.vtu").mkdir()
+    _refused_before_solve(capsys, tmp_path, "r_0001.vtu", "is a directory", "r.pvd")
+    (tmp_path / "r_0001.vtu").rmdir()
+    (tmp_path / "r_springs.vtu").mkdir()
+    _refused_before_solve(capsys, tmp_path, "r_springs.vtu", "is a directory")
+
+
+def test_series_file_linked_to_an_input_is_refused_before_the_solve(tmp_path, capsys, no_solve):
+    (tmp_path / "swing.yaml").write_text(yaml.safe_dump(SWING))
+    os.symlink(tmp_path / "swing.yaml", tmp_path / "r_0003.vtu")
+    _refused_before_solve(capsys, tmp_path, "scene file", "swing.yaml", "r_0003.vtu")
+
+
+def _check_time(n_states: int, tries: int = 1) -> float:
+    """Seconds taken to check the output file and the ``n_states + 2`` files of a series against
+    each other and the inputs (the shortest of ``tries``)."""
+    directory = os.path.abspath("series-not-written")
+    files = [("output file", os.path.join(directory, "r.nc")), *series_files(os.path.join(directory, "r.pvd"),
+                                                                              n_states, springs=True)]
+    inputs = [("scene file", os.path.join(directory, "scene.yaml")), ("mesh file", os.path.join(directory, "m.vtu"))]
+    best = float("inf")
+    for _ in range(tries):
+        t = time.perf_counter()
+        _check_distinct(files, inputs)
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def test_checking_a_long_series_takes_linear_time():
+    small, large = _check_time(1_000, tries=3), _check_time(10_001)
+    assert large < 2.0  # was about 36 min (every name against every other)
+    assert large / small < 30, (small, large)  # linear: about 10; every name against every other: about 100
+
+
+def test_checking_a_series_still_finds_two_names_of_one_file(tmp_path):
+    files = series_files(tmp_path / "r.pvd", 5000, springs=False)
+    with pytest.raises(cli.CommandError, match="r_4999.vtu.*the same file"):
+        _check_distinct([*files, ("copy", tmp_path / "." / "r_4999.vtu")])
+    (tmp_path / "m.vtu").write_text("mesh\n")
+    os.link(tmp_path / "m.vtu", tmp_path / "r_2500.vtu")  # a hard link: the same file by another name
+    with pytest.raises(cli.CommandError, match="r_2500.vtu.*is the mesh file"):
+        _check_distinct(files, [("mesh file", tmp_path / "m.vtu")])
+
+
+def _stage_time(n_files: int, directory) -> float:
+    staged = StagedOutputs()
+    t = time.perf_counter()
+    try:
+        for i in range(n_files):
+            staged.stage(directory / f"r_{i:05d}.vtu", what="VTU file of the series")
+        return time.perf_counter() - t
+    finally:
+        staged.discard()
+
+
+def test_staging_a_long_series_takes_linear_time(tmp_path):
+    small = min(_stage_time(300, tmp_path) for _ in range(3))
+    large = _stage_time(3000, tmp_path)
+    assert large / small < 30, (small, large)  # linear: about 10; quadratic: about 100
+    assert os.listdir(tmp_path) == []  # every temporary file removed
+
+
+def test_normal_series_is_written_complete(tmp_path, capsys):
+    (tmp_path / "swing.yaml").write_text(yaml.safe_dump(SWING))
+    (tmp_path / "r_0003.vtu").write_text("an older state\n")  # replaced
+    (tmp_path / "r_0040.vtu").write_text("a state of an older, longer series\n")  # left alone
+    code, err = _cli(capsys, "run", tmp_path / "swing.yaml", "--out", tmp_path / "r.nc", "--vtu", tmp_path / "r.pvd",
+                     "--quiet")
+    assert code == 0, err
+    n_states = 21  # t_end / dt = 20 steps, every one saved, and the start
+    collection = ET.parse(tmp_path / "r.pvd").getroot().find("Collection")
+    entries = [(float(d.get("timestep")), d.get("file")) for d in collection]
+    assert [name for _, name in entries] == [f"r_{i:04d}.vtu" for i in range(n_states)]
+    np.testing.assert_allclose([t for t, _ in entries], np.arange(n_states) * 1.0e-4, rtol=1e-12, atol=1e-15)
+    first = meshio.read(tmp_path / "r_0000.vtu")
+    np.testing.assert_array_equal(first.point_data["displacement"], 0.0)  # the run starts at rest
+    ds = read_result(tmp_path / "r.nc")
+    last = meshio.read(tmp_path / f"r_{n_states - 1:04d}.vtu")
+    np.testing.assert_array_equal(last.point_data["displacement"], ds["displacement"].transpose("node", "axis").values)
+    # gravity pulls every free node down
+    assert np.all(last.point_data["displacement"][ds["rest_position"].values[:, 0] > 0, 2] < 0)
+    assert (tmp_path / "r_0040.vtu").read_text() == "a state of an older, longer series\n"
+    assert "older" not in (tmp_path / "r_0003.vtu").read_text(errors="replace")
+    assert (tmp_path / "r_springs.vtu").is_file()
+    assert not [n for n in os.listdir(tmp_path) if "msslib-tmp" in n or "msslib-bak" in n]
