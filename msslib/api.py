@@ -17,6 +17,7 @@ as it is.
 
 from __future__ import annotations
 
+import copy
 import os
 import tempfile
 from collections.abc import Mapping
@@ -184,8 +185,13 @@ def build_model(name: str, mesh, materials, *, fixed=None, loads=None, thickness
     Returns a :class:`ModelSetup`: ``.model`` is the :class:`msslib.model.Model`.  Bad arguments
     raise a one-line ValueError naming the scene key (``scene.materials[0].nu: must be < 0.5``).
     """
-    raw = _source(name, materials, fixed, loads, thickness, solver, checks, options)
+    # the model's own copy of the arguments: editing them afterwards changes nothing
+    raw = copy.deepcopy(_source(name, materials, fixed, loads, thickness, solver, checks, options))
     base_dir = Path.cwd()
+    if isinstance(mesh, _mesh.Mesh):  # the model's own copy: editing the caller's mesh changes nothing
+        from msslib.model import frozen_mesh
+
+        mesh = frozen_mesh(mesh)
     with _loaded(raw, mesh, base_dir) as scene:
         setup = _scene.prepare(scene)
     values = {f.name: getattr(setup, f.name) for f in fields(_scene.Setup)}

@@ -34,6 +34,7 @@ from msslib.terms.assembly import (
 
 __all__ = [
     "Model",
+    "frozen_mesh",
     "material_arrays",
     "assemble_springs",
     "lloyd_triangle_springs",
@@ -44,6 +45,64 @@ __all__ = [
     "baudet_correction",
     "golec_cube_springs",
 ]
+
+
+# --------------------------------------------------------------------------------------------
+# frozen copies
+# --------------------------------------------------------------------------------------------
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a = np.array(a, copy=True)
+    a.flags.writeable = False
+    return a
+
+
+def frozen_mesh(mesh):
+    """A copy of ``mesh`` (a :class:`msslib.mesh.Mesh`) with read-only arrays of its own: node
+    positions, cells, materials and groups.  What a built model keeps, so that editing the mesh it
+    was built from (``mesh.points[...] = ...``) changes neither the model nor its solutions."""
+    import dataclasses
+
+    groups = {kind: {name: _read_only(a) for name, a in (getattr(mesh, kind) or {}).items()}
+              for kind in ("cell_groups", "facet_groups", "node_groups")}
+    frozen = dataclasses.replace(mesh, points=np.array(mesh.points, dtype=float), cells=np.array(mesh.cells),
+                                 material=np.array(mesh.material), **groups)
+    for name in ("points", "cells", "material"):
+        getattr(frozen, name).flags.writeable = False
+    for kind in groups:
+        for a in getattr(frozen, kind).values():
+            a.flags.writeable = False
+    return frozen
+
+
+def _mesh_arrays(mesh) -> list[np.ndarray]:
+    arrays = [mesh.points, mesh.cells, mesh.material]
+    for kind in ("cell_groups", "facet_groups", "node_groups"):
+        arrays += list((getattr(mesh, kind, None) or {}).values())
+    return [a for a in arrays if isinstance(a, np.ndarray)]
+
+
+def _detach(terms, arrays) -> None:
+    """Give every array attribute of ``terms`` that shares memory with one of ``arrays`` (the
+    caller's mesh) a copy of its own; arrays that were one object stay one object."""
+    copies: dict[int, np.ndarray] = {}
+
+    def own(value):
+        if isinstance(value, np.ndarray) and any(np.may_share_memory(value, a) for a in arrays):
+            if id(value) not in copies:
+                copies[id(value)] = value.copy()
+            return copies[id(value)]
+        if type(value) is tuple:  # e.g. a cached layout of arrays
+            items = tuple(own(v) for v in value)
+            return items if any(a is not b for a, b in zip(items, value)) else value
+        return value
+
+    for term in terms:
+        for name, value in list(getattr(term, "__dict__", {}).items()):
+            new = own(value)
+            if new is not value:
+                setattr(term, name, new)
 
 
 # --------------------------------------------------------------------------------------------
@@ -72,12 +131,15 @@ class Model:
     """
 
     def __init__(self, mesh, terms, *, fixed=None, prescribed=None, masses=None, damping=0.0):
-        self.mesh = mesh
+        # frozen: the model keeps its own read-only copy of the mesh, and its terms no array of
+        # the mesh given, so that editing that mesh afterwards changes nothing here
+        self.mesh = frozen_mesh(mesh)
         self.dim = mesh.dim
         self.n_nodes = mesh.n_nodes
         self.n_dof = mesh.n_nodes * mesh.dim
         self.x0 = mesh.points.ravel().copy()
         self.terms = [t for t in terms]
+        _detach(self.terms, _mesh_arrays(mesh))
         for t in self.terms:
             if not isinstance(t, Term):
                 raise TypeError(f"not a term: {t!r}")
@@ -108,7 +170,7 @@ class Model:
 
         if masses is None:
             masses = _mesh.lumped_masses(mesh, 1.0)
-        masses = np.asarray(masses, dtype=float)
+        masses = np.array(masses, dtype=float)  # a copy: the caller's array may change
         if masses.shape != (self.n_nodes,):
             raise ValueError(f"masses must have shape ({self.n_nodes},), got {masses.shape}")
         self.node_masses = masses
