@@ -1,10 +1,12 @@
-"""A one-line text progress bar for long runs."""
+"""A one-line text progress bar for long runs, and the line that says numba kernels are being
+compiled (:func:`compile_notice`)."""
 
 from __future__ import annotations
 
 import math
 import sys
 import time
+from contextlib import contextmanager
 
 
 class TextProgress:
@@ -16,7 +18,9 @@ class TextProgress:
 
     The line shows the elapsed time, the rate since the first report and the time left at that
     rate: ``(3.1 s, 12.3 steps/s, 0:42 left)`` when ``total`` (the number of ``unit`` in the whole
-    run) is given, ``(3.1 s, 2.5 %/s, 0:42 left)`` otherwise.
+    run) is given, ``(3.1 s, 2.5 %/s, 0:42 left)`` otherwise.  :meth:`restart_rate` measures the
+    rate from the next report on (after a compile, which is no part of the pace of the run);
+    :meth:`note` writes a line of its own.
     """
 
     def __init__(self, label: str = "", stream=None, width: int = 30, delay: float = 0.5, interval: float = 0.1,
@@ -47,6 +51,19 @@ class TextProgress:
             return
         self.last = now
         self._draw(now)
+
+    def restart_rate(self) -> None:
+        """Measure the rate (and the time left) from the next report on."""
+        self.first = None
+
+    def note(self, text: str) -> None:
+        """Write ``text`` as a line of its own (below the bar when it is drawn on a terminal)."""
+        stream = self._stream()
+        if self.shown and self._tty() and self.drawn:
+            stream.write("\n")
+            self.drawn = 0
+        stream.write(text + "\n")
+        stream.flush()
 
     def _stream(self):
         return self.stream if self.stream is not None else sys.stderr
@@ -96,3 +113,26 @@ class TextProgress:
                 self._stream().flush()
             self.shown = False
 
+
+
+@contextmanager
+def compile_notice(bar: TextProgress, what: str):
+    """Within the block, the first compile of numba kernels (a cache miss: the first run of a model
+    family; loading compiled kernels from the cache says nothing) is said in one line on the
+    bar's stream, ``msslib: compiling the WHAT kernels (first run only, cached afterwards) ...``,
+    and after each compile the bar's rate starts again (the time left does not count the
+    compile)."""
+    from msslib.terms.jit import cached_on_disk, watch_compiles
+
+    said = False
+
+    def start(dispatcher):
+        nonlocal said
+        if not said:
+            said = True
+            cached = cached_on_disk(dispatcher) is not False
+            why = "first run only, cached afterwards" if cached else "not cached: numba's cache directory is read-only"
+            bar.note(f"msslib: compiling the {what} kernels ({why}) ...")
+
+    with watch_compiles(start, lambda seconds: bar.restart_rate()):
+        yield

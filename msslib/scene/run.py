@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from typing import Callable
@@ -11,7 +12,7 @@ import numpy as np
 
 from msslib import models as _models
 from msslib.scene.prepare import Setup, prepare
-from msslib.scene.progress import TextProgress
+from msslib.scene.progress import TextProgress, compile_notice
 from msslib.scene.schema import load_scene
 
 
@@ -123,11 +124,22 @@ def _solve_mss_dynamic(setup: Setup, report):
     return out
 
 
+def _family(model: str) -> str:
+    """The family of ``model`` (whose kernels it compiles), or its name."""
+    try:
+        return _models.get(model).family or model
+    except Exception:  # an unknown model is refused elsewhere
+        return model
+
+
 def run_scene(scene, progress=True):
     """Build and solve a scene (a :class:`Scene`, a path or a dict) and return its result dataset.
 
-    ``progress``: True draws a text progress bar on stderr for runs longer than half a second,
-    False/None is silent, a callable receives ``(fraction, text)``.  Raises ValueError /
+    ``progress``: True draws a text progress bar on stderr for runs longer than half a second
+    (and says in one line when numba compiles kernels, on the first run of a model family:
+    ``msslib: compiling the FAMILY kernels (first run only, cached afterwards) ...``; the rate and
+    the time left do not count the compile), False/None is silent, a callable receives
+    ``(fraction, text)``.  Raises ValueError /
     FileNotFoundError for bad scenes, :class:`msslib.solvers.ConvergenceError` when a static solve
     fails and :class:`msslib.solvers.DivergenceError` when a dynamic run blows up.
 
@@ -155,14 +167,17 @@ def run_scene(scene, progress=True):
     else:
         def report(_fraction, _text=""):
             return None
+    # a first run compiles numba kernels (seconds to a minute): said in one line, not in the pace
+    notice = compile_notice(bar, _family(scene.model)) if bar is not None else contextlib.nullcontext()
     try:
-        setup = prepare(scene)
-        if scene.is_fem:
-            out = _solve_fem(setup, report)
-        elif scene.is_dynamic:
-            out = _solve_mss_dynamic(setup, report)
-        else:
-            out = _solve_mss_static(setup, report)
+        with notice:
+            setup = prepare(scene)
+            if scene.is_fem:
+                out = _solve_fem(setup, report)
+            elif scene.is_dynamic:
+                out = _solve_mss_dynamic(setup, report)
+            else:
+                out = _solve_mss_static(setup, report)
     finally:
         if bar is not None:
             bar.close()

@@ -51,3 +51,46 @@ _jit_fast = njit(cache=True, error_model="numpy", nogil=True, fastmath=_FAST)
 # loops (fast spring force, Hessian assembly); our indices are never negative, so the hot loops
 # index through ``_U(i)``.
 _U = np.uint64
+
+
+
+def watch_compiles(on_start, on_end):
+    """A context manager: within it, ``on_start(dispatcher)`` is called when numba starts
+    compiling a kernel (a cache miss, as on the first run of a model family; loading a kernel
+    from the on-disk cache is no compile) and ``on_end(seconds)`` when that compile ends, the
+    kernels it compiles on the way (callees) included.  Uses numba's event API
+    (``numba:compile``); a numba without it watches nothing."""
+    import time
+    from contextlib import nullcontext
+
+    try:
+        from numba.core import event
+    except ImportError:  # pragma: no cover - numba before 0.53
+        return nullcontext()
+
+    class CompileListener(event.Listener):
+        depth, t0 = 0, 0.0
+
+        def on_start(self, ev):
+            if self.depth == 0:
+                self.t0 = time.perf_counter()
+                on_start((ev.data or {}).get("dispatcher"))
+            self.depth += 1
+
+        def on_end(self, ev):
+            self.depth = max(self.depth - 1, 0)
+            if self.depth == 0:
+                on_end(time.perf_counter() - self.t0)
+
+    return event.install_listener("numba:compile", CompileListener())
+
+
+def cached_on_disk(dispatcher) -> bool | None:
+    """Whether numba can save what it compiles for ``dispatcher`` in its on-disk cache (the
+    cache directory is writable); None when unknown."""
+    import os
+
+    path = getattr(getattr(dispatcher, "_cache", None), "_cache_path", None)
+    if not path:
+        return None
+    return os.access(path, os.W_OK)
