@@ -509,7 +509,8 @@ def write_result(path: str | os.PathLike, ds: xr.Dataset) -> Path:
         if a variable of :data:`FINITE_VARIABLES` holds NaN or infinity (nothing is written).
     OSError
         (``FileNotFoundError``, ``NotADirectoryError``, ``PermissionError``, ...) naming ``path``
-        when the target directory does not exist or is not writable.
+        when the target directory does not exist or is not writable; ``ENOSPC``, ``no space left
+        on device``, when the disk is full (NetCDF reports it as ``NetCDF: HDF error``).
     """
     path = Path(path)
     with StagedOutputs() as out:

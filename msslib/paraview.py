@@ -29,7 +29,9 @@ decides by the suffix of the path:
 
     In ParaView, open the ``.pvd`` and apply *Warp By Vector* (``displacement``) to see the
     deformed states.  Files of an earlier, longer series with the same name are not removed; the
-    ``.pvd`` lists only the new ones.
+    ``.pvd`` lists only the new ones.  ``run --vtu OUT.pvd`` refuses, before it solves, a
+    directory (or anything but a regular file, or a link to an input) where the series would
+    write one of its files (``OUT_NNNN.vtu`` whatever the number of states, ``OUT_springs.vtu``).
 """
 
 from __future__ import annotations

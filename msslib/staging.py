@@ -3,8 +3,12 @@
 :class:`StagedOutputs` writes several files as one (all are replaced, or none is): each is written
 to a hidden temporary file beside its target, flushed to disk and renamed over it only when every
 file was written; on any error, on SIGINT and on SIGTERM the temporaries are removed and the targets
-are left as they were. :class:`msslib.io.StagedOutputs` adds NetCDF results to it; every write of
-msslib goes through that class.
+are left as they were (an interrupt landing anywhere, even between creating a temporary file and
+registering it, leaves nothing behind: the few steps that create, rename or remove files run with
+the signals held for that moment).  A write that fails on a full disk says ``no space left on
+device``, also when the writer's library says otherwise (NetCDF's ``HDF error``).
+:class:`msslib.io.StagedOutputs` adds NetCDF results to it; every write of msslib goes through
+that class.  Staging and committing take a time linear in the number of files.
 """
 
 from __future__ import annotations
