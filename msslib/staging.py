@@ -98,7 +98,7 @@ def _interrupts_held():
         for sig, handler in previous.items():
             signal.signal(sig, handler)
         for sig in dict.fromkeys(held):
-            os.kill(os.getpid(), sig)  # the restored handler acts on it now
+            signal.raise_signal(sig)  # the restored handler acts on it now
 
 
 def _temp_path(dest: Path, tag: str = TEMP_TAG) -> Path:
