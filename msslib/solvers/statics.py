@@ -171,6 +171,11 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
     # a problem that fills the free node blocks itself (Model.stiffness_blocks) spares forming
     # the full tangent and copying its free block out of it
     direct_blocks = context.get("direct_blocks", callable(getattr(problem, "stiffness_blocks", None)))
+    # the natural monotonicity test stays on while the Newton corrections contract: a step it
+    # accepted (the residual norm rose) must be followed by a smaller correction, else it was a
+    # drift, not progress (a 1000x stiffness contrast drifts so), and the residual test alone
+    # decides the rest of this load step
+    monotone, monotone_step = not use_energy, None
     while rnorm > target():
         if it >= max_iter:
             raise fail(f"no convergence in {max_iter} iterations")
@@ -215,11 +220,17 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
                                truncate=bool(line_search and use_energy))
         except _NewtonFailure as exc:
             raise fail(str(exc)) from None
+        dx_norm = float(np.linalg.norm(dx))
+        if monotone_step is not None and dx_norm >= monotone_step:
+            monotone = False
         if line_search:
             try:
-                resolve = None if use_energy else (  # the same tangent, for the natural monotonicity test
+                resolve = None if not monotone else (  # the same tangent, for the natural monotonicity test
                     lambda b, K=K, rtol=rtol: _linear_solve(K, b, linear_solver, symmetric, messages, context, rtol))
-                x, r, rnorm, e, _ = _line_search(problem, x, dx, free, load, r, rnorm, e, use_energy, resolve)
+                rnorm_before = rnorm
+                x, r, rnorm, e, alpha = _line_search(problem, x, dx, free, load, r, rnorm, e, use_energy, resolve)
+                armijo = rnorm**2 <= (1.0 - 2.0 * _ARMIJO_C * alpha) * rnorm_before**2
+                monotone_step = None if (armijo or not monotone) else dx_norm
             except _NewtonFailure as exc:
                 raise fail(str(exc)) from None
         else:
