@@ -1,10 +1,10 @@
-"""The worked examples in examples/ run as written and give a choice with the reference's own error."""
+"""The worked examples in experiments/examples/ run as written and give a choice with the reference's own error."""
 
 import re
 
 import pytest
 
-from examples import incompressible_cube, liver_plan
+from experiments.examples import incompressible_cube, liver_plan
 
 
 @pytest.mark.parametrize("example, budget, nu", [(liver_plan, "0.7", "0.45"), (incompressible_cube, "0.3", "0.49")])

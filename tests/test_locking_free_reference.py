@@ -6,7 +6,7 @@ import warnings
 import numpy as np
 import pytest
 
-from examples.incompressible_cube import scene
+from experiments.examples.incompressible_cube import scene
 from msslib import fem
 from msslib import mesh as M
 from msslib import planning

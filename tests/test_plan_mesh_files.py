@@ -10,7 +10,7 @@ import pytest
 import xarray as xr
 import yaml
 
-from examples.liver_plan import SCENE, write_mesh
+from experiments.examples.liver_plan import SCENE, write_mesh
 from msslib import mesh as M
 from msslib import planning
 from msslib.cli import main as cli

@@ -7,7 +7,7 @@ and its uniform refinements against a quadratic-element neo-Hookean reference (l
 this nu), prints the reference's own error estimate beside the choice, and picks the cheapest
 model within the budget.
 
-    python examples/liver_plan.py [OUT_DIR]
+    python -m experiments.examples.liver_plan [OUT_DIR]
 """
 
 from __future__ import annotations

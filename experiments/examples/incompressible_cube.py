@@ -5,7 +5,7 @@ hexahedra); ``plan`` detects the nu and measures every model against a quadratic
 volumetric term is integrated with the reduced rule (locking-free), so the errors it prints are the
 models' own.
 
-    python examples/incompressible_cube.py [OUT_DIR]
+    python -m experiments.examples.incompressible_cube [OUT_DIR]
 """
 
 from __future__ import annotations
