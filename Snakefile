@@ -33,8 +33,9 @@ ENGINE = sorted(str(p) for p in Path("derivations").glob("*.py"))
 NOTEBOOKS = [f"paper/build/derivations/{m}.html" for m in (list(DERIVATIONS)[:1] if QUICK else DERIVATIONS)]
 SCENES = sorted(glob_wildcards("experiments/scenes/{name}.yaml").name)
 # every result depends on the library that computed it: a change in msslib reruns what it touches
-# (msslib/paper.py computes no result: only the paper rules depend on it)
-MSSLIB = sorted(str(p) for p in Path("msslib").rglob("*.py") if p != Path("msslib", "paper.py"))
+# (the paper builder and the plotting, experiments/paper.py and experiments/plotting.py, compute no
+# result: only the paper and the figure rules depend on them)
+MSSLIB = sorted(str(p) for p in Path("msslib").rglob("*.py"))
 
 wildcard_constraints:
     paper="|".join(PAPERS),
@@ -214,6 +215,7 @@ rule figure:
     input:
         script="experiments/{paper}/figures/{name}.py",
         shared=shared,
+        plotting="experiments/plotting.py",
         data=lambda wc: declared_inputs(f"experiments/{wc.paper}/figures/{wc.name}.py"),
     output:
         png=report("paper/figures/{paper}_{name}.png", caption="paper/report/figure.rst",
@@ -295,13 +297,13 @@ rule paper_markdown:
         figures=FIGURES,
         tables=TABLES,
         results=COMPARISONS + STUDIES,
-        code="msslib/paper.py",
+        code="experiments/paper.py",
     output:
         "paper/build/paper.md",
     log:
         "logs/paper_markdown.log",
     shell:
-        "python -m msslib.paper fill paper/paper.md.in --out {output} > {log} 2>&1"
+        "python -m experiments.paper fill paper/paper.md.in --out {output} > {log} 2>&1"
 
 
 rule paper_html:
@@ -309,13 +311,13 @@ rule paper_html:
     input:
         markdown="paper/build/paper.md",
         figures=FIGURES,
-        code="msslib/paper.py",
+        code="experiments/paper.py",
     output:
         report("paper/build/paper.html", caption="paper/report/paper.rst", category="Paper", labels={"format": "HTML"}),
     log:
         "logs/paper_html.log",
     shell:
-        "python -m msslib.paper html {input.markdown} --out {output} > {log} 2>&1"
+        "python -m experiments.paper html {input.markdown} --out {output} > {log} 2>&1"
 
 
 rule paper_pdf:
@@ -323,14 +325,14 @@ rule paper_pdf:
     input:
         markdown="paper/build/paper.md",
         figures=FIGURES,
-        code="msslib/paper.py",
+        code="experiments/paper.py",
     output:
         pdf=report("paper/build/paper.pdf", caption="paper/report/paper.rst", category="Paper", labels={"format": "PDF"}),
         typst="paper/build/paper.typ",
     log:
         "logs/paper_pdf.log",
     shell:
-        "python -m msslib.paper pdf {input.markdown} --out {output.pdf} > {log} 2>&1"
+        "python -m experiments.paper pdf {input.markdown} --out {output.pdf} > {log} 2>&1"
 
 
 rule derivation_notebook:
@@ -339,7 +341,7 @@ rule derivation_notebook:
     input:
         module=lambda wc: DERIVATIONS[wc.module],
         engine=ENGINE,
-        code="msslib/paper.py",
+        code="experiments/paper.py",
     output:
         "paper/build/derivations/{module}.html",
     wildcard_constraints:
@@ -347,4 +349,4 @@ rule derivation_notebook:
     log:
         "logs/derivations/{module}.log",
     shell:
-        "python -m msslib.paper notebook {wildcards.module} --out {output} > {log} 2>&1"
+        "python -m experiments.paper notebook {wildcards.module} --out {output} > {log} 2>&1"

@@ -8,7 +8,7 @@ Cholesky, even with the factorisation reused) and would have to take > 30x longe
 
 Three kernels, same scheme and physics:
 
-* :class:`msslib.fastexplicit.LatticeExplicit`, structured-lattice kernels (structure-of-arrays
+* :class:`msslib.explicit.LatticeExplicit`, structured-lattice kernels (structure-of-arrays
   state, springs grouped by the 13 lattice directions as shifted contiguous slices, hexahedron
   volume term over the cell slots, all loops SIMD-vectorised), with the forces in single
   precision (the state and the update in double) -- the figure with the target -- and in double
@@ -34,7 +34,7 @@ from msslib import mesh as M
 from msslib import model as MD
 from msslib import solvers as S
 from msslib import terms as T
-from msslib.fastexplicit import LatticeExplicit
+from msslib.explicit import LatticeExplicit
 
 
 @njit(cache=True, nogil=True)
@@ -140,7 +140,7 @@ def run(res, quick: bool):
 
     common = (f"{t_end:g} s simulated, nu = 0.3, E = 20 kPa, 1 cm cubes, gravity, alpha = {alpha:g}/s, {n_steps} "
               f"steps of {h:.3g} s (0.9 x dt_crit), symplectic Euler, structured-lattice SIMD kernels "
-              f"(msslib.fastexplicit), 1 thread")
+              f"(msslib.explicit.lattice), 1 thread")
     spread = {p: f"median of {len(w)} (min {min(w):.3g} s, max {max(w):.3g} s)" for p, w in walls.items()}
     res.add("golec_sample_explicit_wall", wall["single"], "s", paper / wall["single"],
             "Golec et al. 2.88 s per 10 s on 8 cores",

@@ -10,7 +10,7 @@ process (the warm-up pays numba's one-off start, ~0.5-1 s per process).  The rat
 
 Also: the banded Cholesky of one Newton matrix of the cylinder (level 2, bandwidth 242) with the
 BLAS pool at two threads against one (the solver now always factorises bands on one thread:
-``msslib.blas_threads``).  The two-thread time depends on what else runs on the cores: on an
+``msslib.solvers.blas_threads``).  The two-thread time depends on what else runs on the cores: on an
 idle machine the two are close; on busy cores two threads took up to 2.4 s against 1.7 ms.
 """
 

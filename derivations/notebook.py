@@ -1,14 +1,14 @@
 """Run a derivation module (a jupytext percent-format notebook) cell by cell into Markdown.
 
     python -m derivations.notebook triangle --out triangle.md
-    python -m msslib.paper notebook triangle --out paper/build/derivations/triangle.html
+    python -m experiments.paper notebook triangle --out paper/build/derivations/triangle.html
 
 A module is named as :func:`derivations.registry.resolve` accepts it: ``triangle``,
 ``elements/triangle`` or ``derivations/elements/triangle.py``, wherever it lives.
 The module's cells run in order in one namespace, as ``__main__`` (as in Jupyter). A markdown cell
 (``# %% [markdown]``) becomes Markdown text; a code cell becomes a code block followed by what it
 showed: the math of :mod:`derivations.show` as ``$$...$$`` and its printed output as a text block.
-The paper stage (``python -m msslib.paper notebook``) turns the Markdown into one self-contained HTML
+The paper stage (``python -m experiments.paper notebook``) turns the Markdown into one self-contained HTML
 page by the same path as the paper's HTML (pandoc, math as MathML, no script), beside the paper
 (``paper/build/derivations/``), so that the paper links them as ``derivations/<name>.html``. This
 module imports nothing of msslib: the derivations come first in the workflow.

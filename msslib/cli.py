@@ -26,8 +26,6 @@ Commands
     The complete mass-spring system of a scene, without solving (:mod:`msslib.export`): springs,
     volume and correction terms, masses, fixed nodes and loads as CSV/JSON and VTU, a MuJoCo model,
     a SOFA scene and the C header of the derived formulas and kernels.
-``paper SOURCE --out OUT.html``
-    Build the paper (:mod:`msslib.paper`).
 
 Inputs and outputs: an output that is one of the command's inputs (the scene, its mesh file, the
 experiment, the result or front read) or another of its outputs is refused before anything runs
@@ -329,40 +327,6 @@ def _cmd_compare(args) -> int:
     return 0
 
 
-def _add_paper(subparsers) -> None:
-    p = subparsers.add_parser("paper", help="build the paper (Markdown with placeholders -> HTML)")
-    p.add_argument("source", help="main source, e.g. paper/paper.md.in")
-    p.add_argument("--out", "-o", required=True, help="HTML file (a .md twin is written beside it)")
-    p.set_defaults(func=_cmd_paper)
-
-
-def _cmd_paper(args) -> int:
-    from msslib.io import StagedOutputs
-    from msslib.paper import expand, render_html, title_of
-
-    source, out = Path(args.source), Path(args.out)
-    twin = out.with_suffix(".md")
-    _input_file(source, "paper source")
-    _check_distinct([("output file", out), ("Markdown twin", twin)], [("paper source", source)])
-    try:
-        main_text = source.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise _not_utf8(source, "paper source", exc) from None
-    text = expand(main_text, source.parent, source.parent.parent)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    # figures are linked as ../figures/NAME.png (from paper/build/); looked up from the source's
-    # figures/ folder itself ("figures/../figures/NAME.png"), they are found wherever the HTML goes
-    # and embedded in it
-    try:
-        html = render_html(text, title_of(text), resource_dir=source.parent / "figures")
-    except RuntimeError as exc:
-        raise CommandError(f"cannot build the paper from {str(source)!r}: {_one_line(exc)}") from None
-    with StagedOutputs() as staged:  # the HTML and its Markdown twin, or neither
-        staged.write_text(out, html, what="output file")
-        staged.write_text(twin, text, what="Markdown twin")
-    return 0
-
-
 LEVELS_HELP = "distinct integers >= 1 separated by commas, e.g. 1,2,3"
 
 
@@ -534,7 +498,7 @@ def _cmd_export(args) -> int:
 
 
 #: subparser builders, in the order of the help text
-COMMANDS = [_add_run, _add_validate, _add_experiment, _add_compare, _add_paper, _add_plan, _add_vtu, _add_export]
+COMMANDS = [_add_run, _add_validate, _add_experiment, _add_compare, _add_plan, _add_vtu, _add_export]
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -7,7 +7,7 @@ decides by the suffix of the path:
 ``OUT.vtu``
     The final state (:func:`write_state`): the mesh at rest with the point data ``displacement``
     (m), ``reaction_force`` (N) and ``fixed`` (0/1), and the cell data ``material``,
-    ``cell_state`` and ``relative_jacobian`` (the final state's cell check, :mod:`msslib.quality`).
+    ``cell_state`` and ``relative_jacobian`` (the final state's cell check, :mod:`msslib.mesh.quality`).
 ``OUT.pvd``
     Every saved state (:func:`write_series`), written together (all files, or none):
 
@@ -21,7 +21,7 @@ decides by the suffix of the path:
       when the result stores the reactions of every state (``reaction_force_history``, written by
       dynamic scene runs), else ``reaction_force_final`` (the final state's, and the name says so),
       and ``fixed``; the cell data ``material``, and ``cell_state`` and ``relative_jacobian`` of
-      that state (:func:`msslib.quality.check_state`, at the result's ``collapse_threshold``).
+      that state (:func:`msslib.mesh.quality.check_state`, at the result's ``collapse_threshold``).
     * ``OUT_springs.vtu`` (results with springs): one line cell (VTK_LINE) per spring between
       the rest positions, with the cell data ``spring_constant`` (N/m) and ``rest_length`` (m).
       It is a file of its own, not part of the collection (cells of two types in one grid would
@@ -163,7 +163,7 @@ def write_state(path, ds) -> Path:
         point_data["reaction_force"] = _nodes_axes(ds, "reaction_force")
     if "fixed" in ds:
         point_data["fixed"] = _fixed(ds)
-    # the final state's cell check (msslib.quality): ParaView can threshold on the inverted cells
+    # the final state's cell check (msslib.mesh.quality): ParaView can threshold on the inverted cells
     cell_data = {name: np.asarray(ds[name].values) for name in ("cell_state", "relative_jacobian") if name in ds}
     return write_vtu(path, mesh, point_data=point_data, cell_data=cell_data or None)
 
@@ -171,7 +171,7 @@ def write_state(path, ds) -> Path:
 def _state_writer(mesh, u, v, reaction, fixed, threshold):
     def write(path):
         from msslib.mesh import write_vtu
-        from msslib.quality import check_state
+        from msslib.mesh.quality import check_state
 
         point_data = {"displacement": u}
         if v is not None:
@@ -223,7 +223,7 @@ def _stage_series(staged, path, ds) -> list[Path]:
     else:
         reactions = [None] * len(times)
     fixed = _fixed(ds) if "fixed" in ds else None
-    from msslib.quality import COLLAPSE_THRESHOLD
+    from msslib.mesh.quality import COLLAPSE_THRESHOLD
 
     threshold = float(ds.attrs.get("collapse_threshold", COLLAPSE_THRESHOLD))
     files = series_files(path, len(times), "springs" in ds)

@@ -135,7 +135,7 @@ variable                                               units    content
 
 Further variables may be added with ``extra_vars``; they need a ``long_name``, and ``units`` unless
 they are flags (``flag_values`` and ``flag_meanings``) or text. :func:`msslib.scene.run_scene`
-adds ``cell_state(cell)`` (flags, :mod:`msslib.quality`), ``relative_jacobian(cell)`` [1], the
+adds ``cell_state(cell)`` (flags, :mod:`msslib.mesh.quality`), ``relative_jacobian(cell)`` [1], the
 energies of dynamic runs (``kinetic_energy(time)``, ``potential_energy(time)`` [J]) and the
 potential energy of the final state of static mass-spring runs (scalar ``potential_energy`` [J]).
 

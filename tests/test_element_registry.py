@@ -134,7 +134,7 @@ def test_elements_and_model_specs_name_each_other():
 def test_module_is_a_notebook(module):
     """The cheap part of the notebook page (the full render of one module: tests/test_notebooks.py):
     a jupytext notebook whose first cell is the title, whose code cells compile, and which
-    ``python -m msslib.paper notebook NAME`` finds by its bare name."""
+    ``python -m experiments.paper notebook NAME`` finds by its bare name."""
     import jupytext
 
     path = registry.path(module)

@@ -107,7 +107,6 @@ def _refusals(d):
         "plan --save scene": (["plan", scene, "--max-error", "0.1", "--save", scene], [scene, "--save"]),
         "plan --save equals --front": (["plan", scene, "--max-error", "0.1", "--front", old, "--save", old],
                                        [old, "--front"]),
-        "paper twin is the source": (["paper", d / "paper.md", "--out", d / "paper.html"], ["paper.md", "source"]),
         "run --out /dev/null": (["run", scene, "--out", os.devnull], [os.devnull, "not a regular file"]),
     }
 
@@ -118,7 +117,7 @@ REFUSAL_NAMES = [
     "run --vtu mesh file", "vtu --out result", "experiment run --out experiment",
     "experiment compare --table experiment", "experiment compare --out a run",
     "experiment compare --table equals --out", "plan --save scene", "plan --save equals --front",
-    "paper twin is the source", "run --out /dev/null",
+    "run --out /dev/null",
 ]
 
 

@@ -9,7 +9,8 @@ import textwrap
 import numpy as np
 import pytest
 
-from msslib import mesh, resources
+from msslib import mesh
+from msslib.scene import resources
 from msslib.cli import main
 from msslib.errors import ResourceError
 from msslib.scene import load_scene

@@ -16,7 +16,7 @@ from msslib import model as MD
 from msslib import solvers as S
 from msslib import terms as T
 from msslib.errors import StabilityError
-from msslib.fastexplicit import LatticeExplicit
+from msslib.explicit import LatticeExplicit
 from msslib.scene import load_scene, prepare, run_scene
 
 E0, RHO, G = 1.0e6, 1000.0, 9.81

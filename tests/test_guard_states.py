@@ -1,5 +1,5 @@
 """Inverted and collapsed cells in solved states are detected, reported and recorded
-(msslib.quality and its guard in msslib.scene.run_scene)."""
+(msslib.mesh.quality and its guard in msslib.scene.run_scene)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import yaml
 
 from msslib import experiment
 from msslib import mesh as M
-from msslib import quality as Q
+from msslib.mesh import quality as Q
 from msslib.cli import main
 from msslib.errors import MsslibWarning, UnphysicalStateError
 from msslib.io import read_result

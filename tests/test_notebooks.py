@@ -23,7 +23,7 @@ def triangle_markdown():
 
 @pytest.fixture(scope="module")
 def triangle_html(triangle_markdown):
-    from msslib.paper import render_html
+    from experiments.paper import render_html
     return render_html(triangle_markdown)
 
 
@@ -96,7 +96,7 @@ def test_triangle_notebook_html_has_mathml(triangle_html):
 
 
 def test_notebook_commands_write_markdown_and_html(tmp_path, monkeypatch):
-    from msslib import paper
+    from experiments import paper
 
     monkeypatch.setattr(notebook, "to_markdown", lambda m: "# T\n\n$$x = \\frac{1}{2}$$\n")
     md = tmp_path / "t.md"

@@ -1,4 +1,4 @@
-"""The paper build (msslib.paper): math rendered at build time, offline HTML, PDF, and the LaTeX
+"""The paper build (experiments.paper): math rendered at build time, offline HTML, PDF, and the LaTeX
 of the derivation findings. Each test builds a small paper in tmp_path (a second or two)."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from derivations import report
-from msslib import paper
+from experiments import paper
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -1,10 +1,10 @@
-"""Smoke tests of msslib.plotting on tiny hand-made result datasets."""
+"""Smoke tests of experiments.plotting on tiny hand-made result datasets."""
 
 import numpy as np
 import pytest
 
 from msslib import mesh as M
-from msslib import plotting
+from experiments import plotting
 from msslib.io import make_dataset
 
 

@@ -1,11 +1,11 @@
-"""Uniform nested refinement (msslib.refine): same domain, nested nodes, exact child measures."""
+"""Uniform nested refinement (msslib.mesh.refine): same domain, nested nodes, exact child measures."""
 
 import numpy as np
 import pytest
 
 from msslib import fem
 from msslib import mesh as M
-from msslib.refine import CHILDREN, uniform
+from msslib.mesh.refine import CHILDREN, uniform
 
 
 def _cell_sets(mesh, decimals=12):

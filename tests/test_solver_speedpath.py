@@ -12,7 +12,7 @@ from solver_problems import lattice_system
 
 
 def _pools_or_skip():
-    from msslib.blas_threads import _controller
+    from msslib.solvers.blas_threads import _controller
 
     if _controller() is None:
         pytest.skip("no controllable BLAS thread pool (threadpoolctl)")
@@ -22,7 +22,7 @@ def _pools_or_skip():
 
 
 def test_one_blas_thread_limits_and_restores():
-    from msslib.blas_threads import blas_threads, one_blas_thread
+    from msslib.solvers.blas_threads import blas_threads, one_blas_thread
 
     ctl = _pools_or_skip()
     with ctl.limit(limits=2, user_api="blas"):
@@ -56,7 +56,7 @@ def test_banded_factorisations_run_on_one_blas_thread(monkeypatch, shift):
     from scipy.linalg import lapack
 
     from msslib import solvers as S
-    from msslib.blas_threads import BLOCKED_BANDWIDTH, blas_threads
+    from msslib.solvers.blas_threads import BLOCKED_BANDWIDTH, blas_threads
 
     ctl = _pools_or_skip()
     seen = []

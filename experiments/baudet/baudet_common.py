@@ -252,8 +252,8 @@ CUBE_PANELS = {"boundary reading, derived factor": {"geometry": "cube", "factor"
 def comparison(doc, labels, inputs, **kw):
     """A figure of MSS wireframes over the FEM reference and per-node error maps, side view (xz) in mm:
     one column per label, with the MSS result of the same position in ``inputs`` against the reference,
-    the last of ``inputs``; ``kw`` goes to :func:`msslib.plotting.comparison_figure`."""
-    from msslib import plotting
+    the last of ``inputs``; ``kw`` goes to :func:`experiments.plotting.comparison_figure`."""
+    from experiments import plotting
 
     args = figure_args(doc)
     ref = open_result(inputs[-1])
@@ -272,7 +272,7 @@ def curves(da, x, *, xlabel, ylabel, panels, xscale=100.0, yscale=100.0, absolut
     published points {title: [(x, y, nu_label), ...]} drawn as black-edged markers."""
     from matplotlib.lines import Line2D
 
-    from msslib import plotting
+    from experiments import plotting
 
     n = len(panels)
     fig = plotting.figure(figsize=(3.6 * n + 0.4, 3.4))

@@ -1,12 +1,12 @@
 """Shared by the Golec figures: the states the wrinkles study stores, as result-like datasets
-that msslib.plotting draws."""
+that experiments.plotting draws."""
 
 import numpy as np
 import xarray as xr
 
 
 def positions_dataset(rest, x, cells):
-    """A minimal result-like dataset (rest_position, displacement, cells) for msslib.plotting."""
+    """A minimal result-like dataset (rest_position, displacement, cells) for experiments.plotting."""
     ds = xr.Dataset({"rest_position": (("node", "axis"), np.asarray(rest)),
                      "displacement": (("node", "axis"), np.asarray(x) - np.asarray(rest)),
                      "cells": (("cell", "cell_node"), np.asarray(cells))})

@@ -6,7 +6,7 @@ magnitude, the rest shape in grey; bottom row: the per-node distance between the
 import argparse
 from pathlib import Path
 
-from msslib import plotting
+from experiments import plotting
 from msslib.io import read_result
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -3,7 +3,7 @@ quadratic reference of :mod:`msslib.planning.reference`.  ``python -m msslib pla
 paper's study (``experiments/performance``) both measure with :func:`measure_front`.
 
 Levels: level ``k`` (``k >= 1``) is the scene's mesh, generated or read from a file, refined
-uniformly ``k - 1`` times (``geometry.refine``, :func:`msslib.refine.uniform`, on top of a
+uniformly ``k - 1`` times (``geometry.refine``, :func:`msslib.mesh.refine.uniform`, on top of a
 ``refine`` the scene asks for itself): nested meshes of one domain, every node of a level a node
 of the finer ones.  The reference is the dimension's non-linear FEM law (2D St Venant-Kirchhoff,
 3D neo-Hookean) with quadratic elements on the finest measured level (its dofs are the nodes of

@@ -8,7 +8,7 @@ with the quadratic shape functions (not lumped at the nodes: a lumped load on qu
 is a set of point loads), nodal forces at the nodes, gravity over the cells.
 
 :func:`reference` solves it on the finest measured level and up to two coarser ones.  Each level
-is one uniform refinement of the one below (:func:`msslib.refine.uniform`), so every node of a
+is one uniform refinement of the one below (:func:`msslib.mesh.refine.uniform`), so every node of a
 coarser level is a node of the finer ones, and the quadratic dofs of level ``L`` sit exactly at
 the nodes of level ``L + 1``: every measured model is compared with the reference at its own
 nodes, without interpolation.  Error estimate: ``c = max |u_L - u_{L-1}|`` at the nodes of level

@@ -48,7 +48,7 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     :func:`msslib.mesh.read`): groups of its cells for ``materials``, groups of boundary facets
     (gmsh physical surfaces of a 3D mesh, curves of a 2D mesh) and nodes for ``select``.  A group
     is known by its name, a gmsh physical group without a name by its number (``3`` or ``"3"``).
-    ``refine: k`` (optional) refines the mesh uniformly ``k`` times (:func:`msslib.refine.uniform`:
+    ``refine: k`` (optional) refines the mesh uniformly ``k`` times (:func:`msslib.mesh.refine.uniform`:
     nested meshes of one domain, the coarse nodes keeping their numbers).
 ``materials``
     A non-empty list (every material used by some cell) of ``{E, nu, density}``: Young's modulus ``E > 0`` (Pa), Poisson's ratio
@@ -175,7 +175,7 @@ Result
 variables (``material_E``, ``material_nu``, ``material_density``, ``material_name`` when they are
 keyed by group), ``thickness`` (2D), springs with constants and rest lengths (MSS), the history
 (time, displacement, velocity, kinetic energy) of dynamic runs, the cell check of
-:mod:`msslib.quality`, solver statistics (``solver_*``), wall time, the scene text, the model name,
+:mod:`msslib.mesh.quality`, solver statistics (``solver_*``), wall time, the scene text, the model name,
 plus the attributes ``scene_name`` and ``scene_description``.
 """
 

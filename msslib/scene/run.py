@@ -144,14 +144,14 @@ def run_scene(scene, progress=True):
     fails and :class:`msslib.solvers.DivergenceError` when a dynamic run blows up.
 
     The final state, and every saved state of a dynamic run with ``output.history``, is checked
-    for inverted and collapsed cells (:func:`msslib.quality.guard`, for every model and cell type):
+    for inverted and collapsed cells (:func:`msslib.mesh.quality.guard`, for every model and cell type):
     the result records ``inverted_cells``, ``collapsed_cells``, ``min_relative_jacobian``, ... (0
     counts for a clean run) and the cell variables ``cell_state`` and ``relative_jacobian``; a
     flagged state is one :class:`msslib.errors.MsslibWarning`, or with ``checks: {inverted:
     error}`` an :class:`msslib.errors.UnphysicalStateError` (no dataset is returned).
     """
     from msslib.io import make_dataset
-    from msslib.quality import guard
+    from msslib.mesh.quality import guard
 
     scene = load_scene(scene)
     t0 = time.perf_counter()

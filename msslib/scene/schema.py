@@ -112,7 +112,7 @@ def _geometry(path, value, base_dir: Path):
     has_gen, has_file = "generator" in value, "file" in value
     if has_gen == has_file:
         _fail(path, "give exactly one of 'generator' (with 'args') or 'file'")
-    # uniform midpoint refinements of the mesh (msslib.refine.uniform); only stored when asked for
+    # uniform midpoint refinements of the mesh (msslib.mesh.refine.uniform); only stored when asked for
     refine = {"refine": _integer(f"{path}.refine", value["refine"], minimum=0, maximum=8,
                                  why=" (each multiplies the cells by 4 or 8)")} if "refine" in value else {}
     if has_file:
@@ -391,7 +391,7 @@ def _saved_states(solver, output) -> float:
 
 def _check_size(root, geometry, model, solver, output, checks, n_nodes=None, dim=None):
     """Refuse, before anything is allocated, a run whose estimated memory exceeds the limit."""
-    from msslib import resources
+    from msslib.scene import resources
 
     if n_nodes is None:
         n_nodes, _n_cells, dim = resources.generated_mesh_size(geometry["generator"], geometry["args"])

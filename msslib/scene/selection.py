@@ -31,7 +31,7 @@ def _build_mesh(scene: Scene) -> _mesh.Mesh:
         except (ValueError, TypeError) as exc:
             _fail("scene.geometry", f"{geo['generator']}: {exc}")
     if geo.get("refine"):
-        from msslib.refine import uniform
+        from msslib.mesh.refine import uniform
 
         mesh = uniform(mesh, geo["refine"])
     if scene.thickness is not None and mesh.dim == 3:

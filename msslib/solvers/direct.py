@@ -1,6 +1,6 @@
 """Direct factorisations of the Newton systems: banded Cholesky (banded LU once the tangent is
 found indefinite) in a bandwidth-reducing ordering, else SuperLU.  The blocked banded
-factorisations run on one BLAS thread (:mod:`msslib.blas_threads`)."""
+factorisations run on one BLAS thread (:mod:`msslib.solvers.blas_threads`)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from msslib.blas_threads import BLOCKED_BANDWIDTH, one_blas_thread
+from msslib.solvers.blas_threads import BLOCKED_BANDWIDTH, one_blas_thread
 
 from . import plans as _plans
 from .plans import _plans_of, _same_readonly
@@ -110,7 +110,7 @@ def _banded_cholesky_solve(A, b, context):
         flat = ab.reshape(-1, order="F")  # a view (Fortran-contiguous)
         flat[plan["dst"]] = A.data[plan["src"]]
         try:
-            with one_blas_thread(bw >= BLOCKED_BANDWIDTH):  # msslib.blas_threads: shared cores
+            with one_blas_thread(bw >= BLOCKED_BANDWIDTH):  # msslib.solvers.blas_threads: shared cores
                 cb = cholesky_banded(ab, lower=True, overwrite_ab=True, check_finite=False)
                 y = cho_solve_banded((cb, True), bp, check_finite=False)
         except LinAlgError:  # not positive definite: banded LU (partial pivoting) from now on

@@ -2,7 +2,7 @@
 the boundary and the element reading of the correction force."""
 
 from experiments.baudet import baudet_common as C
-from msslib import plotting
+from experiments import plotting
 
 INPUTS = ["results/baudet/studies/bulk.nc"]
 

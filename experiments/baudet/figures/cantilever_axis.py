@@ -3,7 +3,7 @@
 from experiments.baudet import baudet_common as C
 from experiments.baudet.baudet_common import CANTILEVER_INPUTS as INPUTS
 from experiments.baudet.baudet_common import CANTILEVER_RES as RES
-from msslib import plotting
+from experiments import plotting
 
 
 def main():

@@ -4,7 +4,7 @@ import numpy as np
 from matplotlib.ticker import NullLocator
 
 from experiments.baudet import baudet_common as C
-from msslib import plotting
+from experiments import plotting
 
 INPUTS = ["results/baudet/studies/cantilever_floor.nc", "results/baudet/cantilever/comparison.nc"]
 

@@ -4,7 +4,7 @@ import numpy as np
 from matplotlib.patches import Polygon, Rectangle
 
 from experiments.baudet import baudet_common as C
-from msslib import plotting
+from experiments import plotting
 
 INPUTS = ["results/baudet/studies/large_deformation.nc"]
 COLORS = {"mss_4x1x1": "tab:red", "mss_8x2x2": "tab:orange", "mss_16x4x4": "tab:blue", "mss_32x8x8": "tab:purple",

@@ -4,7 +4,7 @@ the boundary and the element reading of the correction force."""
 import matplotlib.ticker
 
 from experiments.baudet import baudet_common as C
-from msslib import plotting
+from experiments import plotting
 
 INPUTS = ["results/baudet/studies/tension.nc"]
 BAND = 5.0  # %, the tolerance drawn

@@ -2,7 +2,7 @@
 with it under the boundary reading (derived, printed factor) and the element reading (derived)."""
 
 from experiments.baudet import baudet_common as C
-from msslib import plotting
+from experiments import plotting
 
 INPUTS = ["results/baudet/studies/shear.nc"]
 

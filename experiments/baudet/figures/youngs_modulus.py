@@ -2,7 +2,7 @@
 correction read at element level (every cube corrected from the forces on it from outside)."""
 
 from experiments.baudet import baudet_common as C
-from msslib import plotting
+from experiments import plotting
 
 INPUTS = ["results/baudet/studies/tension.nc"]
 PUBLISHED = [(10.0, 2.7, "0.3"), (10.0, 2.0, "0.4"), (10.0, 1.5, "0.499")]  # Sec. 5 text, nu = 0.5 as 0.499

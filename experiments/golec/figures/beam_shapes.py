@@ -5,7 +5,7 @@ import numpy as np
 
 from experiments import script
 from experiments.golec.wrinkle_states import positions_dataset, study_state
-from msslib import plotting
+from experiments import plotting
 from msslib.io import read_result
 
 R = "results/golec/beam"

@@ -4,7 +4,7 @@ import numpy as np
 
 from experiments import script
 from experiments.golec.wrinkle_states import study_state
-from msslib import plotting
+from experiments import plotting
 from msslib.io import read_result
 
 R = "results/golec/compression"

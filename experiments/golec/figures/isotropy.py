@@ -4,7 +4,7 @@ import matplotlib.ticker
 from matplotlib.lines import Line2D
 
 from experiments import script
-from msslib import plotting
+from experiments import plotting
 from msslib.io import read_result
 
 INPUTS = ["results/golec/studies/isotropy.nc"]

@@ -15,7 +15,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from experiments import script
-from msslib import plotting
+from experiments import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
 INPUTS = ["results/lloyd/studies/load_sweep.nc"]

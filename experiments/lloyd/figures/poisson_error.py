@@ -11,7 +11,7 @@ from pathlib import Path
 import xarray as xr
 
 from experiments import script
-from msslib import plotting
+from experiments import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
 INPUTS = ["results/lloyd/studies/poisson_error.nc"]

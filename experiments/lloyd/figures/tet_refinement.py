@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from experiments import script
-from msslib import plotting
+from experiments import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
 INPUTS = ["results/lloyd/studies/tet_refinement.nc"]

@@ -15,7 +15,7 @@ Four parts, one NetCDF:
    mesh along the load path (continuation in the load factor).
 4. *Load paths* of the two experiments with trouble: the cylinder with a hole under the full
    compressive traction (1800 Pa) and the cone under its shear (2000 Pa): largest displacement,
-   smallest relative Jacobian, inverted cells (msslib.quality) and the smallest eigenvalue of the
+   smallest relative Jacobian, inverted cells (msslib.mesh.quality) and the smallest eigenvalue of the
    free tangent stiffness (divided by the mean of its diagonal) at every converged load factor.
 
     python -m experiments.lloyd.studies.tet_refinement --out results/lloyd/studies/tet_refinement.nc [--quick]
@@ -38,7 +38,7 @@ from scipy.stats import spearmanr
 from experiments.script import LoadSegment
 from msslib.compare import interpolate
 from msslib.io import mesh_from_result, write_result
-from msslib.quality import relative_jacobians
+from msslib.mesh.quality import relative_jacobians
 from msslib.scene import load_scene, prepare, run_scene
 from msslib.solvers import ConvergenceError, static_solve
 

@@ -6,7 +6,7 @@ import argparse
 
 import numpy as np
 
-from msslib import plotting
+from experiments import plotting
 from msslib.io import read_result
 
 SCENES = ["cantilever", "cylinder", "membrane"]

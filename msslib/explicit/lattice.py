@@ -29,14 +29,14 @@ the positions (state and update stay double), about twice as fast, with forces w
 1e-5 of the double ones; see ``tests/test_fastexplicit.py``.
 
 This module finds the lattice (:func:`lattice_index`) and holds the integrator; the numba
-kernels are in :mod:`msslib.fastexplicit_kernels`.
+kernels are in :mod:`msslib.explicit.kernels`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from msslib.fastexplicit_kernels import _from_lattice, _gradient, _run, _to_lattice
+from msslib.explicit.kernels import _from_lattice, _gradient, _run, _to_lattice
 from msslib.terms import ExternalForce, HexVolume, Springs, Term
 
 __all__ = ["LatticeExplicit", "lattice_index"]

@@ -1,4 +1,4 @@
-"""msslib.fastexplicit: lattice kernels give the model's forces and integrate's trajectories."""
+"""msslib.explicit.lattice: lattice kernels give the model's forces and integrate's trajectories."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from msslib import mesh as M
 from msslib import model as MD
 from msslib import solvers as S
 from msslib import terms as T
-from msslib.fastexplicit import LatticeExplicit, lattice_index
+from msslib.explicit.lattice import LatticeExplicit, lattice_index
 from msslib.generated import kernels as K
 
 

@@ -30,9 +30,9 @@ resolution for three): a false claim whose result files, or the run files beside
 attribute ``quick = 1`` is printed with the mark "[not met by the reduced quick-build results]" instead. The filled Markdown (``paper/build/paper.md``, figures linked as
 ``../figures/NAME.png``) is then rendered twice::
 
-    python -m msslib.paper fill paper/paper.md.in --out paper/build/paper.md
-    python -m msslib.paper html paper/build/paper.md --out paper/build/paper.html
-    python -m msslib.paper pdf paper/build/paper.md --out paper/build/paper.pdf
+    python -m experiments.paper fill paper/paper.md.in --out paper/build/paper.md
+    python -m experiments.paper html paper/build/paper.md --out paper/build/paper.html
+    python -m experiments.paper pdf paper/build/paper.md --out paper/build/paper.pdf
 
 Math is ``$...$`` (inline) and ``$$...$$`` (display) TeX and is converted at build time, so the
 outputs load nothing: no script, no font or style from the network.
@@ -497,7 +497,7 @@ def build(source, out, pdf=None) -> Path:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m msslib.paper", description=__doc__.splitlines()[0])
+    p = argparse.ArgumentParser(prog="python -m experiments.paper", description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="step", required=True)
     for step, src, dst in [("fill", "main source, e.g. paper/paper.md.in", "filled Markdown"),
                            ("html", "filled Markdown", "HTML file"), ("pdf", "filled Markdown", "PDF file"),
@@ -510,7 +510,7 @@ def main(argv=None) -> int:
     try:
         step(args.source, args.out)
     except (OSError, ValueError, KeyError, RuntimeError) as exc:
-        print(f"python -m msslib.paper {args.step}: {exc}", file=sys.stderr)
+        print(f"python -m experiments.paper {args.step}: {exc}", file=sys.stderr)
         return 1
     return 0
 

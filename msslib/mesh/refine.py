@@ -21,7 +21,7 @@ import itertools
 
 import numpy as np
 
-from .mesh import Mesh
+from msslib.mesh import Mesh
 
 __all__ = ["CHILDREN", "uniform"]
 

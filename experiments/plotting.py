@@ -26,7 +26,7 @@ boundary faces turned towards the viewer are drawn, back to front.
 
 Example::
 
-    from msslib import plotting
+    from experiments import plotting
     from msslib.io import read_result
 
     mss, fem = read_result("shear__mss.nc"), read_result("shear__fem.nc")
