@@ -10,7 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from msslib.io import write_text
+from msslib.results import write_text
 
 
 def main(argv=None):

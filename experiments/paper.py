@@ -64,7 +64,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from msslib.io import write_text
+from msslib.results import write_text
 
 PLACEHOLDER = re.compile(r"\{\{\s*(include|figure|value)\s+(.*?)\s*\}\}", re.S)
 #: a claim, matched after the other placeholders (including those in its text) are filled

@@ -1,4 +1,4 @@
-"""Plotting helpers for result datasets (:mod:`msslib.io` schema): deformed meshes, error maps.
+"""Plotting helpers for result datasets (:mod:`msslib.results.netcdf` schema): deformed meshes, error maps.
 
 The figures of the papers draw the mass-spring system as a wireframe over the reference
 deformation; this module provides the pieces, for 2D meshes (triangles, quads) and for 3D meshes
@@ -27,7 +27,7 @@ boundary faces turned towards the viewer are drawn, back to front.
 Example::
 
     from experiments import plotting
-    from msslib.io import read_result
+    from msslib.results import read_result
 
     mss, fem = read_result("shear__mss.nc"), read_result("shear__fem.nc")
     fig = plotting.figure(figsize=(5, 4))
@@ -367,7 +367,7 @@ def node_error(ds, ref_ds) -> np.ndarray:
     Xr, ur, _, _ = _arrays(ref_ds)
     if not (X.shape == Xr.shape and np.allclose(X, Xr, atol=1e-12 * max(np.abs(Xr).max(), 1e-300))):
         from msslib.compare import interpolate
-        from msslib.io import mesh_from_result
+        from msslib.results import mesh_from_result
 
         ur = interpolate(mesh_from_result(ref_ds), ur, X)
     return np.linalg.norm(u - ur, axis=1)

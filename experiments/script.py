@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from msslib.io import write_text
+from msslib.results import write_text
 
 
 def args(doc, argv=None):

@@ -6,7 +6,7 @@ Runs every case for every model it applies to and records, per (case, model): wh
 whether the solver converged, the error against the neo-Hookean FEM reference on the same mesh
 where that is meaningful, the volume ratio V/V0, the smallest element volume ratio, the number of
 inverted elements and a one-line text of the outcome (how it broke).  The result is an xarray
-Dataset written atomically (:func:`msslib.io.write_result`).
+Dataset written atomically (:func:`msslib.results.netcdf.write_result`).
 
 Models (dimension ``model``):
 
@@ -82,7 +82,7 @@ from experiments.stability_common import (
     TET_EDGES,
     _record,
 )
-from msslib.io import write_result
+from msslib.results import write_result
 
 # --------------------------------------------------------------------------------------------
 # driver and output

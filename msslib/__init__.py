@@ -28,13 +28,13 @@ The API (names are imported on first use: ``import msslib`` loads neither numba 
     and the per-cell constants of the other terms (volume terms, Baudet's correction).
 ``solve_static(model, *, load_steps=None, tol=None, max_iter=None, progress=True) -> xarray.Dataset``
 ``solve_dynamic(model, *, dt, t_end, method=None, damping=None, save_every=None, allow_unstable=None, history=True, progress=True) -> xarray.Dataset``
-    The result dataset of :mod:`msslib.io` (what ``run`` writes), for the model's scene with
+    The result dataset of :mod:`msslib.results.netcdf` (what ``run`` writes), for the model's scene with
     that solver.
 ``write_result(path, ds)``, ``read_result(path)``
     NetCDF results, written atomically.
 ``write_paraview(path, ds)``
     ``.vtu``: the final state; ``.pvd``: every saved state as a ParaView time series
-    (:mod:`msslib.paraview`).
+    (:mod:`msslib.results.paraview`).
 ``run_scene(scene_or_path, progress=True) -> xarray.Dataset``, ``load_scene(path_or_dict)``
     Scenes (:mod:`msslib.scene`).
 ``__version__``
@@ -63,7 +63,7 @@ _LAZY = {
     "Material": "msslib.scene",
     "load_scene": "msslib.scene",
     "run_scene": "msslib.scene",
-    "read_result": "msslib.io",
+    "read_result": "msslib.results",
 }
 
 __all__ = ["__version__", *_LAZY]

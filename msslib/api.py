@@ -204,7 +204,7 @@ def build_model(name: str, mesh, materials, *, fixed=None, loads=None, thickness
 
 
 def _var(dims, data, units, long_name):
-    """``units``: UDUNITS strings as in :mod:`msslib.schema`; None for indices (not quantities)."""
+    """``units``: UDUNITS strings as in :mod:`msslib.results.conventions`; None for indices (not quantities)."""
     return (dims, data, {"long_name": long_name} if units is None else {"units": units, "long_name": long_name})
 
 
@@ -292,7 +292,7 @@ def _run(model, kind: str, given: dict, output: dict | None, progress):
 def solve_static(model, *, load_steps=None, tol=None, max_iter=None, progress=True):
     """Solve ``model`` (from :func:`build_model`) statically, as ``run`` solves a scene with
     ``solver: {type: static, ...}`` (the arguments given override the model's ``solver``), and
-    return the result dataset (:mod:`msslib.schema`).  ``progress``: see
+    return the result dataset (:mod:`msslib.results.conventions`).  ``progress``: see
     :func:`msslib.scene.run_scene`."""
     return _run(model, "static", {"load_steps": load_steps, "tol": tol, "max_iter": max_iter}, None, progress)
 
@@ -326,18 +326,18 @@ def _path_and_dataset(function, a, b):
 
 
 def write_result(path, ds) -> Path:
-    """Write a result atomically as NetCDF (:func:`msslib.io.write_result`); the two arguments
+    """Write a result atomically as NetCDF (:func:`msslib.results.netcdf.write_result`); the two arguments
     may come in either order."""
-    from msslib.io import write_result as _write
+    from msslib.results import write_result as _write
 
     path, ds = _path_and_dataset("write_result", path, ds)
     return _write(path, ds)
 
 
 def write_paraview(path, ds) -> list[Path]:
-    """Write a result for ParaView (:func:`msslib.paraview.write`): ``.vtu`` the final state,
+    """Write a result for ParaView (:func:`msslib.results.paraview.write`): ``.vtu`` the final state,
     ``.pvd`` every saved state; the two arguments may come in either order."""
-    from msslib.paraview import write
+    from msslib.results.paraview import write
 
     path, ds = _path_and_dataset("write_paraview", path, ds)
     return write(path, ds)

@@ -4,8 +4,8 @@ Commands
 --------
 ``run SCENE.yaml --out OUT.nc [--vtu OUT.vtu|OUT.pvd] [--quiet]``
     Validate, build and solve a scene (:mod:`msslib.scene`) and write the result atomically as
-    NetCDF (:func:`msslib.io.write_result`); with ``--vtu`` (or ``output: {vtu: ...}`` in the scene)
-    also for ParaView (:mod:`msslib.paraview`; the suffix decides): ``.vtu`` the final state,
+    NetCDF (:func:`msslib.results.netcdf.write_result`); with ``--vtu`` (or ``output: {vtu: ...}`` in the scene)
+    also for ParaView (:mod:`msslib.results.paraview`; the suffix decides): ``.vtu`` the final state,
     ``.pvd`` every saved state as a time series (``OUT_0000.vtu``, ... and ``OUT_springs.vtu``
     beside it).  Output directories are checked before the run; on any failure no
     output file is left behind.  A progress bar is drawn on stderr for runs longer than half a
@@ -31,7 +31,7 @@ Inputs and outputs: an output that is one of the command's inputs (the scene, it
 experiment, the result or front read) or another of its outputs is refused before anything runs
 (same resolved path, or :func:`os.path.samefile`: hard and symbolic links too); a ParaView series
 is refused before the run when a file it writes beside the ``.pvd`` would be an input.  A command that
-writes several files writes them together (:class:`msslib.staging.StagedOutputs`): all are replaced,
+writes several files writes them together (:class:`msslib.results.staging.StagedOutputs`): all are replaced,
 or none is; temporary files are removed on any error, on SIGINT and on SIGTERM.
 
 ``--version`` prints ``msslib X.Y.Z``.
@@ -96,7 +96,7 @@ def _add_run(subparsers) -> None:
 
 
 def _cmd_run(args) -> int:
-    from msslib.io import StagedOutputs
+    from msslib.results import StagedOutputs, stage_result
     from msslib.scene import run_scene
 
     scene = _load_scene(args.scene)
@@ -114,7 +114,7 @@ def _cmd_run(args) -> int:
     files = _paraview_files(vtu, ds) if vtu is not None else []
     _check_distinct([("output file", out), *files], inputs)  # every file of a series, links included
     with StagedOutputs() as staged:  # every file, or none
-        staged.write_result(out, ds)
+        stage_result(staged, out, ds)
         if vtu is not None:
             _stage_paraview(staged, vtu, ds)
     if not args.quiet:
@@ -191,7 +191,7 @@ def _experiment_scenes(exp, pairs, quick):
 
 def _cmd_experiment_run(args) -> int:
     from msslib import experiment
-    from msslib.io import write_result
+    from msslib.results import write_result
 
     exp = _load_experiment(args.experiment)
     _choice("--case", args.case, list(exp.cases), f"case of experiment {exp.name}")
@@ -207,7 +207,7 @@ def _cmd_experiment_run(args) -> int:
 
 def _cmd_experiment_run_all(args) -> int:
     from msslib import experiment
-    from msslib.io import StagedOutputs
+    from msslib.results import StagedOutputs, stage_result
 
     exp = _load_experiment(args.experiment)
     out_dir = Path(args.out_dir)
@@ -224,13 +224,13 @@ def _cmd_experiment_run_all(args) -> int:
         for i, ((case, model), (_, out)) in enumerate(zip(runs, outputs), 1):
             if not args.quiet:
                 print(f"[{i}/{len(runs)}] {exp.name}: {case} / {model}", file=sys.stderr, flush=True)
-            staged.write_result(out, experiment.run(exp, case, model, quick=args.quick, progress=not args.quiet))
+            stage_result(staged, out, experiment.run(exp, case, model, quick=args.quick, progress=not args.quiet))
     return 0
 
 
 def _cmd_experiment_compare(args) -> int:
     from msslib import experiment
-    from msslib.io import StagedOutputs
+    from msslib.results import StagedOutputs, stage_result
 
     exp = _load_experiment(args.experiment)
     out = Path(args.out)
@@ -251,7 +251,7 @@ def _cmd_experiment_compare(args) -> int:
         results[key] = _read_result(path, "run")
     ds = experiment.compare(exp, results)
     with StagedOutputs() as staged:  # both files, or neither
-        staged.write_result(out, ds, what="comparison")
+        stage_result(staged, out, ds, what="comparison")
         if table is not None:
             staged.write_text(table, experiment.markdown_table(ds), what="table")
     return 0
@@ -278,7 +278,7 @@ def _add_vtu(subparsers) -> None:
 
 
 def _cmd_vtu(args) -> int:
-    from msslib.io import StagedOutputs
+    from msslib.results import StagedOutputs
 
     src, out = Path(args.result), Path(args.out)
     if not src.exists():
@@ -305,7 +305,7 @@ def _add_compare(subparsers) -> None:
 
 def _cmd_compare(args) -> int:
     from msslib.compare import compare_results, write_error_field
-    from msslib.io import StagedOutputs
+    from msslib.results import StagedOutputs
 
     src, ref = Path(args.result), Path(args.reference)
     out, vtu = (Path(a) if a else None for a in (args.out, args.vtu))
@@ -391,7 +391,7 @@ def _read_front(path: Path, scene: Path):
 
 def _cmd_plan(args) -> int:
     from msslib import planning
-    from msslib.io import write_result
+    from msslib.results import write_result
 
     scene = Path(args.scene)
     max_error = _positive_number("--max-error", args.max_error, "a fraction of the largest reference displacement")
@@ -518,7 +518,7 @@ def main(argv=None) -> int:
     import warnings
 
     from msslib.errors import MsslibWarning, UnphysicalStateError
-    from msslib.io import Terminated, terminate_raises
+    from msslib.results import Terminated, terminate_raises
     from msslib.solvers import ConvergenceError, DivergenceError
 
     parser = build_parser()

@@ -164,7 +164,7 @@ RESULT_VARIABLES = ("rest_position", "displacement", "cells")
 
 def _read_result(path: Path, what: str = "result file", required=RESULT_VARIABLES):
     """Read an msslib result; CommandError naming ``path`` when it is not one."""
-    from msslib.io import SCHEMA_VERSION, read_result
+    from msslib.results import SCHEMA_VERSION, read_result
 
     _input_file(path, what)
     try:
@@ -183,7 +183,7 @@ def _read_result(path: Path, what: str = "result file", required=RESULT_VARIABLE
             raise CommandError(f"{what} {str(path)!r}: variable {name!r} has dimensions {ds[name].dims}, "
                                f"expected (node, axis)")
     if "cells" in required:
-        from msslib.io import mesh_from_result
+        from msslib.results import mesh_from_result
 
         try:
             mesh_from_result(ds)
@@ -204,14 +204,14 @@ def _vtu_path(scene, out: Path, cli_vtu: str | None) -> Path | None:
 
 
 def _write_vtu(path: Path, ds) -> None:
-    """The final state as one VTU file (:func:`msslib.paraview.write_state`)."""
-    from msslib.paraview import write_state
+    """The final state as one VTU file (:func:`msslib.results.paraview.write_state`)."""
+    from msslib.results.paraview import write_state
 
     write_state(path, ds)
 
 
 def _paraview_what(path: Path) -> str:
-    from msslib.paraview import is_series
+    from msslib.results.paraview import is_series
 
     return "ParaView series" if is_series(path) else "VTU file"
 
@@ -220,7 +220,7 @@ def _check_paraview(path: Path, others) -> None:
     """Refuse, before anything runs, a ParaView output whose suffix is neither .vtu nor .pvd, or a
     series whose files beside the .pvd (STEM_NNNN.vtu, STEM_springs.vtu) would be one of
     ``others`` (pairs ``(what, path)``: the inputs and the other outputs)."""
-    from msslib.paraview import check_suffix, in_series, is_series
+    from msslib.results.paraview import check_suffix, in_series, is_series
 
     try:
         check_suffix(path, _paraview_what(path))
@@ -271,7 +271,7 @@ def _check_series_members(pvd: Path, others) -> None:
 
 def _paraview_files(path: Path, ds) -> list:
     """Every file of the ParaView export of ``ds`` at ``path``, pairs ``(what, path)``."""
-    from msslib.paraview import is_series, series_files, states
+    from msslib.results.paraview import is_series, series_files, states
 
     if not is_series(path):
         return [("VTU file", path)]
@@ -279,7 +279,7 @@ def _paraview_files(path: Path, ds) -> list:
 
 
 def _stage_paraview(staged, path: Path, ds) -> None:
-    from msslib.paraview import is_series, stage
+    from msslib.results.paraview import is_series, stage
 
     if is_series(path):
         stage(staged, path, ds)

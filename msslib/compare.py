@@ -1,7 +1,7 @@
 """The error of one result against another: ``msslib compare RESULT.nc REFERENCE.nc``.
 
 :func:`compare_results` measures the final displacement of a result (a mass-spring system, an FEM
-run, anything :func:`msslib.io.write_result` wrote) against a reference result:
+run, anything :func:`msslib.results.netcdf.write_result` wrote) against a reference result:
 
 * on the **same mesh** (equal rest positions, node for node) the per-node error is
   ``|u_i - u_ref_i|``;
@@ -134,7 +134,7 @@ class Comparison:
 
 
 def _final_state(ds, name):
-    from msslib.io import mesh_from_result
+    from msslib.results import mesh_from_result
 
     if "displacement" not in ds or "rest_position" not in ds:
         raise ValueError(f"{name} has no displacement and rest positions: not an msslib result with a mesh")
@@ -147,10 +147,10 @@ def _final_state(ds, name):
 
 def compare_results(result, reference, *, result_name: str = "result",
                     reference_name: str = "reference") -> Comparison:
-    """The error of ``result`` against ``reference`` (datasets as :func:`msslib.io.read_result`
+    """The error of ``result`` against ``reference`` (datasets as :func:`msslib.results.netcdf.read_result`
     returns them, or paths to result files).  Raises ValueError naming the problem when they
     cannot be compared (another dimension, different bodies, not a result with a mesh)."""
-    from msslib.io import read_result
+    from msslib.results import read_result
     from msslib.metrics import displacement_error
 
     if isinstance(result, (str, Path)):

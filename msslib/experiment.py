@@ -160,7 +160,7 @@ def compare(exp: Experiment, results: dict):
     import xarray as xr
 
     from msslib.compare import interpolate
-    from msslib.io import mesh_from_result
+    from msslib.results import mesh_from_result
     from msslib.metrics import displacement_error
 
     variants = [m for m in exp.models if m != exp.reference]

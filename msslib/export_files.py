@@ -20,11 +20,11 @@ import shutil
 import warnings
 from pathlib import Path
 
-from . import export_simulators, export_text
-from .errors import MsslibWarning
-from .export import C_HEADER_PATH, FORMATS, SPRINGS_ONLY_FORMATS, MssExport, _safe_name, c_header_paths, not_carried  # noqa: F401
-from .export import _version
-from .staging import TEMP_TAG, StagedOutputs, terminate_raises
+from msslib import export_simulators, export_text
+from msslib.errors import MsslibWarning
+from msslib.export import C_HEADER_PATH, FORMATS, SPRINGS_ONLY_FORMATS, MssExport, _safe_name, c_header_paths, not_carried  # noqa: F401
+from msslib.export import _version
+from msslib.results.staging import TEMP_TAG, StagedOutputs, terminate_raises
 
 MANIFEST_SCHEMA = "msslib-export-manifest"
 MANIFEST_SUFFIX = ".export-manifest.json"
@@ -86,7 +86,7 @@ def output_paths(exp: MssExport, stem: Path, formats) -> list[tuple[str, str, Pa
 
 
 def file_writer(exp: MssExport, fmt: str, table: str | None = None):
-    """``writer(path)`` that writes one output of ``fmt`` (for :class:`msslib.io.StagedOutputs`,
+    """``writer(path)`` that writes one output of ``fmt`` (for :class:`msslib.results.staging.StagedOutputs`,
     which then names the destination in any error)."""
     def text(make):
         def write(path):
@@ -217,7 +217,7 @@ def write_outputs(exp: MssExport, stem: Path, planned) -> list[Path]:
     none; returns the paths written, the manifest last.
 
     Into an existing folder the files are staged beside their targets and renamed into place
-    together (:class:`msslib.staging.StagedOutputs`); then the files that the previous export to
+    together (:class:`msslib.results.staging.StagedOutputs`); then the files that the previous export to
     ``stem`` owned and this one does not write are removed (see the module docstring: nothing else
     is ever removed, and a file that is not the export's is never overwritten: FileExistsError).
     A folder that does not exist yet is built as a hidden temporary folder beside it and renamed

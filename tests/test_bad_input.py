@@ -12,7 +12,7 @@ from msslib import cli, fem
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import parameters as P
-from msslib.io import write_result
+from msslib.results import write_result
 from msslib.scene import load_scene, run_scene
 from scene_helpers import pressed_cube
 

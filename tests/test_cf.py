@@ -1,4 +1,4 @@
-"""Results follow CF-1.11 and UGRID-1.0 (schema ``msslib-result-2.0``, :mod:`msslib.io`).
+"""Results follow CF-1.11 and UGRID-1.0 (schema ``msslib-result-2.0``, :mod:`msslib.results.netcdf`).
 
 Two checkers from PyPI run on real results (static mass-spring systems in 2D and 3D, FEM references in
 2D and 3D, a dynamic run with its history, and a quasi-static dataset with step history and a
@@ -27,9 +27,10 @@ import yaml
 compliance_runner = pytest.importorskip("compliance_checker.runner", reason="needs the test extra")
 ugrid_check = pytest.importorskip("ugrid_checks.check", reason="needs the test extra")
 
-from msslib.io import (  # noqa: E402
-    CONVENTIONS, DOUBLE_FILL, SCHEMA_VERSION, make_dataset, mesh_from_result, read_result, write_result,
+from msslib.results import (  # noqa: E402
+    CONVENTIONS, SCHEMA_VERSION, make_dataset, mesh_from_result, read_result, write_result,
 )
+from msslib.results.conventions import DOUBLE_FILL  # noqa: E402
 from msslib.mesh import Mesh  # noqa: E402
 from msslib.scene import run_scene  # noqa: E402
 

@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 from msslib.compare import compare_results
-from msslib.io import make_dataset, write_result
+from msslib.results import make_dataset, write_result
 from msslib.mesh import hex_grid, quad_grid, tet_grid
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -88,7 +88,7 @@ def test_readme_quick_start_mujoco_model_runs_stably_for_the_whole_scene(tmp_pat
     assert (dt, t_end) == (2.0e-3, 0.5)
     tip = np.isclose(exp.points[:, 0], exp.points[:, 0].max())
     # msslib's own answers: the dynamic run of the quick start at t_end, and the static equilibrium
-    from msslib.io import read_result
+    from msslib.results import read_result
 
     ds = read_result(tmp_path / "bar.nc")
     assert float(ds["time"].values[-1]) == pytest.approx(t_end)

@@ -16,7 +16,7 @@ import yaml
 from msslib import mesh as M
 from msslib.cli import main
 from msslib.errors import MsslibWarning
-from msslib.io import mesh_from_result, read_result
+from msslib.results import mesh_from_result, read_result
 from msslib.scene import load_scene, prepare, run_scene
 
 gmsh = pytest.importorskip("gmsh")

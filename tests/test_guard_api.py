@@ -16,7 +16,7 @@ from cli_helpers import assert_refused
 from cli_helpers import run_cli as _cli
 from msslib import planning
 from msslib import parameters as P
-from msslib.io import write_result
+from msslib.results import write_result
 from msslib.scene import load_scene, run_scene
 from scene_helpers import pressed_cube
 

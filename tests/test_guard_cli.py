@@ -1,4 +1,4 @@
-"""Inputs are never destroyed and outputs are all-or-nothing (the command line and msslib.io).
+"""Inputs are never destroyed and outputs are all-or-nothing (the command line and msslib.results.netcdf).
 
 Every refused command must exit with 1 and print exactly one line ``msslib: error: ...`` naming the
 paths involved; afterwards every file of the directory is byte-identical and no temporary file is
@@ -23,7 +23,7 @@ from cli_helpers import run_cli as _cli
 from msslib import cli, cli_inputs
 from msslib import experiment as EXP
 from msslib import mesh as M
-from msslib.io import StagedOutputs, read_result, remove_stale_temporaries, write_result, write_text
+from msslib.results import StagedOutputs, read_result, remove_stale_temporaries, write_result, write_text
 from msslib.scene import run_scene
 from scene_helpers import pressed_cube
 
@@ -271,7 +271,7 @@ def test_sigterm_during_a_staged_write_removes_temporaries(tmp_path):
     proc = _python("""
         import os, signal, sys, time
         from pathlib import Path
-        from msslib.io import StagedOutputs
+        from msslib.results import StagedOutputs
         d = Path(sys.argv[1])
         with StagedOutputs() as out:
             out.write_text(d / "out.txt", "new\\n")

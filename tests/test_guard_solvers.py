@@ -364,7 +364,7 @@ def test_cli_reports_one_error_line(tmp_path, capsys):
 
 
 def test_cli_unloaded_and_slender_beam_scenes_converge(tmp_path, capsys):
-    from msslib.io import read_result
+    from msslib.results import read_result
 
     base = {"materials": [{"E": 1.0e9, "nu": 0.3, "density": RHO}], "model": "golec_cube",
             "boundary": [{"select": {"plane": ["x", 0.0]}, "fix": "all"}]}

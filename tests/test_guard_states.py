@@ -16,7 +16,7 @@ from msslib import mesh as M
 from msslib.mesh import quality as Q
 from msslib.cli import main
 from msslib.errors import MsslibWarning, UnphysicalStateError
-from msslib.io import read_result
+from msslib.results import read_result
 from msslib.scene import run_scene
 
 # one reference cell of each type, positively oriented (node order of msslib.mesh)

@@ -244,7 +244,7 @@ def test_cli_explicit_over_limit_fails_without_output(tmp_path, capsys):
             assert "msslib: error:" in err and "would diverge" in err and "stability limit" in err
             assert not out.exists()
         else:
-            from msslib.io import read_result
+            from msslib.results import read_result
 
             ds = read_result(out)
             assert np.isfinite(ds["displacement"].values).all()

@@ -1,4 +1,4 @@
-"""Staged outputs (msslib.staging) under interrupts and on a full disk: an interrupt landing at
+"""Staged outputs (msslib.results.staging) under interrupts and on a full disk: an interrupt landing at
 any point of a write leaves no temporary file and the outputs all old or all new; a full disk is
 said to be one (``no space left on device``, one ``msslib: error:`` line naming the output), also
 when the NetCDF library reports it as ``NetCDF: HDF error``."""
@@ -16,8 +16,9 @@ import pytest
 import xarray as xr
 import yaml
 
-from msslib import cli, staging
-from msslib.io import StagedOutputs
+from msslib import cli
+from msslib.results import staging
+from msslib.results import StagedOutputs
 
 OLD, NEW_KEPT, NEW_FRESH = "the user's file\n", "new content of kept.txt\n", "new content of fresh.txt\n"
 
@@ -44,7 +45,7 @@ def _settle():
 
 def _interrupted_at(n: int, action) -> tuple[bool, int]:
     """Run ``action`` with SIGINT sent to this process at the ``n``-th line run in
-    msslib/staging.py; returns (interrupted, lines run there)."""
+    msslib/results/staging.py; returns (interrupted, lines run there)."""
     count = 0
     source = staging.__file__
 

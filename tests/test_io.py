@@ -7,16 +7,7 @@ import pytest
 import xarray as xr
 
 import msslib
-from msslib.io import (
-    CONVENTIONS,
-    SCHEMA_VERSION,
-    git_commit,
-    make_dataset,
-    mesh_from_result,
-    read_result,
-    write_result,
-    write_text,
-)
+from msslib.results import CONVENTIONS, SCHEMA_VERSION, git_commit, make_dataset, mesh_from_result, read_result, write_result, write_text
 from msslib.mesh import Mesh
 
 COMMIT_RE = re.compile(r"^(unknown|[0-9a-f]{40,64}(\+dirty)?)$")

@@ -15,9 +15,9 @@ import yaml
 
 from msslib import cli
 from msslib.cli_inputs import _check_distinct
-from msslib.io import read_result
-from msslib.paraview import series_files
-from msslib.staging import StagedOutputs
+from msslib.results import read_result
+from msslib.results.paraview import series_files
+from msslib.results.staging import StagedOutputs
 
 SWING = {
     "name": "swing",

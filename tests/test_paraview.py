@@ -1,4 +1,4 @@
-"""ParaView export (msslib.paraview, ``run --vtu OUT.pvd``, ``vtu RESULT.nc --out OUT.pvd``): every
+"""ParaView export (msslib.results.paraview, ``run --vtu OUT.pvd``, ``vtu RESULT.nc --out OUT.pvd``): every
 saved state of a dynamic run as a .pvd collection of VTU files, springs as line cells, all files
 written together or none, outputs that are inputs refused."""
 
@@ -13,9 +13,10 @@ import numpy as np
 import pytest
 import yaml
 
-from msslib import cli, paraview
+from msslib import cli
+from msslib.results import paraview
 from msslib import mesh as M
-from msslib.io import read_result, write_result
+from msslib.results import read_result, write_result
 from msslib.scene import run_scene
 
 DYNAMIC = {

@@ -5,7 +5,7 @@ import pytest
 
 from msslib import mesh as M
 from experiments import plotting
-from msslib.io import make_dataset
+from msslib.results import make_dataset
 
 
 def _result(mesh, u, model="test"):

@@ -29,7 +29,7 @@ def test_quick_start_runs_as_written(tmp_path):
         proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True)
         assert proc.returncode == 0, proc.stderr[-2000:]
 
-    from msslib.io import read_result
+    from msslib.results import read_result
 
     ds = read_result(tmp_path / "bar.nc")
     # the two materials reached the cells of their groups, the clamp held the base
@@ -71,7 +71,7 @@ def test_model_against_fem_runs_as_written(tmp_path):
     assert proc.returncode == 0, proc.stderr[-2000:]
     import meshio
 
-    from msslib.io import mesh_from_result, read_result
+    from msslib.results import mesh_from_result, read_result
     from msslib.metrics import cell_volumes
 
     results = [read_result(tmp_path / name) for name in ("bar_mss.nc", "bar_fem.nc")]

@@ -10,7 +10,7 @@ import yaml
 
 from msslib import mesh as M
 from msslib.cli import main
-from msslib.io import read_result
+from msslib.results import read_result
 from msslib.scene import Scene, load_scene, prepare, run_scene
 
 SCENES = Path(__file__).resolve().parents[1] / "experiments" / "scenes"

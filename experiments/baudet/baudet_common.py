@@ -7,7 +7,7 @@
   :mod:`msslib.baudet_correction`); derived factor, or the printed one with ``published=True``;
 * :func:`follow` -- load continuation until a measured quantity reaches a target (each equilibrium
   starts from the previous one; the line search judges the residual);
-* :func:`write` -- atomic NetCDF output through :func:`msslib.io.write_result`.
+* :func:`write` -- atomic NetCDF output through :func:`msslib.results.netcdf.write_result`.
 
 All quantities SI. Loads are dead loads in the reference configuration (nominal stresses), as in
 the paper's definitions (eqs. 1-6: forces over the rest areas, changes over rest lengths).
@@ -138,7 +138,7 @@ def split_readings(ds, default="boundary"):
 
 
 def write(ds, out, t0):
-    from msslib.io import write_result
+    from msslib.results import write_result
 
     ds.attrs.setdefault("paper", "baudet")
     ds.attrs["wall_time_s"] = time.perf_counter() - t0

@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from experiments import plotting
-from msslib.io import read_result
+from msslib.results import read_result
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -144,7 +144,7 @@ def crossover(front):
 
 
 def main(scene: str, levels, quick_levels=(0, 1), below=1):
-    from msslib.io import write_result
+    from msslib.results import write_result
 
     p = argparse.ArgumentParser(description=f"speed against error for {scene}")
     p.add_argument("--out", required=True)

@@ -383,7 +383,7 @@ def guard(mesh: Mesh, displacement, *, history_displacement=None, history_time=N
     state, NaN if none is defined), ``collapse_threshold``; with a history also
     ``checked_states``, ``unphysical_states`` (saved states with an inverted or collapsed cell),
     ``first_inverted_time`` and ``first_unphysical_time`` (s; NaN when no saved state has one).
-    ``variables`` (``(dims, data, attrs)`` tuples for :func:`msslib.io.make_dataset`):
+    ``variables`` (``(dims, data, attrs)`` tuples for :func:`msslib.results.netcdf.make_dataset`):
     ``relative_jacobian(cell)``, ``cell_state(cell)`` (int8 flags, CF ``flag_values`` /
     ``flag_meanings``) and with a history ``inverted_cells_history(time)``,
     ``collapsed_cells_history(time)``, ``min_relative_jacobian_history(time)``.

@@ -3,7 +3,7 @@
 :func:`load_scene` reads and validates a scene (a YAML file or an equivalent ``dict``) into a
 :class:`Scene`; :func:`prepare` builds its mesh, boundary conditions, loads and model;
 :func:`run_scene` solves it and returns an :class:`xarray.Dataset` in the schema of
-:mod:`msslib.io`.  The command line (``python -m msslib run SCENE.yaml --out OUT.nc``) wraps them.
+:mod:`msslib.results.netcdf`.  The command line (``python -m msslib run SCENE.yaml --out OUT.nc``) wraps them.
 
 Syntax reference
 ================
@@ -170,8 +170,8 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
 
 Result
 ------
-:func:`run_scene` returns :func:`msslib.io.make_dataset`'s dataset (CF-1.11 and UGRID-1.0, see
-:mod:`msslib.io`): rest positions, final displacement, reactions, fixed mask, the materials as
+:func:`run_scene` returns :func:`msslib.results.netcdf.make_dataset`'s dataset (CF-1.11 and UGRID-1.0, see
+:mod:`msslib.results.netcdf`): rest positions, final displacement, reactions, fixed mask, the materials as
 variables (``material_E``, ``material_nu``, ``material_density``, ``material_name`` when they are
 keyed by group), ``thickness`` (2D), springs with constants and rest lengths (MSS), the history
 (time, displacement, velocity, kinetic energy) of dynamic runs, the cell check of

@@ -150,7 +150,7 @@ def run_scene(scene, progress=True):
     flagged state is one :class:`msslib.errors.MsslibWarning`, or with ``checks: {inverted:
     error}`` an :class:`msslib.errors.UnphysicalStateError` (no dataset is returned).
     """
-    from msslib.io import make_dataset
+    from msslib.results import make_dataset
     from msslib.mesh.quality import guard
 
     scene = load_scene(scene)

@@ -167,7 +167,7 @@ def main():
 def at_points(ref, u_ref, X):
     """The reference displacement at the points X (exact at shared nodes)."""
     from msslib.compare import interpolate
-    from msslib.io import mesh_from_result
+    from msslib.results import mesh_from_result
 
     Xr = ref["rest_position"].transpose("node", "axis").values
     if X.shape == Xr.shape and np.allclose(X, Xr):

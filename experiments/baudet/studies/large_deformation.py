@@ -31,7 +31,7 @@ def label(n):
 
 def at_points(ds, u, X):
     from msslib.compare import interpolate
-    from msslib.io import mesh_from_result
+    from msslib.results import mesh_from_result
 
     Xr = ds["rest_position"].transpose("node", "axis").values
     if X.shape == Xr.shape and np.allclose(X, Xr):

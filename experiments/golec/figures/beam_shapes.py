@@ -6,7 +6,7 @@ import numpy as np
 from experiments import script
 from experiments.golec.wrinkle_states import positions_dataset, study_state
 from experiments import plotting
-from msslib.io import read_result
+from msslib.results import read_result
 
 R = "results/golec/beam"
 INPUTS = ["results/golec/beam/default__fem.nc", "results/golec/beam/default__golec.nc",

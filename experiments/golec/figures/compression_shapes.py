@@ -5,7 +5,7 @@ import numpy as np
 from experiments import script
 from experiments.golec.wrinkle_states import study_state
 from experiments import plotting
-from msslib.io import read_result
+from msslib.results import read_result
 
 R = "results/golec/compression"
 INPUTS = ["results/golec/compression/clamped__mss_classical.nc", "results/golec/compression/clamped__golec.nc",

@@ -5,7 +5,7 @@ from matplotlib.lines import Line2D
 
 from experiments import script
 from experiments import plotting
-from msslib.io import read_result
+from msslib.results import read_result
 
 INPUTS = ["results/golec/studies/isotropy.nc"]
 LABELS = {"derived": "derived constants", "published": "printed constants, per element",

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from msslib.io import write_result
+from msslib.results import write_result
 from msslib.mesh import hex_grid
 from msslib.metrics import mesh_volume, shear_modulus, youngs_modulus_poisson
 from msslib.model import Model, assemble_springs, golec_cube_springs

@@ -26,7 +26,7 @@ import numpy as np
 import xarray as xr
 
 from msslib.explicit import LatticeExplicit
-from msslib.io import mesh_from_result, write_result
+from msslib.results import mesh_from_result, write_result
 from msslib.metrics import mesh_volume
 from msslib.scene import load_scene, prepare, run_scene
 from msslib.solvers import critical_time_step, explicit_stability_limit

@@ -21,7 +21,7 @@ import xarray as xr
 from scipy.optimize import minimize
 
 from msslib.experiment import load_experiment, run, scene_of
-from msslib.io import mesh_from_result, write_result
+from msslib.results import mesh_from_result, write_result
 from msslib.metrics import mesh_volume
 from msslib.scene import load_scene, prepare
 from msslib.solvers import static_solve

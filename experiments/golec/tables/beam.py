@@ -1,7 +1,7 @@
 """Beam under gravity (Golec Fig. 2 (3-4)): deflection, volume, error against FEM, stability."""
 
 from experiments import script
-from msslib.io import read_result
+from msslib.results import read_result
 
 INPUTS = ["results/golec/studies/wrinkles.nc", "results/golec/beam/comparison.nc"]
 VARIANTS = {

@@ -3,7 +3,7 @@
 import numpy as np
 
 from experiments import script
-from msslib.io import mesh_from_result, read_result
+from msslib.results import mesh_from_result, read_result
 from msslib.metrics import mesh_volume
 
 R = "results/golec/compression"

@@ -1,7 +1,7 @@
 """Effective moduli of the Golec lattice at A = 1 (and their spread over A), derived vs printed."""
 
 from experiments import script
-from msslib.io import read_result
+from msslib.results import read_result
 
 INPUTS = ["results/golec/studies/isotropy.nc"]
 LABELS = {"derived": "derived (per element)", "published": "printed, used per element",

@@ -1,7 +1,7 @@
 """Wall time of a 10 s simulation of 1,000 Golec cubes beside the paper's 2.88 s on 8 cores."""
 
 from experiments import script
-from msslib.io import read_result
+from msslib.results import read_result
 
 INPUTS = ["results/golec/studies/timing.nc"]
 

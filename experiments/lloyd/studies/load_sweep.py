@@ -32,7 +32,7 @@ import numpy as np
 import xarray as xr
 
 from msslib.experiment import UNITS, compare, load_experiment, scene_of
-from msslib.io import write_result
+from msslib.results import write_result
 from msslib.scene import load_scene, run_scene
 
 LLOYD = Path(__file__).resolve().parents[1]

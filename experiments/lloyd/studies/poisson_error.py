@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from msslib.io import write_result
+from msslib.results import write_result
 from msslib.metrics import displacement_error
 from msslib.scene import run_scene
 

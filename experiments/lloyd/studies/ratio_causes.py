@@ -40,7 +40,7 @@ import xarray as xr
 
 from msslib import fem
 from msslib import mesh as M
-from msslib.io import write_result
+from msslib.results import write_result
 from msslib.metrics import displacement_error
 from msslib.model import Model, lloyd_square_springs, lloyd_triangle_springs
 from msslib.solvers import static_solve

@@ -37,7 +37,7 @@ from scipy.stats import spearmanr
 
 from experiments.script import LoadSegment
 from msslib.compare import interpolate
-from msslib.io import mesh_from_result, write_result
+from msslib.results import mesh_from_result, write_result
 from msslib.mesh.quality import relative_jacobians
 from msslib.scene import load_scene, prepare, run_scene
 from msslib.solvers import ConvergenceError, static_solve

@@ -4,7 +4,7 @@ cylinder and the cone."""
 import numpy as np
 
 from experiments import script
-from msslib.io import read_result
+from msslib.results import read_result
 
 INPUTS = ["results/lloyd/studies/tet_refinement.nc"]
 

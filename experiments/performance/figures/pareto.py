@@ -7,7 +7,7 @@ import argparse
 import numpy as np
 
 from experiments import plotting
-from msslib.io import read_result
+from msslib.results import read_result
 
 SCENES = ["cantilever", "cylinder", "membrane"]
 INPUTS = [f"results/performance/studies/front_{s}.nc" for s in SCENES]

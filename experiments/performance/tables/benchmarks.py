@@ -4,7 +4,7 @@ import argparse
 import json
 from pathlib import Path
 
-from msslib.io import write_text
+from msslib.results import write_text
 
 INPUTS = ["results/benchmarks.json"]
 

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from msslib.io import read_result, write_text
+from msslib.results import read_result, write_text
 from msslib.planning import pareto
 
 SCENES = ["cantilever", "cylinder", "membrane"]

@@ -4,7 +4,7 @@ import argparse
 
 import numpy as np
 
-from msslib.io import read_result, write_text
+from msslib.results import read_result, write_text
 
 INPUTS = ["results/stability.nc"]
 

@@ -1,7 +1,7 @@
 """How each erratum changes results: the printed formula against the derived one, in simulation."""
 
 from experiments import script
-from msslib.io import read_result
+from msslib.results import read_result
 
 INPUTS = ["results/golec/studies/isotropy.nc", "results/baudet/studies/tension.nc",
           "results/baudet/studies/bulk.nc", "results/lloyd/studies/poisson_error.nc",

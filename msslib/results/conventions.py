@@ -1,12 +1,12 @@
 """The NetCDF result schema of msslib (CF-1.11, UGRID-1.0): its description and constants.
 
-Results are built by :func:`msslib.io.make_dataset`, written by :func:`msslib.io.write_result` and
-read by :func:`msslib.io.read_result` and :func:`msslib.io.mesh_from_result`; this module holds
+Results are built by :func:`msslib.results.netcdf.make_dataset`, written by :func:`msslib.results.netcdf.write_result` and
+read by :func:`msslib.results.netcdf.read_result` and :func:`msslib.results.netcdf.mesh_from_result`; this module holds
 what they share: the schema below and its names.
 
-Results are :class:`xarray.Dataset` objects built by :func:`msslib.io.make_dataset`, written atomically by
-:func:`msslib.io.write_result` (engine ``netcdf4``) and read back fully into memory by :func:`msslib.io.read_result`.
-:func:`msslib.io.mesh_from_result` rebuilds the :class:`~msslib.mesh.Mesh`. :class:`msslib.staging.StagedOutputs` writes
+Results are :class:`xarray.Dataset` objects built by :func:`msslib.results.netcdf.make_dataset`, written atomically by
+:func:`msslib.results.netcdf.write_result` (engine ``netcdf4``) and read back fully into memory by :func:`msslib.results.netcdf.read_result`.
+:func:`msslib.results.netcdf.mesh_from_result` rebuilds the :class:`~msslib.mesh.Mesh`. :class:`msslib.results.staging.StagedOutputs` writes
 several files as one (all are replaced, or none is); every write goes through it, so temporary
 files are removed on any error, on SIGINT and on SIGTERM.
 
@@ -18,7 +18,7 @@ meshes (global attribute ``Conventions = "CF-1.11 UGRID-1.0"``, :data:`CONVENTIO
 attribute ``msslib_schema`` (:data:`SCHEMA_VERSION`) tells this schema from the older
 ``msslib-result-1.0`` (which had ``Conventions = "msslib-result-1.0"``, the material constants as
 global attributes and the per-cell material index in a variable ``material``; such files are still
-read by :func:`msslib.io.mesh_from_result`). ``tests/test_cf.py`` runs the IOOS compliance checker (CF-1.11)
+read by :func:`msslib.results.netcdf.mesh_from_result`). ``tests/test_cf.py`` runs the IOOS compliance checker (CF-1.11)
 and checks the UGRID rules listed here.
 
 Units are UDUNITS strings (``m``, ``N``, ``N m-1``, ``Pa``, ``kg m-3``, ``J``, ``s``, ``m s-1``;
@@ -50,7 +50,7 @@ because many models have springs along face and cell diagonals. Connectivities a
 needed. Variables defined on the mesh carry ``mesh`` and ``location``: ``"node"`` (dimension
 ``node``; with ``coordinates = "node_x node_y (node_z)"``, written by xarray), ``"face"`` (2D) or
 ``"volume"`` (3D) for dimension ``cell``, and ``mesh = "spring_network"``, ``location = "edge"``
-for dimension ``spring``. :func:`msslib.io.make_dataset` adds these to every variable with one of these
+for dimension ``spring``. :func:`msslib.results.netcdf.make_dataset` adds these to every variable with one of these
 dimensions (``extra_vars`` included) that does not set them itself.
 
 Dimensions

@@ -3,9 +3,9 @@
 Results are :class:`xarray.Dataset` objects built by :func:`make_dataset`, written atomically by
 :func:`write_result` (engine ``netcdf4``) and read back fully into memory by :func:`read_result`.
 :func:`mesh_from_result` rebuilds the :class:`~msslib.mesh.Mesh`. Every write goes through
-:class:`msslib.staging.StagedOutputs` (several files as one; temporaries removed on any error, on
+:class:`msslib.results.staging.StagedOutputs` (several files as one; temporaries removed on any error, on
 SIGINT and on SIGTERM). The schema (CF-1.11 and UGRID-1.0, ``msslib-result-2.0``: dimensions,
-variables, attributes) is described in :mod:`msslib.schema`.
+variables, attributes) is described in :mod:`msslib.results.conventions`.
 """
 
 from __future__ import annotations
@@ -22,16 +22,14 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from . import __version__
-from .mesh import CELL_TYPES, Mesh
-from .schema import (  # noqa: F401
+from msslib import __version__
+from msslib.mesh import CELL_TYPES, Mesh
+from msslib.results.conventions import (
     CONVENTIONS,
     SCHEMA_VERSION,
-    LEGACY_SCHEMA_VERSION,
     AXIS_NAMES,
     ENGINE,
     FINITE_VARIABLES,
-    SCHEMA_ATTRS,
     MESH,
     SPRING_NETWORK,
     VOLUME_SHAPES,
@@ -39,23 +37,9 @@ from .schema import (  # noqa: F401
     DOUBLE_FILL,
     FILLED_VARIABLES,
 )
-from . import staging
-from .staging import TEMP_TAG, Terminated, remove_stale_temporaries, terminate_raises  # noqa: F401
+from msslib.results.staging import StagedOutputs
 
-__all__ = [
-    "CONVENTIONS",
-    "SCHEMA_VERSION",
-    "git_commit",
-    "make_dataset",
-    "write_result",
-    "write_text",
-    "StagedOutputs",
-    "Terminated",
-    "terminate_raises",
-    "remove_stale_temporaries",
-    "read_result",
-    "mesh_from_result",
-]
+__all__ = ["git_commit", "make_dataset", "write_result", "write_text", "read_result", "mesh_from_result"]
 
 # --------------------------------------------------------------------------------------------------
 # provenance and attribute sanitising
@@ -485,13 +469,11 @@ def _to_netcdf(ds: xr.Dataset):
     return lambda tmp: ds.to_netcdf(tmp, mode="w", format="NETCDF4", engine=ENGINE, encoding=_encoding(ds))
 
 
-class StagedOutputs(staging.StagedOutputs):
-    """:class:`msslib.staging.StagedOutputs` that also stages NetCDF results."""
-
-    def write_result(self, dest: str | os.PathLike, ds: xr.Dataset, what: str = "result") -> Path:
-        """Stage a NetCDF result (refused, ValueError, if :data:`FINITE_VARIABLES` are not finite)."""
-        _check_finite(Path(dest), ds)
-        return self.write(dest, _to_netcdf(ds), what)
+def stage_result(staged: StagedOutputs, dest: str | os.PathLike, ds: xr.Dataset, what: str = "result") -> Path:
+    """Stage a NetCDF result in ``staged`` (refused, ValueError, if :data:`FINITE_VARIABLES` are
+    not finite); :meth:`msslib.results.staging.StagedOutputs.write_result` calls it."""
+    _check_finite(Path(dest), ds)
+    return staged.write(dest, _to_netcdf(ds), what)
 
 
 def write_result(path: str | os.PathLike, ds: xr.Dataset) -> Path:
@@ -514,7 +496,7 @@ def write_result(path: str | os.PathLike, ds: xr.Dataset) -> Path:
     """
     path = Path(path)
     with StagedOutputs() as out:
-        out.write_result(path, ds)
+        stage_result(out, path, ds)
     return path
 
 

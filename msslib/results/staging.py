@@ -7,8 +7,8 @@ are left as they were (an interrupt landing anywhere, even between creating a te
 registering it, leaves nothing behind: the few steps that create, rename or remove files run with
 the signals held for that moment).  A write that fails on a full disk says ``no space left on
 device``, also when the writer's library says otherwise (NetCDF's ``HDF error``).
-:class:`msslib.io.StagedOutputs` adds NetCDF results to it; every write of msslib goes through
-that class.  Staging and committing take a time linear in the number of files.
+:func:`msslib.results.netcdf.stage_result` stages a NetCDF result in it; every write of msslib goes
+through that class.  Staging and committing take a time linear in the number of files.
 """
 
 from __future__ import annotations
@@ -301,7 +301,7 @@ class StagedOutputs:
 
     .. code-block:: python
 
-        with StagedOutputs() as out:  # msslib.io.StagedOutputs adds out.write_result(path, dataset)
+        with StagedOutputs() as out:  # msslib.results.netcdf.stage_result(out, path, dataset) stages a result
             out.write_text("run.md", table)
             out.write("run.vtu", lambda tmp: write_vtu(tmp, mesh), what="VTU file")
         # here both files are in place; had anything in the block failed, neither would be touched

@@ -1,7 +1,7 @@
 """ParaView export of msslib results: the final state as one VTU file, or every saved state as a
 time series (a ``.pvd`` collection of VTU files).
 
-:func:`write` (and :func:`stage`, which adds the files to a :class:`msslib.io.StagedOutputs`)
+:func:`write` (and :func:`stage`, which adds the files to a :class:`msslib.results.staging.StagedOutputs`)
 decides by the suffix of the path:
 
 ``OUT.vtu``
@@ -144,7 +144,7 @@ def in_series(pvd, path) -> bool:
 
 
 def _mesh(ds):
-    from msslib.io import mesh_from_result
+    from msslib.results.netcdf import mesh_from_result
 
     return mesh_from_result(ds)
 
@@ -240,7 +240,7 @@ def _stage_series(staged, path, ds) -> list[Path]:
 
 def stage(staged, path, ds) -> list[Path]:
     """Add the ParaView export of ``ds`` at ``path`` (``.vtu``: the final state, ``.pvd``: every
-    saved state) to ``staged`` (a :class:`msslib.io.StagedOutputs`); returns the files."""
+    saved state) to ``staged`` (a :class:`msslib.results.staging.StagedOutputs`); returns the files."""
     path = check_suffix(path)
     if is_series(path):
         return _stage_series(staged, path, ds)
@@ -259,7 +259,7 @@ def write_series(path, ds) -> list[Path]:
 def write(path, ds) -> list[Path]:
     """Write the ParaView export of the result ``ds`` at ``path`` (the suffix decides, see the
     module docstring), all files together or none; returns the files written."""
-    from msslib.io import StagedOutputs
+    from msslib.results.staging import StagedOutputs
 
     with StagedOutputs() as staged:
         files = stage(staged, path, ds)
