@@ -449,7 +449,8 @@ def _add_export(subparsers) -> None:
 def _cmd_export(args) -> int:
     import warnings
 
-    from msslib import export, export_files
+    from msslib.export import files as export_files
+    from msslib import export
     from msslib.errors import MsslibWarning
 
     try:

@@ -28,7 +28,11 @@ import pytest
 import yaml
 
 from derivations import codegen, registry
-from msslib import cli, export, export_files, export_simulators, export_text
+from msslib import cli
+from msslib.export import simulators as export_simulators
+from msslib.export import text as export_text
+from msslib.export import files as export_files
+from msslib import export
 from msslib.solvers import static_solve
 from msslib.terms import BaudetCorrection, HexVolume, Springs, TetVolume
 

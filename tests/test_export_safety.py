@@ -28,7 +28,10 @@ import pytest
 import yaml
 from test_readme import _quick_start_blocks
 
-from msslib import cli, export, export_files, export_simulators
+from msslib import cli
+from msslib.export import simulators as export_simulators
+from msslib.export import files as export_files
+from msslib import export
 from msslib.solvers import static_solve
 
 _SCENES = yaml.safe_load((Path(__file__).parent / "data" / "export_scenes.yaml").read_text())

@@ -20,7 +20,8 @@ from dataclasses import fields, is_dataclass
 import numpy as np
 import pytest
 
-from msslib import export, parameters
+from msslib import parameters
+from msslib import export
 
 #: the public functions of msslib.parameters (its classes and tables left out)
 FUNCTIONS = {name: getattr(parameters, name) for name in parameters.__all__

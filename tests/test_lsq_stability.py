@@ -154,7 +154,8 @@ def test_negative_springs_are_exported_as_they_are_and_mujoco_rests_at_msslibs_e
     import yaml
 
     mujoco = pytest.importorskip("mujoco")
-    from msslib import cli, export
+    from msslib import cli
+    from msslib import export
     from msslib.solvers import static_solve
 
     scene = {"name": "lsq_cylinder",

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 3a266b7c89a007afddc26a9036503a7b5c4559ab9ac2bc133156430be6d2ab1e
+# source-sha256: 188668b2ef2cad0ca95b6a9abcd840af56b34969c13b06085b466969b4c38451
 # body-sha256: ead1efdd2788a93d1bcf1adc1fdb9209f754b2834f6888e42bd556b419504f40
 """Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.).
 

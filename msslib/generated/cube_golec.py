@@ -1,5 +1,5 @@
 # Generated from derivations/elements/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 1e2df523ca75b9a6f219971898ebc94941c5fa451023d6066ad8d551ab21ca1d
+# source-sha256: a64290e50dcb8f8dce749b641be48b0a0d73bcb725505243c7d00adfd72c2898
 # body-sha256: ead38ff0979f342e371691d41eaa2c1fcc80bd8a3ec45ce6848072726eb1950e
 """Cube with edge, face and inner springs and volume correction (Golec et al.).
 

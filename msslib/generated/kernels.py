@@ -1,5 +1,5 @@
 # Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: cd97bb0af343010fe0dc3fecc084e4e0d71bf4d6bb58367264e8ebe22e3b7fec
+# source-sha256: 4ac5afbb74e3e73f6029e669688f452703b06f152465cbfefa727cc75c56119b
 # body-sha256: 3d373773da99006a61be809dfa382060e5f3e52fab7de0235f0cb4b483a8f761
 """Energy, gradient and Hessian kernels.
 

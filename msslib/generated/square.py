@@ -1,5 +1,5 @@
 # Generated from derivations/elements/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 9f9b62bf27e94647cc78a2370fe5e900b9e57603a308bb77f7754abaa2fa0438
+# source-sha256: fb7fc9401a92ec6d8f3d57de3537276e4098de6958b5951adc4d07fe6fe7ffe8
 # body-sha256: 1dd982c2337e75087dee499cd350e6dc2d1ddc93b1216533dccefec5767742ed
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 

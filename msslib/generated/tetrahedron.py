@@ -1,5 +1,5 @@
 # Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 98de68b95dc7fb66e227e767f4eb058f929642330c83c6b00bbf8f9b7ce1b3db
+# source-sha256: de740ea435d2eb81e5f431fa2f8fa625ae0a7f33dd69f94ceee649554b424bee
 # body-sha256: 0b2dbb0b56041ab2d1c0d5c290b0fcfc5ecc68a47555a831b2b6251b8cfd020f
 """Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: acfa88a7315d1870cdd7d0ab45e15eeb629b2d522d421d510604fc85dc6a2d60
+# source-sha256: cad14ecafde09e75d6411bd1fbd6e217477bb963982561e0c2f310fb4b10d20e
 # body-sha256: 4015acd45b86546c6a6abfcd250b2d8757c57c8cce0e75c00be6d90ffeb475b9
 """Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9).
 

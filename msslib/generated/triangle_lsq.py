@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle_lsq.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: d5ee0e0e39a2318432e4e2dfcfbc2e66774870bf8b91fb16ad568295fc27ed82
+# source-sha256: 591b10f6a27e45dcf19258180bf41b26669e030dc737ac2125f6fb36aa6031ac
 # body-sha256: 57450fa1afc4ade7ef6a3d860ad9bb3d9c204b40b131686eafec79f025b5913c
 """Triangle of any shape, three springs fitted to its own CST by least squares (Natsupakpong and Cavusoglu 2010, closed form).
 

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 98de68b95dc7fb66e227e767f4eb058f929642330c83c6b00bbf8f9b7ce1b3db
+// source-sha256: de740ea435d2eb81e5f431fa2f8fa625ae0a7f33dd69f94ceee649554b424bee
 // body-sha256: 738438200b0fb2aa500fae7fafe7d5ed17024c3591a585f1464bc59692366c65
 /* Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/tetrahedron.py (derivations/elements/tetrahedron.py). */

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/triangle_angular.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 317fb9008609eaef6d64ade1f78c32655a384e083327ef96397daeb9e844bbfb
+// source-sha256: 9727cec1d6b1f9be14dfe425a177933b769c9013abed1677a7713165fd2d14f1
 // body-sha256: 666ed28d996e4b629e2d25822fc536937149ffc24f310907ef001194ef6b2a72
 /* Triangle of any shape with tensile and angular springs (Delingette 2008), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/triangle_angular.py (derivations/elements/triangle_angular.py). */

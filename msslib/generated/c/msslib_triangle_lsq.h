@@ -1,5 +1,5 @@
 // Generated from derivations/elements/triangle_lsq.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: d5ee0e0e39a2318432e4e2dfcfbc2e66774870bf8b91fb16ad568295fc27ed82
+// source-sha256: 591b10f6a27e45dcf19258180bf41b26669e030dc737ac2125f6fb36aa6031ac
 // body-sha256: c170b5b8e3023be5ac195a0759f71c4844255dea36ed3e84d56a659f5840c7b2
 /* Triangle of any shape, three springs fitted to its own CST by least squares (Natsupakpong and Cavusoglu 2010, closed form), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/triangle_lsq.py (derivations/elements/triangle_lsq.py). */

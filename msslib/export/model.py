@@ -1,55 +1,6 @@
-"""Export a scene's complete mass-spring system without solving it.
-
-:func:`build` reads a scene (:mod:`msslib.scene`), builds its mesh, boundary conditions, loads and
-model exactly as ``run`` would, and collects everything that defines the model in an
-:class:`MssExport`: the springs (nodes, stiffness, rest length), the volume terms and Baudet's
-correction with their constants, the node masses and rest positions, the fixed dofs and prescribed
-displacements, the loads and gravity. The writers turn it into
-
-``csv``
-    One file per table, a header row with the units (``name [unit]``): ``nodes`` (rest position,
-    mass), ``springs``, ``fixed`` (fixed axes and prescribed displacements), ``loads`` (surface
-    loads at load factor 1), ``gravity``, and when the model has them ``tet_volume`` (Lloyd),
-    ``hex_volume`` (Golec), ``baudet_correction`` (factor and face forces per cell) and
-    ``baudet_correction_forces`` (the nodal forces it adds at load factor 1). Node indices are
-    0-based. Floats are written with ``repr`` (they read back bit for bit): :func:`msslib.export_text.read_csv`.
-``json``
-    One document with the same tables, a schema name and version (:data:`SCHEMA`,
-    :data:`SCHEMA_VERSION`), the units, the energy of every term, the scene text: :func:`msslib.export_text.read_json`.
-``vtu``
-    The springs as line cells (cell data ``stiffness``, ``rest_length``) on the rest positions,
-    with the point data ``mass``, ``fixed``, ``prescribed_displacement``, ``load`` (and
-    ``baudet_correction``): for ParaView. The volume terms are in the tables only.
-``mjcf``
-    A MuJoCo model (:func:`msslib.export_simulators.mjcf_text`): one body per node with a slide joint per free axis (a node
-    fixed on every axis has none: it is welded to the world; prescribed displacements move the
-    body), its mass as a point mass, a site at the node; one spatial tendon per spring between the
-    two sites with ``stiffness`` = k and ``springlength`` = the rest length, i.e. the force
-    ``k (|x_j - x_i| - L)`` along the spring, exactly msslib's spring; gravity in ``<option>``;
-    surface loads and Baudet's correction (constant at load factor 1) as ``<general>`` actuators
-    with a constant affine bias on the joints; mass-proportional damping ``alpha`` as joint damping
-    ``alpha m``. Volume terms cannot be expressed: an XML comment and the command say so. MuJoCo
-    integrates tendon springs explicitly, so the model steps at most at half their stability limit
-    ``2/omega_max`` (a dynamic scene's ``dt`` when below it, else half the limit, with a warning and
-    a comment in the file: :func:`msslib.export_simulators.mjcf_time_step`).
-``sofa``
-    A SOFA scene (:func:`msslib.export_simulators.sofa_text`, ``.scn`` XML) made only of the components and attributes of
-    :data:`SOFA_COMPONENTS`: MechanicalObject, DiagonalMass (``vertexMass``), SpringForceField
-    (``spring``: ``i j ks kd L`` per spring), Fixed/PartialFixedProjectiveConstraint,
-    ConstantForceField, StaticSolver (static scenes) or EulerImplicitSolver (dynamic scenes,
-    Rayleigh damping), CGLinearSolver. Volume terms: not carried, said in a comment.
-``c``
-    The generated C headers (:mod:`derivations.codegen`): ``msslib_mss.h``, which includes one
-    header per derivation module (``msslib_<module>.h``: its spring-constant formulas, or the energy,
-    gradient and Hessian kernels), all copied beside the outputs (:func:`c_header_paths`).
-
-Units are SI throughout. The writers are in :mod:`msslib.export_text` (CSV, JSON, VTU) and
-:mod:`msslib.export_simulators` (MuJoCo, SOFA); :mod:`msslib.export_files` chooses formats and
-file names, hands each output its writer and writes them all or none (a folder it creates appears
-whole), with a manifest ``STEM.export-manifest.json`` of the files the export owns: the next export
-to the same stem removes those it no longer writes, and nothing else; it never overwrites a file
-that is not the export's.
-"""
+"""The exported model: :class:`MssExport` and its tables (:class:`Table`, :class:`Column`), built
+from a scene by :func:`build` (or from a prepared setup by :func:`from_setup`); see
+:mod:`msslib.export` for the formats."""
 
 from __future__ import annotations
 
@@ -69,7 +20,7 @@ SPRINGS_ONLY_FORMATS = ("mjcf", "sofa")
 SCHEMA = "msslib-mss-export"
 SCHEMA_VERSION = 1
 #: the umbrella C header; every module's header is beside it (msslib/generated/c/)
-C_HEADER_PATH = Path(__file__).resolve().parent / "generated" / "c" / "msslib_mss.h"
+C_HEADER_PATH = Path(__file__).resolve().parents[1] / "generated" / "c" / "msslib_mss.h"
 
 
 def c_header_paths() -> list[Path]:

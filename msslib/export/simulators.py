@@ -1,7 +1,7 @@
 """The simulator formats of ``msslib export``: a MuJoCo model (MJCF) and a SOFA scene.
 
 Both carry the springs, node masses, fixed and prescribed dofs, loads and gravity of an
-:class:`msslib.export.MssExport` (see :mod:`msslib.export` for the mapping of each); neither can
+:class:`msslib.export.model.MssExport` (see :mod:`msslib.export.model` for the mapping of each); neither can
 carry a volume term, and both files say so in a comment when the model has one.
 """
 
@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import MsslibWarning
-from .export import AXES, MssExport, _pad3, _safe_name, _version, not_carried
+from msslib.errors import MsslibWarning
+from msslib.export.model import AXES, MssExport, _pad3, _safe_name, _version, not_carried
 
 __all__ = ["SOFA_COMPONENTS", "SOFA_TARGET", "MJCF_SAFETY", "MjcfStep", "time_step", "stability_limit",
            "mjcf_time_step", "mjcf_text", "sofa_text"]

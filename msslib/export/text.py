@@ -1,5 +1,5 @@
 """The table formats of ``msslib export``: CSV (one file per table), JSON (one document) and VTU
-(the springs for ParaView), with readers of the CSV and JSON; see :mod:`msslib.export`."""
+(the springs for ParaView), with readers of the CSV and JSON; see :mod:`msslib.export.model`."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .export import SCHEMA, SCHEMA_VERSION, UNITS, Column, MssExport, Table, _pad3, _version
+from msslib.export.model import SCHEMA, SCHEMA_VERSION, UNITS, Column, MssExport, Table, _pad3, _version
 
 # --------------------------------------------------------------------------------------------
 # CSV and JSON

@@ -20,10 +20,11 @@ import shutil
 import warnings
 from pathlib import Path
 
-from msslib import export_simulators, export_text
+from msslib.export import simulators as export_simulators
+from msslib.export import text as export_text
 from msslib.errors import MsslibWarning
-from msslib.export import C_HEADER_PATH, FORMATS, SPRINGS_ONLY_FORMATS, MssExport, _safe_name, c_header_paths, not_carried  # noqa: F401
-from msslib.export import _version
+from msslib.export.model import C_HEADER_PATH, FORMATS, SPRINGS_ONLY_FORMATS, MssExport, _safe_name, c_header_paths, not_carried  # noqa: F401
+from msslib.export.model import _version
 from msslib.results.staging import TEMP_TAG, StagedOutputs, terminate_raises
 
 MANIFEST_SCHEMA = "msslib-export-manifest"
