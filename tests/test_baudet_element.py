@@ -1,4 +1,4 @@
-"""Baudet's correction at element level (msslib.baudet_correction) against the boundary reading,
+"""Baudet's correction at element level (msslib.terms.baudet) against the boundary reading,
 eqs. 7-8, the paper's fixed-point loop and dynamic relaxation."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import pytest
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import terms as T
-from msslib.baudet_correction import (
+from msslib.terms.baudet import (
     ElementBaudetCorrection,
     FrozenForce,
     fixed_point_solve,

@@ -95,7 +95,7 @@ def test_scene_tables_come_from_the_registry():
 
 
 def test_baudet_readings_match_the_correction_module():
-    from msslib.baudet_correction import READINGS
+    from msslib.terms.baudet import READINGS
 
     assert SPECS["baudet_cube"].option("correction").parse.choices == READINGS
 

@@ -4,7 +4,7 @@
   body twice as large in every direction), a unit load on chosen faces and the correction in one
   of two readings (:data:`READINGS`): built from that load on the loaded boundary faces
   (``boundary``) or for every cube from the forces acting on it from outside (``element``, see
-  :mod:`msslib.baudet_correction`); derived factor, or the printed one with ``published=True``;
+  :mod:`msslib.terms.baudet`); derived factor, or the printed one with ``published=True``;
 * :func:`follow` -- load continuation until a measured quantity reaches a target (each equilibrium
   starts from the previous one; the line search judges the residual);
 * :func:`write` -- atomic NetCDF output through :func:`msslib.results.netcdf.write_result`.
@@ -32,7 +32,7 @@ A0 = 0.1  # m, cube edge
 NUS = (0.1, 0.2, 0.3, 0.4, 0.499)  # nu = 0.5 of the paper as 0.499 (nu < 1/2 for the FEM-style parameters)
 NU_LABELS = tuple(f"{v:g}" for v in NUS)
 FACTORS = ("derived", "printed")
-READINGS = ("boundary", "element")  # readings of the correction force (msslib.baudet_correction)
+READINGS = ("boundary", "element")  # readings of the correction force (msslib.terms.baudet)
 STEPS = 40  # load levels per curve (set to 10 by --quick)
 # the cantilever's MSS resolutions and the results its figure and table read
 CANTILEVER_RES = ("4x1x1", "8x2x2", "16x4x4", "32x8x8")

@@ -42,7 +42,7 @@ def main():
         for tag, extra in variants:
             models[f"{tag}_n{n}"] = {"model": {"type": "baudet_cube", **extra}, "geometry": {"args": {"n": n}},
                                      "loads": loads(n)}
-    for n in N_MSS:  # the correction read at element level (msslib.baudet_correction)
+    for n in N_MSS:  # the correction read at element level (msslib.terms.baudet)
         models[f"mss_n{n}_element"] = {"model": {"type": "baudet_cube", "correction": "element"},
                                        "geometry": {"args": {"n": n}}, "loads": loads(n)}
     models["fem"] = {"model": "fem_linear", "geometry": {"args": {"n": N_FEM}}, "loads": loads(N_FEM)}

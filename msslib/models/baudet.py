@@ -1,5 +1,5 @@
 """Baudet et al. (2007): the cube with edge and inner-diagonal springs (configuration M2, eqs. 7-8)
-and its correction force for the Poisson effect, in two readings (:mod:`msslib.baudet_correction`).
+and its correction force for the Poisson effect, in two readings (:mod:`msslib.terms.baudet`).
 """
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from msslib.baudet_correction import READINGS, ElementBaudetCorrection
+from msslib.terms.baudet import READINGS, ElementBaudetCorrection
 from msslib.generated import cube_baudet as _baudet
 from msslib.models.checks import evaluate, flag, poisson, positive, same_shape
 from msslib.models.common import cube_constants, cube_springs
@@ -109,7 +109,7 @@ SPECS = (
               terms=("springs", "correction"), nonconservative=("correction",),
               options=(Option("correction", choice(*CORRECTION_READINGS, what="Baudet correction reading"), "boundary",
                               "boundary: from the surface loads; element: each cube's correction from the forces "
-                              "acting on it from outside (msslib.baudet_correction)"),),
+                              "acting on it from outside (msslib.terms.baudet)"),),
               parameters=baudet_cube, build=_build, published_variant=True,
               exact=(Exactness("lattice", "cube", nu=0.25, options={"terms": ("springs",)},
                                source="without the correction the lattice is isotropic only at nu = 1/4, "

@@ -115,7 +115,7 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     is non-conservative, so the static solver's line search works on the residual norm.  Its
     reading ``boundary`` (the default, as just said) or ``element``, each cube's correction from
     the forces acting on it from outside (neighbours, loads, gravity, supports), see
-    :mod:`msslib.baudet_correction`.
+    :mod:`msslib.terms.baudet`.
 ``boundary``
     List of ``{select: SELECTION, fix: [x, y(, z)] | all, displacement: [...]}``, e.g.
     ``{select: {group: base}, fix: all}`` for a gmsh physical surface ``base``.  ``fix``

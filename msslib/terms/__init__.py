@@ -41,12 +41,13 @@ Contents of this package, one concern per module; every name below is importable
 * :mod:`msslib.terms.internal`: :class:`Springs`, :class:`TetVolume`, :class:`HexVolume`;
 * :mod:`msslib.terms.external`: :class:`ExternalForce`, :class:`NodalForces`, :class:`Gravity`,
   :class:`Traction`, :func:`sum_external_forces`;
-* :mod:`msslib.terms.baudet`: :class:`BaudetCorrection` (Baudet's correction from the surface
-  loads).
+* :mod:`msslib.terms.baudet`: Baudet's correction in its two readings, :class:`BaudetCorrection`
+  (from the surface loads) and :class:`ElementBaudetCorrection` (every cube from the forces acting
+  on it from outside).
 
 The modules import one another in one direction: ``jit`` <- ``loops``, ``assembly``;
-``assembly`` <- ``base``; ``base``, ``loops`` <- ``internal``; ``base`` <- ``external`` <-
-``baudet``.
+``assembly`` <- ``base``; ``base``, ``loops`` <- ``internal``; ``assembly``, ``base`` <-
+``external`` <- ``baudet``.
 """
 
 from __future__ import annotations
@@ -66,7 +67,7 @@ from .base import _format_bad as _format_bad
 from .base import _per_element as _per_element
 from .baudet import _FACE_PAIRS as _FACE_PAIRS
 from .baudet import _HEX_FACES as _HEX_FACES
-from .baudet import BaudetCorrection
+from .baudet import BaudetCorrection, ElementBaudetCorrection
 from .external import ExternalForce, Gravity, NodalForces, Traction, sum_external_forces
 from .external import _traction_nodal as _traction_nodal
 from .internal import HexVolume, Springs, TetVolume
@@ -93,6 +94,7 @@ from .loops import _tet_hessian_loop as _tet_hessian_loop
 
 __all__ = [
     "Term",
+    "ElementBaudetCorrection",
     "Springs",
     "TetVolume",
     "HexVolume",

@@ -7,7 +7,7 @@ deformed cubes. Volume changes from -10 % to +10 % (beyond, the
 compressed inner lattice of the block buckles and the continuation crawls), nu in {0.1, ..., 0.499}, with the derived and
 the printed correction factor. In the block only the cubes with a loaded face get a correction:
 the inner cubes are the bare lattice (reading ``boundary``); with the reading ``element`` every cube
-is corrected from the forces acting on it from outside (msslib.baudet_correction). Every variable
+is corrected from the forces acting on it from outside (msslib.terms.baudet). Every variable
 ``V_by_reading`` has the ``reading`` dimension, ``V`` is its ``boundary`` slice.
 """
 

@@ -5,7 +5,7 @@ x = y = z = 0) pulled along z by a dead traction P on the free z face, up to 20 
 for nu in {0.1, 0.2, 0.3, 0.4, 0.499}, with the derived correction factor -(4 nu - 1)/2 and the
 printed -(4 nu - 1)/16 (resultants per face), each under the two readings of the correction force
 (dimension ``reading``): ``boundary`` (driven by the loads on the body's loaded faces) and ``element``
-(every cube driven by the forces acting on it from outside, msslib.baudet_correction). E = P / eps_z
+(every cube driven by the forces acting on it from outside, msslib.terms.baudet). E = P / eps_z
 and nu = -eps_lat / eps_z (eqs. 1-2, nominal stress and engineering strains from the least-squares
 mean displacement gradient of all nodes, exact for the cube's affine deformation). Errors are
 signed, relative to the input values. Every variable ``V_by_reading`` has the ``reading`` dimension;

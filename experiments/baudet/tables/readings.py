@@ -1,6 +1,6 @@
 """Baudet's claims (Sec. 5) judged under both readings of the correction force: ``boundary`` (driven
 by the loads on the body's loaded faces) and ``element`` (every cube driven by the forces acting on it
-from outside: neighbours, loads, gravity, supports; msslib.baudet_correction). Derived factor."""
+from outside: neighbours, loads, gravity, supports; msslib.terms.baudet). Derived factor."""
 
 import numpy as np
 
