@@ -20,7 +20,8 @@ import yaml
 
 from cli_helpers import assert_refused
 from cli_helpers import run_cli as _cli
-from msslib import cli, cli_inputs
+from msslib import cli
+from msslib.cli import inputs as cli_inputs
 from msslib import experiment as EXP
 from msslib import mesh as M
 from msslib.results import StagedOutputs, read_result, remove_stale_temporaries, write_result, write_text
@@ -292,7 +293,8 @@ def test_sigterm_during_cli_run_keeps_old_outputs(work):
     before = _snapshot(work)
     proc = _python("""
         import os, signal, sys, time
-        from msslib import cli, cli_inputs
+        from msslib import cli
+        from msslib.cli import inputs as cli_inputs
 
         def killed(tmp, ds):  # SIGTERM arrives while both outputs are staged
             os.kill(os.getpid(), signal.SIGTERM)

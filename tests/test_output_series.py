@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 from msslib import cli
-from msslib.cli_inputs import _check_distinct
+from msslib.cli.inputs import _check_distinct
 from msslib.results import read_result
 from msslib.results.paraview import series_files
 from msslib.results.staging import StagedOutputs

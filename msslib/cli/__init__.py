@@ -56,7 +56,7 @@ from pathlib import Path
 __all__ = ["main", "build_parser", "COMMANDS"]
 
 
-from .cli_inputs import (  # noqa: F401
+from msslib.cli.inputs import (  # noqa: F401
     CommandError,
     _one_line,
     _same_file,
