@@ -30,6 +30,7 @@ import time
 import numpy as np
 from numba import njit
 
+from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import solvers as S
@@ -60,7 +61,7 @@ def _explicit_run(x, v, free, inv_m, mass, fext, alpha, h, n_steps, save_every,
 def sample(nu: float = 0.3, E: float = 2e4, a: float = 0.01, rho: float = 1000.0):
     """10 x 10 x 10 Golec cubes of edge ``a`` (10 cm sample), bottom clamped, gravity -z."""
     mesh = M.hex_grid(10 * a, 10 * a, 10 * a, 10, 10, 10)
-    terms = MD.golec_cube_springs(mesh, [(E, nu)], 1.0)
+    terms = golec_cube_springs(mesh, [(E, nu)], 1.0)
     masses = M.lumped_masses(mesh, rho)
     fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
     fixed[mesh.points[:, 2] < 1e-12] = True

@@ -7,6 +7,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import terms as T
@@ -18,7 +19,7 @@ def lattice(n: int, E: float = 1e4, nu: float = 0.25):
     """n^3 cubes of 1 cm, springs on edges, face and inner diagonals (Golec's constants at
     nu = 1/4, where his volume term vanishes: the springs alone are the model)."""
     mesh = M.hex_grid(0.01 * n, 0.01 * n, 0.01 * n, n, n, n)
-    springs = MD.golec_cube_springs(mesh, [(E, nu)], 1.0)[0]
+    springs = golec_cube_springs(mesh, [(E, nu)], 1.0)[0]
     return mesh, springs
 
 

@@ -24,6 +24,7 @@ from experiments.stability_common import (
     run_mss,
     sliding_bc,
 )
+from msslib.models.common import assemble_springs
 from msslib import fem
 from msslib import mesh as M
 from msslib import model as MD
@@ -178,7 +179,7 @@ def shape_case(shape, nu=0.3):
     neg = np.flatnonzero(k_lsq <= 0)
     try:
         local = {tuple(sorted(e)): i for i, e in enumerate(TET_EDGES.tolist())}
-        MD.assemble_springs(mesh, "edges", lambda _c, pairs: k_lsq[[local[tuple(q)] for q in pairs.tolist()]])
+        assemble_springs(mesh, "edges", lambda _c, pairs: k_lsq[[local[tuple(q)] for q in pairs.tolist()]])
         springs = "accepted by Springs"
     except ValueError as exc:
         springs = f"Springs rejects them: {_short(exc)}"

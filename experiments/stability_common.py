@@ -7,6 +7,9 @@ import time
 
 import numpy as np
 
+from msslib.models.baudet import baudet_correction, baudet_cube_springs
+from msslib.models.golec import golec_cube_springs
+from msslib.models.lloyd import lloyd_tet_springs
 from msslib import fem
 from msslib import mesh as M
 from msslib import model as MD
@@ -86,20 +89,20 @@ def volumes(mesh, x):
 def mss_terms(name, mesh, materials, loads=None):
     """Internal terms of MSS model ``name``; ``loads`` (n, 3) feeds Baudet's correction."""
     if name == "lloyd_tetrahedron":
-        return MD.lloyd_tet_springs(mesh, materials)
+        return lloyd_tet_springs(mesh, materials)
     if name == "lloyd_tetrahedron_volume":
-        return MD.lloyd_tet_springs(mesh, materials, volume=True)
+        return lloyd_tet_springs(mesh, materials, volume=True)
     if name == "baudet_cube":
-        terms = MD.baudet_cube_springs(mesh, materials)
+        terms = baudet_cube_springs(mesh, materials)
         if loads is not None and np.any(loads != 0):
-            terms.append(MD.baudet_correction(mesh, materials, loads))
+            terms.append(baudet_correction(mesh, materials, loads))
         return terms
     if name == "golec_derived":
-        return MD.golec_cube_springs(mesh, materials, 1.0)
+        return golec_cube_springs(mesh, materials, 1.0)
     if name == "golec_published":
-        return MD.golec_cube_springs(mesh, materials, 1.0, published=True)
+        return golec_cube_springs(mesh, materials, 1.0, published=True)
     if name == "golec_springs_only":
-        return MD.golec_cube_springs(mesh, materials, 1.0)[:1]
+        return golec_cube_springs(mesh, materials, 1.0)[:1]
     raise ValueError(f"unknown MSS model {name!r}")
 
 

@@ -4,11 +4,9 @@
 :mod:`msslib.solvers` (``n_dof``, ``force``, ``stiffness``, ``energy``, ``free``, ``mass``,
 ``symmetric``, ``apply_prescribed``, ``damping``, ``dim``), plus ``x0`` and :meth:`Model.reaction`.
 
-The builders that turn a mesh and its materials into terms (:func:`assemble_springs`,
-:func:`lloyd_triangle_springs`, :func:`van_gelder_springs`, :func:`lloyd_square_springs`,
-:func:`lloyd_tet_springs`, :func:`baudet_cube_springs`, :func:`baudet_correction`,
-:func:`golec_cube_springs`, :func:`material_arrays`) live with their models in
-:mod:`msslib.models`, one module per model family; they are importable from here too.
+The builders that turn a mesh and its materials into terms live with their models in
+:mod:`msslib.models`, one module per model family (``msslib.models.lloyd.lloyd_tet_springs``,
+``msslib.models.golec.golec_cube_springs``, ...); a :class:`Model` knows no family.
 """
 
 from __future__ import annotations
@@ -17,11 +15,6 @@ import numpy as np
 import scipy.sparse as sp
 
 from msslib import mesh as _mesh
-from msslib.models.baudet import baudet_correction, baudet_cube_springs
-from msslib.models.common import _pairs_of as _pairs_of
-from msslib.models.common import assemble_springs, material_arrays
-from msslib.models.golec import golec_cube_springs
-from msslib.models.lloyd import lloyd_square_springs, lloyd_tet_springs, lloyd_triangle_springs, van_gelder_springs
 from msslib.terms import ExternalForce, Springs, Term, _ElementTerm
 from msslib.terms.assembly import (
     _block_scatter_bsr,
@@ -32,19 +25,7 @@ from msslib.terms.assembly import (
     _spring3d_hessian_csr,
 )
 
-__all__ = [
-    "Model",
-    "frozen_mesh",
-    "material_arrays",
-    "assemble_springs",
-    "lloyd_triangle_springs",
-    "van_gelder_springs",
-    "lloyd_square_springs",
-    "lloyd_tet_springs",
-    "baudet_cube_springs",
-    "baudet_correction",
-    "golec_cube_springs",
-]
+__all__ = ["Model", "frozen_mesh"]
 
 
 # --------------------------------------------------------------------------------------------

@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 import yaml
 
+from msslib.models.baudet import baudet_correction, baudet_cube_springs
+from msslib.models.golec import golec_cube_springs
+from msslib.models.lloyd import lloyd_square_springs, lloyd_tet_springs, lloyd_triangle_springs, van_gelder_springs
 from msslib import cli, fem
 from msslib import mesh as M
-from msslib import model as MD
 from msslib import parameters as P
 from msslib.results import write_result
 from msslib.scene import load_scene, run_scene
@@ -74,14 +76,14 @@ QUAD = M.quad_grid(1.0, 1.0, 2, 2)
 TET = M.tet_grid(1.0, 1.0, 1.0, 1, 1, 1)
 HEX = M.hex_grid(1.0, 1.0, 1.0, 1, 1, 1)
 BUILDERS = {
-    "lloyd_triangle_springs": lambda mats: MD.lloyd_triangle_springs(TRI, mats, T),
-    "van_gelder_springs": lambda mats: MD.van_gelder_springs(TRI, mats, T),
-    "lloyd_square_springs": lambda mats: MD.lloyd_square_springs(QUAD, mats, T),
-    "lloyd_tet_springs": lambda mats: MD.lloyd_tet_springs(TET, mats),
-    "lloyd_tet_springs_volume": lambda mats: MD.lloyd_tet_springs(TET, mats, volume=True),
-    "baudet_cube_springs": lambda mats: MD.baudet_cube_springs(HEX, mats),
-    "baudet_correction": lambda mats: MD.baudet_correction(HEX, mats, np.ones((HEX.n_nodes, 3))),
-    "golec_cube_springs": lambda mats: MD.golec_cube_springs(HEX, mats, 1.0),
+    "lloyd_triangle_springs": lambda mats: lloyd_triangle_springs(TRI, mats, T),
+    "van_gelder_springs": lambda mats: van_gelder_springs(TRI, mats, T),
+    "lloyd_square_springs": lambda mats: lloyd_square_springs(QUAD, mats, T),
+    "lloyd_tet_springs": lambda mats: lloyd_tet_springs(TET, mats),
+    "lloyd_tet_springs_volume": lambda mats: lloyd_tet_springs(TET, mats, volume=True),
+    "baudet_cube_springs": lambda mats: baudet_cube_springs(HEX, mats),
+    "baudet_correction": lambda mats: baudet_correction(HEX, mats, np.ones((HEX.n_nodes, 3))),
+    "golec_cube_springs": lambda mats: golec_cube_springs(HEX, mats, 1.0),
 }
 
 
@@ -110,7 +112,7 @@ def test_builders_warn_outside_formula_validity(name):
 def test_builder_names_the_bad_material_of_several():
     mesh = M.Mesh(HEX.points, HEX.cells, HEX.cell_type, np.array([1]))
     with pytest.raises(ValueError, match=r"got 0\.7"):
-        MD.golec_cube_springs(mesh, [(E, 0.3), (E, 0.7)], 1.0)
+        golec_cube_springs(mesh, [(E, 0.3), (E, 0.7)], 1.0)
 
 
 # ---- FEM ---------------------------------------------------------------------------------
@@ -148,11 +150,11 @@ FLAT = M.Mesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0]]
 
 
 @pytest.mark.parametrize("call", [
-    lambda: MD.lloyd_triangle_springs(COLLINEAR, [(E, 1 / 3)], T),
-    lambda: MD.van_gelder_springs(COLLINEAR, [(E, 1 / 3)], T),
+    lambda: lloyd_triangle_springs(COLLINEAR, [(E, 1 / 3)], T),
+    lambda: van_gelder_springs(COLLINEAR, [(E, 1 / 3)], T),
     lambda: fem.solve_linear(COLLINEAR, E, 0.3, fixed=np.ones((4, 2), bool)),
-    lambda: MD.lloyd_tet_springs(FLAT, [(E, 0.25)]),
-    lambda: MD.lloyd_tet_springs(FLAT, [(E, 0.25)], volume=True),
+    lambda: lloyd_tet_springs(FLAT, [(E, 0.25)]),
+    lambda: lloyd_tet_springs(FLAT, [(E, 0.25)], volume=True),
     lambda: fem.solve_linear(FLAT, E, 0.3, fixed=np.ones((5, 3), bool)),
     lambda: fem.solve_nonlinear(FLAT, E, 0.3, fixed=np.ones((5, 3), bool)),
 ], ids=["lloyd_triangle", "van_gelder", "fem_triangle", "lloyd_tet", "lloyd_tet_volume", "fem_linear_tet", "fem_svk_tet"])
@@ -168,7 +170,7 @@ def test_inverted_cell_named_by_fem():
     with pytest.raises(ValueError, match=r"1 inverted tetra cell\(s\): cell 3 "):
         fem.solve_linear(inverted, E, 0.3, fixed=np.ones((TET.n_nodes, 3), bool))
     with pytest.raises(ValueError, match=r"1 inverted tetra cell\(s\): cell 3 "):
-        MD.lloyd_tet_springs(inverted, [(E, 0.25)])
+        lloyd_tet_springs(inverted, [(E, 0.25)])
 
 
 # ---- scenes and the command line ---------------------------------------------------------

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from msslib.models.baudet import baudet_correction, baudet_cube_springs
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import terms as T
@@ -32,11 +33,11 @@ def _face(mesh, axis, value):
 def _tension(n, nu, reading, P=1.0, published=False):
     """Octant of a box (symmetry planes x = y = z = 0) pulled along z by a dead traction P."""
     mesh = M.hex_grid(A0 * n[0], A0 * n[1], A0 * n[2], *n)
-    terms = list(MD.baudet_cube_springs(mesh, [(E0, nu)]))
+    terms = list(baudet_cube_springs(mesh, [(E0, nu)]))
     load = T.Traction(mesh, _face(mesh, "z", A0 * n[2]), [0.0, 0.0, P])
     terms.append(load)
     if reading == "boundary":
-        terms.append(MD.baudet_correction(mesh, [(E0, nu)], [load], published=published))
+        terms.append(baudet_correction(mesh, [(E0, nu)], [load], published=published))
     elif reading == "element":
         terms.append(element_correction(mesh, [(E0, nu)], published=published))
     fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
@@ -53,7 +54,7 @@ def _moduli(mesh, x, P):
 def _beam(n, nu, reading, density=1.0):
     """Beam along x clamped at x = 0 under gravity (the boundary reading has no correction)."""
     mesh = M.hex_grid(A0 * n[0], A0 * n[1], A0 * n[2], *n)
-    terms = list(MD.baudet_cube_springs(mesh, [(E0, nu)]))
+    terms = list(baudet_cube_springs(mesh, [(E0, nu)]))
     terms.append(T.Gravity(M.lumped_masses(mesh, density), [0.0, 0.0, -9.81]))
     if reading == "element":
         terms.append(element_correction(mesh, [(E0, nu)]))
@@ -158,7 +159,7 @@ def test_springs_only_variant_differs_in_a_composite_only():
     _, me1 = _tension((1, 1, 1), 0.4, "element", P=10.0)
     x1 = static_solve(me1, me1.x0, tol=1e-12).x
     mesh1 = M.hex_grid(A0, A0, A0, 1, 1, 1)
-    terms = [*MD.baudet_cube_springs(mesh1, [(E0, 0.4)]), T.Traction(mesh1, _face(mesh1, "z", A0), [0, 0, 10.0]),
+    terms = [*baudet_cube_springs(mesh1, [(E0, 0.4)]), T.Traction(mesh1, _face(mesh1, "z", A0), [0, 0, 10.0]),
              FrozenForce(mesh1.n_nodes)]
     mf1 = MD.Model(mesh1, terms, fixed=me1.fixed)
     xs1, _, _ = fixed_point_solve(mf1, me1.terms[-1], tol=1e-12, neighbour_corrections=False)

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
 
+from msslib.models.baudet import baudet_correction, baudet_cube_springs
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import terms as T
@@ -41,13 +42,13 @@ def _face(mesh, axis, value):
 def _model(mesh, materials, reading, fixed, traction=None, facets=None, g=0.0):
     """Baudet's springs, a dead traction on ``facets`` and/or gravity, and the correction of
     ``reading`` (``boundary``, ``element`` or ``springs``: none)."""
-    terms = list(MD.baudet_cube_springs(mesh, materials))
+    terms = list(baudet_cube_springs(mesh, materials))
     surface = [T.Traction(mesh, facets, traction)] if traction is not None else []
     terms += surface
     if g:
         terms.append(T.Gravity(M.lumped_masses(mesh, RHO), [0.0, 0.0, -g]))
     if reading == "boundary" and surface:
-        terms.append(MD.baudet_correction(mesh, materials, surface))
+        terms.append(baudet_correction(mesh, materials, surface))
     elif reading == "element":
         terms.append(element_correction(mesh, materials))
     return MD.Model(mesh, terms, fixed=fixed)

@@ -9,8 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
+from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
-from msslib.model import Model, golec_cube_springs
+from msslib.model import Model
 from msslib.terms import Springs, _spring3d_hessian_loop
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -5,6 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from msslib.models.common import _pairs_of
+from msslib.models.golec import golec_cube_springs
+from msslib.models.lloyd import lloyd_tet_springs
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import solvers as S
@@ -17,7 +20,7 @@ def _golec_sample(n=(4, 4, 4), a=0.01, nu=0.3, E=2e4, rho=1000.0, alpha=0.0):
     """Golec cubes (springs + hex volume), bottom clamped, gravity: the benchmark's model, smaller."""
     nx, ny, nz = n
     mesh = M.hex_grid(nx * a, ny * a, nz * a, nx, ny, nz)
-    terms = MD.golec_cube_springs(mesh, [(E, nu)], 1.0)
+    terms = golec_cube_springs(mesh, [(E, nu)], 1.0)
     masses = M.lumped_masses(mesh, rho)
     fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
     fixed[mesh.points[:, 2] < 1e-12] = True
@@ -49,13 +52,13 @@ def _irregular_model(seed=0):
     mesh = M.Mesh(points, cells, "hexahedron")
     terms = []
     for kind in ("edges", "face_diagonals", "inner_diagonals"):
-        pairs = MD._pairs_of(mesh, kind).pairs
+        pairs = _pairs_of(mesh, kind).pairs
         L = np.linalg.norm(points[pairs[:, 1]] - points[pairs[:, 0]], axis=1)
         # random orientation of the pairs too
         flip = rng.random(len(pairs)) < 0.5
         pairs = np.where(flip[:, None], pairs[:, ::-1], pairs)
         terms.append(T.Springs(pairs, rng.uniform(50, 150, len(pairs)), L * rng.uniform(0.95, 1.05, len(pairs)), 3))
-    extra = MD._pairs_of(mesh, "edges").pairs[::3]
+    extra = _pairs_of(mesh, "edges").pairs[::3]
     Le = np.linalg.norm(points[extra[:, 1]] - points[extra[:, 0]], axis=1)
     terms.append(T.Springs(extra, rng.uniform(10, 20, len(extra)), Le * rng.uniform(0.9, 1.1, len(extra)), 3))
     keep = rng.random(mesh.n_cells) < 0.7
@@ -146,7 +149,7 @@ def test_lattice_index_and_errors():
         lattice_index(bent)
     # a tetrahedral model: its nodes form a lattice, but the volume term is not supported
     tets = M.tet_grid(0.02, 0.02, 0.02, 2, 2, 2)
-    tmodel = MD.Model(tets, MD.lloyd_tet_springs(tets, [(1e4, 0.3)], volume=True))
+    tmodel = MD.Model(tets, lloyd_tet_springs(tets, [(1e4, 0.3)], volume=True))
     with pytest.raises(ValueError, match="TetVolume"):
         LatticeExplicit(tmodel)
     # springs that do not join lattice neighbours

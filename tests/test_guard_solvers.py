@@ -10,6 +10,8 @@ import numpy as np
 import pytest
 import yaml
 
+from msslib.models.baudet import baudet_correction, baudet_cube_springs
+from msslib.models.golec import golec_cube_springs
 from msslib import cli, fem
 from msslib import mesh as M
 from msslib import model as MD
@@ -29,7 +31,7 @@ def cantilever(nx=10, nyz=2, length=0.2, damping=0.0):
     masses = M.lumped_masses(mesh, RHO)
     fixed = np.zeros((mesh.n_nodes, 3), bool)
     fixed[np.isclose(mesh.points[:, 0], 0.0)] = True
-    terms = MD.golec_cube_springs(mesh, [(E0, 0.3)], 1.0) + [T.Gravity(masses, [0.0, 0.0, -G])]
+    terms = golec_cube_springs(mesh, [(E0, 0.3)], 1.0) + [T.Gravity(masses, [0.0, 0.0, -G])]
     return MD.Model(mesh, terms, fixed=fixed, masses=masses, damping=damping)
 
 
@@ -199,7 +201,7 @@ def test_baudet_correction_run_does_not_trip_the_detector(method):
     facets = M.boundary_facets(mesh)
     end = np.isclose(mesh.points[facets][:, :, 0], 0.5).all(axis=1)
     pull = T.Traction(mesh, facets[end], [1.0e4, 0.0, 0.0])
-    terms = MD.baudet_cube_springs(mesh, [(E0, 0.3)]) + [MD.baudet_correction(mesh, [(E0, 0.3)], [pull]), pull]
+    terms = baudet_cube_springs(mesh, [(E0, 0.3)]) + [baudet_correction(mesh, [(E0, 0.3)], [pull]), pull]
     model = MD.Model(mesh, terms, fixed=fixed, masses=masses)
     assert not model.conservative
     limit = S.explicit_stability_limit(model, model.x0)
@@ -217,7 +219,7 @@ def test_lattice_explicit_checks_the_step():
     masses = M.lumped_masses(mesh, RHO)
     fixed = np.zeros((mesh.n_nodes, 3), bool)
     fixed[mesh.points[:, 2] < 1e-12] = True
-    model = MD.Model(mesh, MD.golec_cube_springs(mesh, [(2e4, 0.3)], 1.0) + [T.Gravity(masses, [0, 0, -G])],
+    model = MD.Model(mesh, golec_cube_springs(mesh, [(2e4, 0.3)], 1.0) + [T.Gravity(masses, [0, 0, -G])],
                      fixed=fixed, masses=masses)
     fast = LatticeExplicit(model)
     limit = S.explicit_stability_limit(model, model.x0)
@@ -240,7 +242,7 @@ def test_unloaded_static_solve_returns_at_once():
     mesh = M.hex_grid(0.1, 0.1, 0.1, 3, 3, 3)
     fixed = np.zeros((mesh.n_nodes, 3), bool)
     fixed[np.isclose(mesh.points[:, 0], 0.0)] = True
-    model = MD.Model(mesh, MD.golec_cube_springs(mesh, [(E0, 0.3)], 1.0), fixed=fixed)
+    model = MD.Model(mesh, golec_cube_springs(mesh, [(E0, 0.3)], 1.0), fixed=fixed)
     res = S.static_solve(model, model.x0)
     assert res.iterations == [0]
     assert res.residuals[0][0] <= res.roundoff_floor == res.threshold
@@ -253,7 +255,7 @@ def slender_beam(nx, nyz, length=1.0, width=0.02, E=1e9):
     masses = M.lumped_masses(mesh, RHO)
     fixed = np.zeros((mesh.n_nodes, 3), bool)
     fixed[np.isclose(mesh.points[:, 0], 0.0)] = True
-    terms = MD.golec_cube_springs(mesh, [(E, 0.3)], 1.0) + [T.Gravity(masses, [0.0, 0.0, -G])]
+    terms = golec_cube_springs(mesh, [(E, 0.3)], 1.0) + [T.Gravity(masses, [0.0, 0.0, -G])]
     return MD.Model(mesh, terms, fixed=fixed, masses=masses), mesh, fixed
 
 

@@ -15,6 +15,7 @@ import pytest
 import yaml
 
 from experiments import stability_cases, stability_common
+from msslib.models.common import assemble_springs
 from msslib import cli
 from msslib import mesh as M
 from msslib import model as MD
@@ -163,7 +164,7 @@ def test_sliver_negative_constant_rejected_by_springs_with_its_index():
     bad = np.flatnonzero(k_pairs <= 0)
     assert len(bad) == 2
     with pytest.raises(ValueError) as info:
-        MD.assemble_springs(mesh, edges, lambda _c, p: k[[local[tuple(q)] for q in p.tolist()]])
+        assemble_springs(mesh, edges, lambda _c, p: k[[local[tuple(q)] for q in p.tolist()]])
     for i in bad:
         a, b = pairs[i]
         assert f"spring {i} (nodes {a}-{b})" in str(info.value)

@@ -7,18 +7,12 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from msslib.models.baudet import baudet_correction, baudet_cube_springs
+from msslib.models.common import assemble_springs
+from msslib.models.golec import golec_cube_springs
+from msslib.models.lloyd import lloyd_square_springs, lloyd_tet_springs, lloyd_triangle_springs, van_gelder_springs
 from msslib import mesh as M
-from msslib.model import (
-    Model,
-    assemble_springs,
-    baudet_correction,
-    baudet_cube_springs,
-    golec_cube_springs,
-    lloyd_square_springs,
-    lloyd_tet_springs,
-    lloyd_triangle_springs,
-    van_gelder_springs,
-)
+from msslib.model import Model
 from msslib.terms import (
     BaudetCorrection,
     Gravity,
@@ -501,7 +495,7 @@ def test_prescribed_displacements_and_masks():
 def test_baudet_cube_tension_gives_E_and_nu():
     """A single Baudet cube in tension, with the derived correction, has the target E and nu
     (linearised: a lone M2 cube has two zero-energy modes, which the face loads do not excite)."""
-    from msslib.model import baudet_cube_springs
+
     E, nu, F = 1000.0, 0.4, 1e-3
     mesh = M.hex_grid(1.0, 1.0, 1.0, 1, 1, 1)
     top = mesh.cells[:, 4:]

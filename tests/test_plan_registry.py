@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from scipy.sparse import csgraph
 
+from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
 from msslib import solvers as S
-from msslib.model import Model, golec_cube_springs
+from msslib.model import Model
 from msslib.solvers import direct, memo, plans
 from msslib.solvers.context import ATTRIBUTE
 from msslib.terms import Gravity

@@ -8,6 +8,7 @@ import pytest
 import scipy.sparse as sp
 from solver_problems import SpringNetwork
 
+from msslib.models.golec import golec_cube_springs
 from msslib.solvers import (
     static_solve,
 )
@@ -64,7 +65,7 @@ def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
 def clamped_golec_block(nx, ny, nz, nu=0.3):
     """Golec cube lattice of nx x ny x nz 1 cm cells, clamped at x = 0."""
     from msslib import mesh as M
-    from msslib.model import Model, golec_cube_springs
+    from msslib.model import Model
 
     mesh = M.hex_grid(0.01 * nx, 0.01 * ny, 0.01 * nz, nx, ny, nz)
     fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)

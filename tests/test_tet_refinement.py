@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 
 from experiments.lloyd.studies import tet_refinement as T
+from msslib.models.lloyd import lloyd_tet_springs
 from msslib import fem
 from msslib import mesh as M
-from msslib.model import Model, lloyd_tet_springs
+from msslib.model import Model
 from msslib.mesh.quality import relative_jacobians
 
 E, NU = 14630.0, 0.25

@@ -22,6 +22,7 @@ from pathlib import Path as _P
 import numpy as np
 
 from experiments.script import LoadSegment
+from msslib.models.baudet import baudet_correction, baudet_cube_springs
 from msslib import mesh as M
 from msslib import model as MD
 from msslib import terms as T
@@ -69,7 +70,7 @@ def block(n, nu, *, published=False, tractions=(), fixed_planes="xyz", fix_all_p
     or with ``reading="element"`` from the forces acting on every cube from outside it.
     """
     mesh = M.hex_grid(a * n[0], a * n[1], a * n[2], *n)
-    terms = list(MD.baudet_cube_springs(mesh, [(E, nu)], published=published))
+    terms = list(baudet_cube_springs(mesh, [(E, nu)], published=published))
     loads = [T.Traction(mesh, face_facets(mesh, ax, val), vec) for ax, val, vec in tractions]
     terms += loads
     # One correction per loaded face, summed (the correction is linear in the face forces): msslib
@@ -81,7 +82,7 @@ def block(n, nu, *, published=False, tractions=(), fixed_planes="xyz", fix_all_p
 
         terms.append(element_correction(mesh, [(E, nu)], published=published))
     elif correction:
-        terms += [MD.baudet_correction(mesh, [(E, nu)], [ld], published=published) for ld in loads]
+        terms += [baudet_correction(mesh, [(E, nu)], [ld], published=published) for ld in loads]
     fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)
     for ax in fixed_planes:
         d = "xyz".index(ax)

@@ -25,10 +25,12 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from msslib.models.common import assemble_springs
+from msslib.models.golec import golec_cube_springs
 from msslib.results import write_result
 from msslib.mesh import hex_grid
 from msslib.metrics import mesh_volume, shear_modulus, youngs_modulus_poisson
-from msslib.model import Model, assemble_springs, golec_cube_springs
+from msslib.model import Model
 from msslib.parameters import golec_cube
 from msslib.solvers import static_solve
 from msslib.terms import HexVolume, Springs

@@ -38,11 +38,12 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from msslib.models.lloyd import lloyd_square_springs, lloyd_triangle_springs
 from msslib import fem
 from msslib import mesh as M
 from msslib.results import write_result
 from msslib.metrics import displacement_error
-from msslib.model import Model, lloyd_square_springs, lloyd_triangle_springs
+from msslib.model import Model
 from msslib.solvers import static_solve
 from msslib.terms import NodalForces, Traction
 
