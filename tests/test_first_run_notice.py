@@ -14,16 +14,9 @@ import yaml
 
 from msslib import cli, planning
 from msslib.scene import progress as P
+from scene_helpers import pulled_sheet
 
-SHEET = {
-    "name": "sheet",
-    "geometry": {"generator": "quad_grid", "args": {"lx": 0.1, "ly": 0.1, "nx": 2, "ny": 2}},
-    "materials": [{"E": 1.0e6, "nu": 1 / 3}],
-    "thickness": 0.01,
-    "model": "lloyd_square",
-    "boundary": [{"select": {"plane": ["x", 0.0]}}],
-    "loads": [{"type": "nodal_force", "select": {"plane": ["x", 0.1]}, "total": [1.0, 0.0]}],
-}
+SHEET = pulled_sheet()
 NOTICE = "msslib: compiling the lloyd kernels (first run only, cached afterwards) ..."
 
 

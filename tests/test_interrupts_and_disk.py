@@ -19,6 +19,7 @@ import yaml
 from msslib import cli
 from msslib.results import staging
 from msslib.results import StagedOutputs
+from scene_helpers import pulled_sheet
 
 OLD, NEW_KEPT, NEW_FRESH = "the user's file\n", "new content of kept.txt\n", "new content of fresh.txt\n"
 
@@ -152,15 +153,7 @@ def _hdf_error(monkeypatch):
     monkeypatch.setattr(xr.Dataset, "to_netcdf", to_netcdf)
 
 
-SCENE = {
-    "name": "sheet",
-    "geometry": {"generator": "quad_grid", "args": {"lx": 0.1, "ly": 0.1, "nx": 2, "ny": 2}},
-    "materials": [{"E": 1.0e6, "nu": 1 / 3}],
-    "thickness": 0.01,
-    "model": "lloyd_square",
-    "boundary": [{"select": {"plane": ["x", 0.0]}}],
-    "loads": [{"type": "nodal_force", "select": {"plane": ["x", 0.1]}, "total": [1.0, 0.0]}],
-}
+SCENE = pulled_sheet()
 
 
 def _run(capsys, tmp_path):

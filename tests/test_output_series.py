@@ -18,16 +18,9 @@ from msslib.cli.inputs import _check_distinct
 from msslib.results import read_result
 from msslib.results.paraview import series_files
 from msslib.results.staging import StagedOutputs
+from scene_helpers import swinging_bar
 
-SWING = {
-    "name": "swing",
-    "geometry": {"generator": "hex_grid", "args": {"lx": 0.08, "ly": 0.02, "lz": 0.02, "nx": 4, "ny": 1, "nz": 1}},
-    "materials": [{"E": 1.0e5, "nu": 0.3, "density": 1000.0}],
-    "model": "golec_cube",
-    "boundary": [{"select": {"plane": ["x", 0.0]}}],
-    "loads": [{"type": "gravity", "g": [0.0, 0.0, -9.81]}],
-    "solver": {"type": "dynamic", "dt": 1.0e-4, "t_end": 2.0e-3, "save_every": 1},
-}
+SWING = swinging_bar(save_every=1)
 
 
 def _cli(capsys, *argv):

@@ -18,25 +18,10 @@ from msslib.results import paraview
 from msslib import mesh as M
 from msslib.results import read_result, write_result
 from msslib.scene import run_scene
+from scene_helpers import pulled_sheet, swinging_bar
 
-DYNAMIC = {
-    "name": "swing",
-    "geometry": {"generator": "hex_grid", "args": {"lx": 0.08, "ly": 0.02, "lz": 0.02, "nx": 4, "ny": 1, "nz": 1}},
-    "materials": [{"E": 1.0e5, "nu": 0.3, "density": 1000.0}],
-    "model": "golec_cube",
-    "boundary": [{"select": {"plane": ["x", 0.0]}}],
-    "loads": [{"type": "gravity", "g": [0.0, 0.0, -9.81]}],
-    "solver": {"type": "dynamic", "dt": 1.0e-4, "t_end": 2.0e-3, "save_every": 5},
-}
-STATIC_2D = {
-    "name": "sheet",
-    "geometry": {"generator": "quad_grid", "args": {"lx": 0.1, "ly": 0.1, "nx": 2, "ny": 2}},
-    "materials": [{"E": 1.0e6, "nu": 1 / 3}],
-    "thickness": 0.01,
-    "model": "lloyd_square",
-    "boundary": [{"select": {"plane": ["x", 0.0]}}],
-    "loads": [{"type": "nodal_force", "select": {"plane": ["x", 0.1]}, "total": [1.0, 0.0]}],
-}
+DYNAMIC = swinging_bar(save_every=5)
+STATIC_2D = pulled_sheet()
 
 
 @pytest.fixture(scope="module")
