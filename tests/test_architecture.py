@@ -96,3 +96,14 @@ def test_no_hand_written_file_over_600_lines(package):
     long = [(str(p.relative_to(ROOT)), n) for p in (ROOT / package).rglob("*.py")
             if "generated" not in p.parts and (n := len(p.read_text(encoding="utf-8").splitlines())) > 600]
     assert not long, long
+
+
+def test_a_concern_is_a_package_not_prefixed_siblings():
+    """A concern that outgrows one file becomes a package (msslib.export, msslib.results, ...), not
+    prefixed sibling modules beside the library's face (export, export_files, export_text, ...)."""
+    top = ROOT / "msslib"
+    names = sorted({p.stem for p in top.glob("*.py") if not p.stem.startswith("_")}
+                   | {p.name for p in top.iterdir() if (p / "__init__.py").is_file() and p.name != "generated"})
+    siblings = [(a, b) for a in names for b in names if b.startswith(a + "_")]
+    assert not siblings, siblings
+    assert not (top / "paper.py").exists() and not (top / "plotting.py").exists()  # workflow, not library
