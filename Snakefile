@@ -99,6 +99,7 @@ rule all:
         "paper/build/paper.html",
         "paper/build/paper.pdf",
         NOTEBOOKS,
+        "paper/build/docs/index.html",
         expand("results/scenes/{name}.nc", name=SCENES),
 
 
@@ -350,3 +351,21 @@ rule derivation_notebook:
         "logs/derivations/{module}.log",
     shell:
         "python -m experiments.paper notebook {wildcards.module} --out {output} > {log} 2>&1"
+
+
+rule docs:
+    """The documentation site (Sphinx, offline): the API from the docstrings, the scene syntax, the
+    model and element tables generated from the registries, the worked examples; its element
+    table links the derivation pages of rule derivation_notebook beside it. A few seconds."""
+    input:
+        sources=sorted(str(p) for p in Path("paper", "docs").rglob("*") if p.is_file() and "__pycache__" not in p.parts),
+        code=MSSLIB,
+        derivations=list(DERIVATIONS.values()),
+        examples=sorted(str(p) for p in Path("experiments", "examples").glob("*.py")),
+        readme="README.md",
+    output:
+        "paper/build/docs/index.html",
+    log:
+        "logs/docs.log",
+    shell:
+        "python -m sphinx -W -q -b html paper/docs paper/build/docs > {log} 2>&1"

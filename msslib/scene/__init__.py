@@ -99,7 +99,13 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     ``lloyd_tetrahedron_volume`` tetra        ``springs``, ``volume``
     ``baudet_cube``              hexahedron   ``springs``, ``correction``
     ``golec_cube``               hexahedron   ``springs``, ``volume``
+    ``delingette_triangle``      triangle     ``springs``
+    ``lsq_triangle``             triangle     ``springs``
+    ``lsq_tetrahedron``          tetra        ``springs``
     ============================ ============ =========================================
+
+    (every MSS model of the registry, a test checks; the documentation's model table, generated
+    from the registry, adds each model's family, options and where it is exact.)
 
     Options: ``published: true`` uses the formulas as printed in the papers (see
     :mod:`msslib.parameters`; models without a separate printed variant ignore it), ``terms`` the
