@@ -115,3 +115,39 @@ def test_api_docstring_lists_every_build_model_option():
     options = ["published", "terms", *option_names()]
     missing += [o for o in options if f"``{o}``" not in doc]
     assert not missing, f"build_model's docstring does not name {missing}"
+
+
+def _chromium() -> str:
+    """Debian's chromium, installed with apt-get where missing (as root); else one clear failure."""
+    import os
+    import shutil
+
+    found = shutil.which("chromium") or shutil.which("chromium-browser")
+    if found:
+        return found
+    if os.geteuid() != 0 or not shutil.which("apt-get"):
+        pytest.fail("the headless-browser check needs chromium: install Debian's package (apt-get install -y chromium)")
+    run = subprocess.run(["apt-get", "install", "-y", "-q", "chromium"], capture_output=True, text=True, timeout=600,
+                         env={**os.environ, "DEBIAN_FRONTEND": "noninteractive"})
+    found = shutil.which("chromium")
+    if run.returncode != 0 or not found:
+        pytest.fail(f"apt-get install -y chromium failed (exit {run.returncode}): {run.stderr.strip()[-300:]}")
+    return found
+
+
+def test_site_renders_in_headless_chromium(site, tmp_path):
+    browser = _chromium()
+    flags = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--window-size=1200,900"]
+    dom = subprocess.run([*flags, "--dump-dom", (site / "models.html").as_uri()], capture_output=True, text=True,
+                         timeout=120).stdout
+    table = re.search(r'<table[^>]*msslib-models.*?</table>', dom, re.S)
+    assert table, "the browser's DOM of models.html has no model table"
+    for name in model_names():
+        assert f">{name}<" in table.group(0), name
+    shot = tmp_path / "index.png"
+    subprocess.run([*flags, f"--screenshot={shot}", (site / "index.html").as_uri()], capture_output=True, timeout=120)
+    data = shot.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+    assert (width, height) == (1200, 900)
+    assert len(data) > 10_000  # a rendered page, not a blank one (a blank 1200x900 PNG is a few kB)
