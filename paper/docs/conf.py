@@ -25,7 +25,7 @@ html_theme = "alabaster"
 html_static_path = []
 html_title = "msslib documentation"
 # no link to a network resource: the site opens offline
-html_theme_options = {"show_powered_by": False}
+html_theme_options = {"show_powered_by": False, "page_width": "95%", "body_max_width": "none"}  # the tables are wide
 
 # The reST of the package's docstrings is the package's own: a docstring whose markup docutils
 # reads with a complaint (an indented continuation it takes for a block quote, say) still renders,

@@ -24,7 +24,7 @@ def _exactness(spec) -> str:
         nu = "any nu" if e.nu is None else f"nu = {e.nu:.4g}"
         opts = ", ".join(f"{k}={v}" for k, v in e.options.items())
         out.append(f"{e.level}, {e.mesh} cells, {nu}" + (f" ({opts})" if opts else ""))
-    return "; ".join(out) or "nowhere (approximate)"
+    return "; ".join(out) or "not claimed (approximate)"
 
 
 def model_rows() -> list[tuple[str, ...]]:
