@@ -217,13 +217,13 @@ def spring_constants(model):
     nodes in the mesh; it differs from ``rest_length`` for prestrained springs); along ``cell``:
     ``k_volume`` (J) and ``rest_volume`` (m^3) of Lloyd's tetrahedron volume term, ``kappa`` (Pa)
     and ``rest_volume`` of Golec's hexahedron volume term, ``correction_factor`` (1) of Baudet's
-    correction.  The springs as a pandas table:
+    correction (either reading), ``k_01`` ... ``c_01_02`` (N m-3) of Delingette's triangle: each term
+    declares its per-cell constants (:attr:`msslib.terms.Term.cell_constants`).  The springs as a pandas table:
     ``table[["node_a", "node_b", "spring_constant", "rest_length"]].to_dataframe()``.
     """
     import xarray as xr
 
     from msslib.model import Model
-    from msslib.terms import BaudetCorrection, HexVolume, Springs, TetVolume
 
     name = None
     if isinstance(model, ModelSetup):
@@ -235,7 +235,7 @@ def spring_constants(model):
         raise ValueError(f"spring_constants: expected what msslib.build_model returns (or a msslib.model.Model), "
                          f"got {type(model).__name__}")
     mesh = model.mesh
-    springs = [t for t in model.terms if isinstance(t, Springs)]
+    springs = [t for t in model.terms if t.kind == "springs"]
     pairs = np.concatenate([t.conn for t in springs]) if springs else np.zeros((0, 2), dtype=np.int64)
     k = np.concatenate([t.k for t in springs]) if springs else np.zeros(0)
     rest = np.concatenate([t.rest_length for t in springs]) if springs else np.zeros(0)
@@ -247,22 +247,16 @@ def spring_constants(model):
         "rest_length": _var(("spring",), rest, "m", "spring rest length"),
         "rest_distance": _var(("spring",), distance, "m", "distance of the end nodes in the mesh at rest"),
     }
-    per_cell = {
-        TetVolume: (("k_volume", "k_v", "J", "volume constant k_V of Lloyd's tetrahedron, energy k_V/(2 V0^2) (V - V0)^2"),
-                    ("rest_volume", "V0", "m3", "rest volume of the cell")),
-        HexVolume: (("kappa", "kappa", "Pa", "Golec's volume coefficient kappa, energy kappa/(2 V0) (V - V0)^2"),
-                    ("rest_volume", "V0", "m3", "rest (averaged-edge) volume of the cell")),
-        BaudetCorrection: (("correction_factor", "factor", "1", "Baudet's correction factor c, F_perp = c F_i"),),
-    }
-    for cls, variables in per_cell.items():
-        terms = [t for t in model.terms if isinstance(t, cls)]
-        if not terms:
-            continue
+    by_type: dict = {}  # the terms with per-cell constants (each declares them: Term.cell_constants)
+    for t in model.terms:
+        if t.cell_constants:
+            by_type.setdefault(type(t), []).append(t)
+    for cls, terms in by_type.items():
         conn = getattr(terms[0], "conn", mesh.cells)
         if len(terms) > 1 or conn.shape != mesh.cells.shape or not np.array_equal(conn, mesh.cells):
             raise ValueError(f"spring_constants: the model has {len(terms)} {cls.__name__} term(s) on other "
                              f"elements than the mesh's cells; read their constants from model.terms")
-        for var, attr, units, long_name in variables:
+        for var, attr, units, long_name in terms[0].cell_constants:
             data[var] = _var(("cell",), np.asarray(getattr(terms[0], attr), dtype=float), units, long_name)
     attrs = {"terms": ", ".join(type(t).__name__ for t in model.terms)}
     if name is not None:

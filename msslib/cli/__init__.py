@@ -425,7 +425,7 @@ def _cmd_plan(args) -> int:
 
 
 def _add_export(subparsers) -> None:
-    from msslib.export import FORMATS
+    from msslib.export.files import format_help
 
     p = subparsers.add_parser(
         "export", help="write a scene's mass-spring system without solving it (CSV, JSON, VTU, MuJoCo, SOFA, C)",
@@ -440,8 +440,7 @@ def _add_export(subparsers) -> None:
                    help="a directory (existing, or ending in '/': the files are named after the scene) or a path "
                         "prefix STEM: STEM_TABLE.csv, STEM.json, STEM.vtu, STEM_mujoco.xml, STEM.scn, msslib_mss.h")
     p.add_argument("--format", "-f", dest="formats", metavar="LIST",
-                   help=f"formats separated by commas, from {','.join(FORMATS)} (default: every format that carries "
-                        f"the whole model)")
+                   help=format_help())
     p.add_argument("--quiet", "-q", action="store_true", help="no summary line")
     p.set_defaults(func=_cmd_export)
 

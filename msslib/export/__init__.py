@@ -51,12 +51,11 @@ to the same stem removes those it no longer writes, and nothing else; it never o
 that is not the export's.
 """
 
+from msslib.export.files import FORMAT_TABLE, FORMATS, SPRINGS_ONLY_FORMATS, Format
 from msslib.export.model import (
     C_HEADER_PATH,
-    FORMATS,
     SCHEMA,
     SCHEMA_VERSION,
-    SPRINGS_ONLY_FORMATS,
     Column,
     MssExport,
     Table,
@@ -66,5 +65,5 @@ from msslib.export.model import (
     not_carried,
 )
 
-__all__ = ["FORMATS", "SPRINGS_ONLY_FORMATS", "SCHEMA", "SCHEMA_VERSION", "C_HEADER_PATH", "c_header_paths", "Column",
+__all__ = ["FORMATS", "FORMAT_TABLE", "Format", "SPRINGS_ONLY_FORMATS", "SCHEMA", "SCHEMA_VERSION", "C_HEADER_PATH", "c_header_paths", "Column",
            "Table", "MssExport", "build", "from_setup", "not_carried"]

@@ -18,12 +18,14 @@ import re
 import secrets
 import shutil
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 from msslib.export import simulators as export_simulators
 from msslib.export import text as export_text
 from msslib.errors import MsslibWarning
-from msslib.export.model import C_HEADER_PATH, FORMATS, SPRINGS_ONLY_FORMATS, MssExport, _safe_name, c_header_paths, not_carried  # noqa: F401
+from msslib.export.model import C_HEADER_PATH, MssExport, _safe_name, c_header_paths, not_carried  # noqa: F401
 from msslib.export.model import _version
 from msslib.results.staging import TEMP_TAG, StagedOutputs, terminate_raises
 
@@ -33,6 +35,83 @@ MANIFEST_SUFFIX = ".export-manifest.json"
 # --------------------------------------------------------------------------------------------
 # formats and file names
 # --------------------------------------------------------------------------------------------
+
+
+def _text(make):
+    def write(path):
+        Path(path).write_text(make(), encoding="utf-8")
+    return write
+
+
+def _csv_files(exp, stem):
+    return [(f"CSV table {name}", stem.with_name(f"{stem.name}_{name}.csv"), name) for name in exp.tables()]
+
+
+def _one_file(what, suffix):
+    return lambda exp, stem: [(what, stem.with_name(f"{stem.name}{suffix}"), None)]
+
+
+def _c_files(exp, stem):
+    return [(f"C header {p.name}", stem.with_name(p.name), p.name) for p in c_header_paths()]
+
+
+@dataclass(frozen=True)
+class Format:
+    """One export format: its ``name`` (as ``--format`` takes it), ``files(exp, stem)`` -> ``[(what,
+    path, table)]`` of the files it writes, ``writer(exp, table)`` -> ``write(path)`` of one of them,
+    what it ``carries`` (a phrase), whether it is written by default only when it carries every term
+    of the model (``whole_only``: MuJoCo and SOFA; the others are always written by default), and
+    the ``help`` text of ``msslib export --format``. Which terms a format carries the terms say
+    themselves (:attr:`msslib.terms.Term.export_formats`)."""
+
+    name: str
+    files: Callable
+    writer: Callable
+    carries: str
+    help: str
+    whole_only: bool = False
+
+
+#: every format, in the order outputs are written
+FORMAT_TABLE: tuple[Format, ...] = (
+    Format("csv", _csv_files, lambda exp, table: _text(lambda: export_text.csv_text(exp.tables()[table])),
+           "every table: nodes, springs, fixed, loads, gravity and each term's own tables",
+           "one table per file STEM_TABLE.csv, header row with units"),
+    Format("json", _one_file("JSON document", ".json"), lambda exp, table: _text(lambda: export_text.json_text(exp)),
+           "every table and term, with a schema version", "one document STEM.json with a schema version"),
+    Format("vtu", _one_file("VTU file", ".vtu"), lambda exp, table: lambda path: export_text.write_vtu(path, exp),
+           "the springs as line cells, masses, fixed axes, loads and the terms' constant forces",
+           "springs as line cells STEM.vtu (ParaView)"),
+    Format("mjcf", _one_file("MuJoCo model", "_mujoco.xml"),
+           lambda exp, table: _text(lambda: export_simulators.mjcf_text(exp)),
+           "the springs as tendons, masses, fixed axes, loads, gravity and constant forces",
+           "a MuJoCo model STEM_mujoco.xml (springs only: other terms are named in a note)", whole_only=True),
+    Format("sofa", _one_file("SOFA scene", ".scn"), lambda exp, table: _text(lambda: export_simulators.sofa_text(exp)),
+           "the springs, masses, fixed axes, loads and constant forces",
+           "a SOFA scene STEM.scn (springs only: other terms are named in a note)", whole_only=True),
+    Format("c", _c_files,
+           lambda exp, table: _text(lambda: (C_HEADER_PATH.parent / (table or C_HEADER_PATH.name)).read_text(
+               encoding="utf-8")),
+           "the generated C headers (the formulas and kernels of every term)", "the generated C headers msslib_mss.h"),
+)
+FORMATS_BY_NAME = {f.name: f for f in FORMAT_TABLE}
+#: every format, in the order outputs are written
+FORMATS = tuple(FORMATS_BY_NAME)
+#: formats written by default only for models they carry whole (the springs-only formats)
+SPRINGS_ONLY_FORMATS = tuple(f.name for f in FORMAT_TABLE if f.whole_only)
+
+
+def format_help() -> str:
+    """The help of ``msslib export --format``, from :data:`FORMAT_TABLE`."""
+    return ("formats separated by commas (default: every format that carries the whole model): "
+            + "; ".join(f"{f.name}: {f.help}" for f in FORMAT_TABLE))
+
+
+def _format(fmt: str) -> Format:
+    try:
+        return FORMATS_BY_NAME[fmt]
+    except KeyError:
+        raise ValueError(f"unknown format {fmt!r}") from None
 
 
 def parse_formats(text: str | None) -> tuple[str, ...] | None:
@@ -52,12 +131,9 @@ def parse_formats(text: str | None) -> tuple[str, ...] | None:
 
 
 def default_formats(exp: MssExport) -> tuple[str, ...]:
-    """Every format that carries the whole model: MuJoCo and SOFA only without volume terms."""
-    return tuple(f for f in FORMATS if not (f in SPRINGS_ONLY_FORMATS and exp.volume_terms))
-
-
-
-
+    """Every format that carries the whole model: MuJoCo and SOFA only when every term of the model
+    says they carry it."""
+    return tuple(f.name for f in FORMAT_TABLE if not (f.whole_only and exp.volume_terms))
 
 
 def output_paths(exp: MssExport, stem: Path, formats) -> list[tuple[str, str, Path, str | None]]:
@@ -66,46 +142,13 @@ def output_paths(exp: MssExport, stem: Path, formats) -> list[tuple[str, str, Pa
     ``STEM.vtu``, MuJoCo ``STEM_mujoco.xml``, SOFA ``STEM.scn``, C ``msslib_mss.h`` and the headers it
     includes in the stem's directory (``table``: the header's file name)."""
     stem = Path(stem)
-    out = []
-    for fmt in formats:
-        if fmt == "csv":
-            out += [("csv", f"CSV table {name}", stem.with_name(f"{stem.name}_{name}.csv"), name)
-                    for name in exp.tables()]
-        elif fmt == "json":
-            out.append(("json", "JSON document", stem.with_name(f"{stem.name}.json"), None))
-        elif fmt == "vtu":
-            out.append(("vtu", "VTU file", stem.with_name(f"{stem.name}.vtu"), None))
-        elif fmt == "mjcf":
-            out.append(("mjcf", "MuJoCo model", stem.with_name(f"{stem.name}_mujoco.xml"), None))
-        elif fmt == "sofa":
-            out.append(("sofa", "SOFA scene", stem.with_name(f"{stem.name}.scn"), None))
-        elif fmt == "c":
-            out += [("c", f"C header {p.name}", stem.with_name(p.name), p.name) for p in c_header_paths()]
-        else:
-            raise ValueError(f"unknown format {fmt!r}")
-    return out
+    return [(fmt, what, path, table) for fmt in formats for what, path, table in _format(fmt).files(exp, stem)]
 
 
 def file_writer(exp: MssExport, fmt: str, table: str | None = None):
     """``writer(path)`` that writes one output of ``fmt`` (for :class:`msslib.results.staging.StagedOutputs`,
     which then names the destination in any error)."""
-    def text(make):
-        def write(path):
-            Path(path).write_text(make(), encoding="utf-8")
-        return write
-
-    if fmt == "csv":
-        return text(lambda: export_text.csv_text(exp.tables()[table]))
-    if fmt == "json":
-        return text(lambda: export_text.json_text(exp))
-    if fmt == "vtu":
-        return lambda path: export_text.write_vtu(path, exp)
-    if fmt in ("mjcf", "sofa"):
-        make = export_simulators.mjcf_text if fmt == "mjcf" else export_simulators.sofa_text
-        return text(lambda: make(exp))
-    if fmt == "c":
-        return text(lambda: (C_HEADER_PATH.parent / (table or C_HEADER_PATH.name)).read_text(encoding="utf-8"))
-    raise ValueError(f"unknown format {fmt!r}")
+    return _format(fmt).writer(exp, table)
 
 
 def stem_for(out: Path, scene_name: str, directory: bool) -> Path:

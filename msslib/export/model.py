@@ -10,13 +10,11 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["FORMATS", "SPRINGS_ONLY_FORMATS", "SCHEMA", "SCHEMA_VERSION", "C_HEADER_PATH", "c_header_paths", "Column",
-           "Table", "MssExport", "build", "from_setup", "not_carried"]
+from msslib.terms.base import Column, Table, _col
 
-#: every format, in the order outputs are written
-FORMATS = ("csv", "json", "vtu", "mjcf", "sofa", "c")
-#: formats that cannot express volume terms (they get the springs-only part, with a note)
-SPRINGS_ONLY_FORMATS = ("mjcf", "sofa")
+__all__ = ["SCHEMA", "SCHEMA_VERSION", "C_HEADER_PATH", "c_header_paths", "Column", "Table", "MssExport", "build",
+           "from_setup", "not_carried"]
+
 SCHEMA = "msslib-mss-export"
 SCHEMA_VERSION = 1
 #: the umbrella C header; every module's header is beside it (msslib/generated/c/)
@@ -39,52 +37,6 @@ UNITS = {"length": "m", "mass": "kg", "force": "N", "stiffness": "N/m", "pressur
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass
-class Column:
-    """One column: ``name``, ``unit`` (None for indices and flags; ``"1"`` for dimensionless
-    numbers), ``values`` (1D int or float array) and a description."""
-
-    name: str
-    unit: str | None
-    values: np.ndarray
-    description: str = ""
-
-    @property
-    def header(self) -> str:
-        return self.name if self.unit is None else f"{self.name} [{self.unit}]"
-
-
-@dataclass
-class Table:
-    name: str
-    description: str
-    columns: list[Column] = field(default_factory=list)
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        for c in self.columns:
-            if c.name == name:
-                return c.values
-        raise KeyError(f"table {self.name!r} has no column {name!r}; it has {', '.join(self.names)}")
-
-    @property
-    def names(self) -> list[str]:
-        return [c.name for c in self.columns]
-
-    @property
-    def n_rows(self) -> int:
-        return len(self.columns[0].values) if self.columns else 0
-
-
-def _col(name, unit, values, description="", dtype=float):
-    return Column(name, unit, np.ascontiguousarray(values, dtype=dtype), description)
-
-
-def _cell_columns(conn, solid: str) -> list[Column]:
-    """The columns that name each cell of a per-cell table: its index and its nodes ``conn`` (m, k),
-    ``solid`` the kind of cell (``"tetrahedron"``, ``"hexahedron"``)."""
-    return [_col("cell", None, np.arange(len(conn)), "cell index", int),
-            *[_col(f"node_{a}", None, conn[:, a], f"node {a} of the {solid}", int) for a in range(conn.shape[1])]]
-
 
 # --------------------------------------------------------------------------------------------
 # the model
@@ -97,9 +49,8 @@ class MssExport:
 
     ``points`` (n, dim) rest positions (the mesh's); ``masses`` (n,); ``fixed`` (n, dim) bool and
     ``prescribed`` (n, dim) displacements at load factor 1; ``pairs`` (s, 2), ``stiffness`` (s,),
-    ``rest_length`` (s,); ``tet_volume`` / ``hex_volume`` / ``correction`` the model's
-    :class:`msslib.terms.TetVolume`, :class:`~msslib.terms.HexVolume`,
-    :class:`~msslib.terms.BaudetCorrection` (or None); ``loads`` (n, dim) surface loads at load
+    ``rest_length`` (s,); ``terms`` the model's other exported terms (volume, angular, correction:
+    each describes itself, :class:`msslib.terms.Term`); ``loads`` (n, dim) surface loads at load
     factor 1; ``gravity`` (dim,) or None; ``damping`` (alpha, beta) of a dynamic scene.
     """
 
@@ -113,9 +64,7 @@ class MssExport:
     pairs: np.ndarray
     stiffness: np.ndarray
     rest_length: np.ndarray
-    tet_volume: object = None
-    hex_volume: object = None
-    correction: object = None
+    terms: list = field(default_factory=list)
     loads: np.ndarray | None = None
     gravity: np.ndarray | None = None
     damping: tuple = (0.0, 0.0)
@@ -135,17 +84,34 @@ class MssExport:
     def n_nodes(self) -> int:
         return self.setup.mesh.n_nodes
 
+    def _term(self, name):
+        return next((t for t in self.terms if t.export_name == name), None)
+
+    @property
+    def tet_volume(self):
+        """The model's term with table ``tet_volume`` (Lloyd's), or None."""
+        return self._term("tet_volume")
+
+    @property
+    def hex_volume(self):
+        """The model's term with table ``hex_volume`` (Golec's), or None."""
+        return self._term("hex_volume")
+
+    @property
+    def correction(self):
+        """The model's term with table ``baudet_correction`` (Baudet's, boundary reading), or None."""
+        return self._term("baudet_correction")
+
     @property
     def volume_terms(self) -> list[str]:
-        """One phrase per volume term of the model (what MuJoCo and SOFA cannot carry)."""
-        out = []
-        if self.tet_volume is not None:
-            out.append(f"Lloyd's tetrahedron volume energy k_v/(2 V0^2) (V - V0)^2 on {len(self.tet_volume)} "
-                       f"cells (table tet_volume)")
-        if self.hex_volume is not None:
-            out.append(f"Golec's volume energy kappa/(2 V0) (V - V0)^2 on {len(self.hex_volume)} cells "
-                       f"(table hex_volume)")
-        return out
+        """One phrase per term of the model that MuJoCo and SOFA cannot carry (volume, angular and
+        element-reading correction terms), naming its table."""
+        return [note for t in self.terms if (note := t.export_note("mjcf")) is not None]
+
+    def forces(self) -> list[tuple[str, np.ndarray, str]]:
+        """``(label, nodal forces at load factor 1, description)`` of the terms that the simulator
+        formats carry as constant forces (Baudet's correction)."""
+        return [f for t in self.terms for f in t.export_forces()]
 
     def tables(self) -> dict[str, Table]:
         """The tables of the CSV and JSON outputs, by name (built once)."""
@@ -171,25 +137,23 @@ def build(scene) -> MssExport:
 def from_setup(setup) -> MssExport:
     """Collect the MSS of a prepared scene (:class:`msslib.scene.Setup`); the model's terms are read
     as they are (a term of an unknown kind is an error: nothing is left out silently)."""
-    from msslib.terms import BaudetCorrection, Gravity, HexVolume, NodalForces, Springs, TetVolume
-
     model = setup.model
     if model is None:
         raise ValueError("the scene has no mass-spring model to export")
-    springs, tet, hexv, corr = [], None, None, None
+    springs, others = [], []
     for t in model.terms:
-        if isinstance(t, Springs):
+        if t.kind == "springs":
             springs.append(t)
-        elif isinstance(t, TetVolume):
-            tet = t if tet is None else _merge_error("TetVolume")
-        elif isinstance(t, HexVolume):
-            hexv = t if hexv is None else _merge_error("HexVolume")
-        elif isinstance(t, BaudetCorrection):
-            corr = t if corr is None else _merge_error("BaudetCorrection")
-        elif isinstance(t, (NodalForces, Gravity)):
+        elif t.kind == "external":
             pass  # the scene's surface loads and gravity, taken from the setup below
+        elif t.kind is not None and t.export_name:
+            if any(o.export_name == t.export_name for o in others):
+                raise ValueError(f"the model has two {type(t).__name__} terms (table {t.export_name}); export "
+                                 f"expects one")
+            others.append(t)
         else:
-            raise ValueError(f"cannot export a term of type {type(t).__name__}")
+            raise ValueError(f"cannot export a term of type {type(t).__name__} (model {setup.scene.model}): it "
+                             f"declares no export kind and tables (msslib.terms.Term)")
     dim = model.dim
     pairs = np.concatenate([s.pairs for s in springs]) if springs else np.zeros((0, 2), dtype=np.int64)
     k = np.concatenate([s.k for s in springs]) if springs else np.zeros(0)
@@ -208,18 +172,12 @@ def from_setup(setup) -> MssExport:
     return MssExport(scene=scene, setup=setup, model=model,
                      masses=masses, mass_source=source, fixed=np.asarray(setup.fixed, dtype=bool).reshape(-1, dim),
                      prescribed=np.asarray(setup.prescribed, dtype=float).reshape(-1, dim), pairs=pairs,
-                     stiffness=k, rest_length=rest, tet_volume=tet, hex_volume=hexv, correction=corr,
+                     stiffness=k, rest_length=rest, terms=others,
                      loads=np.asarray(setup.surface_forces, dtype=float).reshape(-1, dim), gravity=gravity,
                      damping=damping)
 
 
-def _merge_error(kind):
-    raise ValueError(f"the model has two {kind} terms; export expects one")
-
-
 def _tables(exp: MssExport) -> dict[str, Table]:
-    from msslib.terms import _HEX_FACES
-
     dim, n = exp.dim, exp.n_nodes
     axes = AXES[:dim]
     nodes = np.arange(n)
@@ -254,43 +212,9 @@ def _tables(exp: MssExport) -> dict[str, Table]:
     out["gravity"] = Table("gravity", "gravitational acceleration (each node carries its mass times it; zero: "
                                       "no gravity)", [_col(f"g_{a}", "m/s^2", [g[i]], f"gravity, {a}")
                                                       for i, a in enumerate(axes)])
-    if exp.tet_volume is not None:
-        t = exp.tet_volume
-        out["tet_volume"] = Table("tet_volume", "Lloyd's tetrahedron volume energy k_v/(2 V0^2) (V - V0)^2, V the "
-                                                "signed volume of (node_0, ..., node_3) (C: msslib_tet_signed_volume)", [
-            *_cell_columns(t.conn, "tetrahedron"),
-            _col("k_v", "J", t.k_v, "volume coefficient k_v (may be negative)"),
-            _col("V0", "m^3", t.V0, "rest volume of the cell"),
-        ])
-    if exp.hex_volume is not None:
-        h = exp.hex_volume
-        out["hex_volume"] = Table("hex_volume", "Golec's volume energy kappa/(2 V0) (V - V0)^2, V the averaged-edge-"
-                                                "vector volume of the hexahedron (node_0, ..., node_7) in VTK order "
-                                                "(C: msslib_hex_averaged_volume)", [
-            *_cell_columns(h.conn, "hexahedron"),
-            _col("kappa", "Pa", h.kappa, "volume coefficient kappa (may be negative)"),
-            _col("V0", "m^3", h.V0, "rest (averaged) volume of the cell"),
-        ])
-    if exp.correction is not None:
-        c = exp.correction
-        cells = exp.setup.mesh.cells
-        faces = "; ".join(f"face {f}: local nodes {' '.join(map(str, nodes_))}" for f, nodes_ in enumerate(_HEX_FACES))
-        out["baudet_correction"] = Table("baudet_correction", "Baudet's orthogonal correction per cube: factor c "
-                                         "(F_perp = c F_i) and the elongation force of each face at load factor 1 "
-                                         f"({faces}; msslib.terms.BaudetCorrection)", [
-            *_cell_columns(cells, "hexahedron"),
-            _col("factor", "1", c.factor, "correction factor c"),
-            *[_col(f"face_force_{f}", "N", c.face_force[:, f], f"elongation force of face {f} (> 0 tension)")
-              for f in range(6)],
-        ])
-        fc = c.nodal
-        on = np.flatnonzero(np.any(fc != 0, axis=1))
-        out["baudet_correction_forces"] = Table(
-            "baudet_correction_forces", "nodal forces of Baudet's correction at load factor 1 (they scale with the "
-                                        "load; constant in the reference configuration)", [
-                _col("node", None, on, "node index", int),
-                *[_col(f"f_{a}", "N", fc[on, i], f"force, {a}") for i, a in enumerate(axes)],
-            ])
+    for t in exp.terms:
+        for table in t.export_tables(exp.setup.mesh):
+            out[table.name] = table
     return out
 
 
@@ -299,17 +223,12 @@ def _tables(exp: MssExport) -> dict[str, Table]:
 # --------------------------------------------------------------------------------------------
 
 def not_carried(exp: MssExport, fmt: str) -> list[str]:
-    """What of the model ``fmt`` leaves out (an empty list: all of it)."""
-    out = []
-    if fmt in SPRINGS_ONLY_FORMATS:
-        out += exp.volume_terms
-        if fmt == "mjcf" and exp.damping[1] != 0.0:
-            out.append(f"the stiffness-proportional damping beta = {exp.damping[1]!r} s (only the mass-proportional "
-                       f"alpha is carried, as joint damping)")
-    elif fmt == "vtu" and (exp.volume_terms or exp.correction is not None):
-        out += [v.split(" (table")[0] for v in exp.volume_terms]
-        if exp.correction is not None:
-            out.append("Baudet's per-cell correction factors (the nodal correction forces are carried)")
+    """What of the model ``fmt`` leaves out (an empty list: all of it): each term says what the
+    format leaves out of it (:meth:`msslib.terms.Term.export_note`)."""
+    out = [note for t in exp.terms if (note := t.export_note(fmt)) is not None]
+    if fmt == "mjcf" and exp.damping[1] != 0.0:
+        out.append(f"the stiffness-proportional damping beta = {exp.damping[1]!r} s (only the mass-proportional "
+                   f"alpha is carried, as joint damping)")
     return out
 
 

@@ -243,9 +243,7 @@ def mjcf_text(exp: MssExport) -> str:
                                width=_f(0.01 * h))
             ET.SubElement(sp, "site", site=f"node{int(i)}")
             ET.SubElement(sp, "site", site=f"node{int(j)}")
-    forces = [("load", exp.loads)]
-    if exp.correction is not None:
-        forces.append(("baudet_correction", exp.correction.nodal))
+    forces = [("load", exp.loads)] + [(label, F) for label, F, _ in exp.forces()]
     actuators = []
     for label, F in forces:
         for i in range(n):
@@ -338,9 +336,7 @@ def sofa_text(exp: MssExport) -> str:
         label = "".join(a for a, m in zip(AXES, mask) if m)
         _sofa(node, "PartialFixedProjectiveConstraint", name=f"fixed_{label}", indices=_ints(idx),
               fixedDirections=_ints(mask))
-    forces = [("loads", exp.loads, "surface loads (N) at load factor 1")]
-    if exp.correction is not None:
-        forces.append(("baudet_correction", exp.correction.nodal, "Baudet's correction forces (N) at load factor 1"))
+    forces = [("loads", exp.loads, "surface loads (N) at load factor 1")] + exp.forces()
     for name, F, what in forces:
         on = np.flatnonzero(np.any(F != 0, axis=1))
         if len(on):

@@ -66,18 +66,7 @@ def json_document(exp: MssExport) -> dict:
     scene = exp.scene
     terms = [{"kind": "springs", "count": int(len(exp.pairs)), "table": "springs",
               "energy": "k/2 (|x_j - x_i| - L)^2", "conservative": True, "scales_with_load": False}]
-    if exp.tet_volume is not None:
-        terms.append({"kind": "tet_volume", "count": len(exp.tet_volume), "table": "tet_volume",
-                      "energy": "k_v/(2 V0^2) (V - V0)^2, V signed tetrahedron volume", "conservative": True,
-                      "scales_with_load": False})
-    if exp.hex_volume is not None:
-        terms.append({"kind": "hex_volume", "count": len(exp.hex_volume), "table": "hex_volume",
-                      "energy": "kappa/(2 V0) (V - V0)^2, V averaged-edge-vector hexahedron volume",
-                      "conservative": True, "scales_with_load": False})
-    if exp.correction is not None:
-        terms.append({"kind": "baudet_correction", "count": int(len(exp.correction.factor)),
-                      "table": "baudet_correction", "forces_table": "baudet_correction_forces",
-                      "energy": None, "conservative": False, "scales_with_load": True})
+    terms += [t.export_entry() for t in exp.terms]
     tables = {}
     for name, t in exp.tables().items():
         tables[name] = {"description": t.description,
@@ -144,13 +133,14 @@ def read_json(path) -> tuple[dict, dict[str, Table]]:
 def write_vtu(path, exp: MssExport) -> Path:
     """The springs as VTK line cells with cell data ``stiffness`` (N/m) and ``rest_length`` (m), on
     the rest positions, with point data ``mass`` (kg), ``fixed`` (0/1 per axis),
-    ``prescribed_displacement`` (m), ``load`` (N) and ``baudet_correction`` (N, when present)."""
+    ``prescribed_displacement`` (m), ``load`` (N) and the constant forces of the terms
+    (``baudet_correction``, N, when present: :meth:`MssExport.forces`)."""
     import meshio
 
     point_data = {"mass": exp.masses, "fixed": _pad3(exp.fixed.astype(np.int8)),
                   "prescribed_displacement": _pad3(exp.prescribed), "load": _pad3(exp.loads)}
-    if exp.correction is not None:
-        point_data["baudet_correction"] = _pad3(exp.correction.nodal)
+    for label, forces, _ in exp.forces():
+        point_data[label] = _pad3(forces)
     mesh = meshio.Mesh(_pad3(exp.points), [("line", exp.pairs.astype(np.int64))], point_data=point_data,
                        cell_data={"stiffness": [exp.stiffness], "rest_length": [exp.rest_length]})
     meshio.write(path, mesh, file_format="vtu")

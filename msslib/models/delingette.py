@@ -26,6 +26,7 @@ from msslib.models.checks import evaluate, poisson, positive, same_shape
 from msslib.models.common import _require, material_arrays
 from msslib.models.spec import Exactness, ModelSpec
 from msslib.terms import Term
+from msslib.terms.base import Table, _cell_columns, _col
 from msslib.terms.assembly import _block_pattern
 from msslib.terms.jit import _jit
 
@@ -77,6 +78,54 @@ class TriangleAngular(Term):
     """The energy of the module docstring on triangles ``cells`` (m, 3) of a 2D mesh, with the
     constants ``Q`` (m, 3, 3) (``Q_ii = k_i``, ``Q_ij = c_ij``: ``W = 1/4 D^T Q D``) and the rest
     squared lengths ``L2`` (m, 3)."""
+
+    kind = "angular"
+    export_name = "delingette_triangle"
+    export_label = "Delingette's tensile and angular triangle energy 1/4 D^T Q D"
+    export_energy = ("sum_i k_i/4 D_i^2 + sum_{i<j} c_ij/2 D_i D_j, D_i = |x_b - x_a|^2 - L2_i on edge i = "
+                     "(node_0, node_1), (node_1, node_2), (node_0, node_2)")
+    cell_constants = tuple((f"{name}", f"_{name}", "N m-3", f"Delingette's {what} constant {name}")
+                           for name, what in (("k_01", "tensile"), ("k_12", "tensile"), ("k_02", "tensile"),
+                                              ("c_01_12", "angular"), ("c_12_02", "angular"), ("c_01_02", "angular")))
+
+    @property
+    def _k_01(self):
+        return self.Q[:, 0, 0]
+
+    @property
+    def _k_12(self):
+        return self.Q[:, 1, 1]
+
+    @property
+    def _k_02(self):
+        return self.Q[:, 2, 2]
+
+    @property
+    def _c_01_12(self):
+        return self.Q[:, 0, 1]
+
+    @property
+    def _c_12_02(self):
+        return self.Q[:, 1, 2]
+
+    @property
+    def _c_01_02(self):
+        return self.Q[:, 0, 2]
+
+    def export_tables(self, mesh) -> list[Table]:
+        edges = ("01", "12", "02")
+        return [Table(self.export_name, "Delingette's triangle per cell: W = sum_i k_i/4 D_i^2 + sum_{i<j} c_ij/2 "
+                      "D_i D_j, D_i = |x_b - x_a|^2 - L2_i the change of squared length of edge i = (node_0, node_1), "
+                      "(node_1, node_2), (node_0, node_2) (msslib.models.delingette.TriangleAngular; thickness "
+                      "included in the constants)", [
+                          *_cell_columns(self.conn, "triangle"),
+                          *[_col(f"k_{e}", "N/m^3", self.Q[:, i, i], f"tensile constant of edge {e}")
+                            for i, e in enumerate(edges)],
+                          *[_col(f"c_{edges[i]}_{edges[j]}", "N/m^3", self.Q[:, i, j],
+                                 f"angular constant of edges {edges[i]} and {edges[j]}") for i, j in PAIRS],
+                          *[_col(f"L2_{e}", "m^2", self.L2[:, i], f"rest squared length of edge {e}")
+                            for i, e in enumerate(edges)],
+                      ])]
 
     def __init__(self, cells, Q, L2):
         self.dim = 2

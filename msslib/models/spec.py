@@ -165,11 +165,9 @@ class ModelSpec:
 def split_terms(terms, wanted) -> dict:
     """``{term name: [Term, ...]}`` of the ``wanted`` internal terms among ``terms`` (a builder's
     list): springs are ``"springs"``, volume terms ``"volume"``."""
-    from msslib.terms import HexVolume, Springs, TetVolume
-
     out: dict = {}
     for t in terms:
-        kind = "springs" if isinstance(t, Springs) else "volume" if isinstance(t, (TetVolume, HexVolume)) else None
+        kind = t.kind if t.kind in ("springs", "volume") else None  # each term declares its kind
         if kind is None:
             raise TypeError(f"unexpected internal term {type(t).__name__}")
         if kind in wanted:

@@ -189,9 +189,7 @@ def run_scene(scene, progress=True):
 
     springs = k = rest = None
     if setup.model is not None:
-        from msslib.terms import Springs
-
-        sp = [t for t in setup.model.terms if isinstance(t, Springs)]
+        sp = [t for t in setup.model.terms if t.kind == "springs"]
         if sp:
             springs = np.concatenate([t.pairs for t in sp])
             k = np.concatenate([t.k for t in sp])

@@ -3,6 +3,8 @@ checks they share; the interface is described in :mod:`msslib.terms`."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from .assembly import _block_pattern
@@ -40,17 +42,123 @@ def _format_bad(ids, values, label, conn=None, max_report=10) -> str:
 
 
 # --------------------------------------------------------------------------------------------
+# the tables a term describes itself with
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass
+class Column:
+    """One column: ``name``, ``unit`` (None for indices and flags; ``"1"`` for dimensionless
+    numbers), ``values`` (1D int or float array) and a description."""
+
+    name: str
+    unit: str | None
+    values: np.ndarray
+    description: str = ""
+
+    @property
+    def header(self) -> str:
+        return self.name if self.unit is None else f"{self.name} [{self.unit}]"
+
+
+@dataclass
+class Table:
+    """A named table of :class:`Column` s of equal length."""
+
+    name: str
+    description: str
+    columns: list[Column] = field(default_factory=list)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        for c in self.columns:
+            if c.name == name:
+                return c.values
+        raise KeyError(f"table {self.name!r} has no column {name!r}; it has {', '.join(self.names)}")
+
+    @property
+    def names(self) -> list[str]:
+        return [c.name for c in self.columns]
+
+    @property
+    def n_rows(self) -> int:
+        return len(self.columns[0].values) if self.columns else 0
+
+
+def _col(name, unit, values, description="", dtype=float) -> Column:
+    return Column(name, unit, np.ascontiguousarray(values, dtype=dtype), description)
+
+
+def _cell_columns(conn, solid: str) -> list[Column]:
+    """The columns that name each cell of a per-cell table: its index and its nodes ``conn`` (m, k),
+    ``solid`` the kind of cell (``"tetrahedron"``, ``"hexahedron"``)."""
+    return [_col("cell", None, np.arange(len(conn)), "cell index", int),
+            *[_col(f"node_{a}", None, conn[:, a], f"node {a} of the {solid}", int) for a in range(conn.shape[1])]]
+
+
+# --------------------------------------------------------------------------------------------
 # base classes
 # --------------------------------------------------------------------------------------------
 
 
 class Term:
-    """Base class; see the module docstring for the interface."""
+    """Base class; see the module docstring for the interface.
+
+    A term also describes itself to the exporters and readers (:mod:`msslib.export`,
+    :func:`msslib.spring_constants`, the scene runner), which never test its type:
+
+    ``kind``
+        ``"springs"`` (``pairs``, ``k``, ``rest_length``: the springs table), ``"volume"``,
+        ``"angular"``, ``"correction"``, ``"external"`` (dead loads the scene states itself), or
+        None: a term that cannot be exported (the exporter refuses it, naming it).
+    ``export_name``, ``export_label``, ``export_energy``
+        the name of its table, a phrase naming it (for notes), its energy as a formula (None:
+        non-conservative).
+    ``export_formats``
+        the export formats that carry it whole (``c``: the generated headers, which hold the
+        kernels of every term); :meth:`export_note` says what another format leaves out.
+    ``cell_constants``
+        ``(variable, attribute, CF unit, long name)`` of its per-cell constants for
+        :func:`msslib.spring_constants`.
+    :meth:`export_tables`, :meth:`export_entry`, :meth:`export_forces`
+        its tables (constants as named columns with units), its entry in the JSON ``terms`` list,
+        and the constant nodal forces at load factor 1 that the simulator formats can carry.
+    """
 
     conservative = True
     scales_with_load = False
     symmetric = True
     dim: int = 3
+    kind: str | None = None
+    export_name: str = ""
+    export_label: str = ""
+    export_energy: str | None = None
+    export_formats: tuple[str, ...] = ("csv", "json", "c")
+    cell_constants: tuple = ()
+
+    def export_tables(self, mesh) -> list[Table]:
+        """The term's tables (``mesh``: the model's mesh, for terms that act on its cells)."""
+        return []
+
+    def export_entry(self) -> dict:
+        """The term's entry in the JSON document's ``terms`` list."""
+        return {"kind": self.export_name, "count": self.export_count(), "table": self.export_name,
+                "energy": self.export_energy, "conservative": self.conservative,
+                "scales_with_load": self.scales_with_load}
+
+    def export_forces(self) -> list[tuple[str, np.ndarray, str]]:
+        """``(label, nodal forces (n, dim) at load factor 1, description)`` that a format carrying
+        the term writes as constant forces (none by default)."""
+        return []
+
+    def export_note(self, fmt: str) -> str | None:
+        """What format ``fmt`` leaves out of the term (None: it carries it whole)."""
+        if fmt in self.export_formats:
+            return None
+        return f"{self.export_label} on {self.export_count()} cells (table {self.export_name})"
+
+    def export_count(self) -> int:
+        """How many elements (cells, springs) the term has."""
+        return int(len(self))
 
     def energy(self, x) -> float | None:  # pragma: no cover - abstract
         raise NotImplementedError

@@ -65,7 +65,7 @@ import numpy as np
 
 from msslib import mesh as _mesh
 from msslib.terms.assembly import _block_pattern
-from msslib.terms.base import Term, _per_element
+from msslib.terms.base import Table, Term, _cell_columns, _col, _per_element
 from msslib.terms.external import sum_external_forces
 
 # local faces of a hexahedron (msslib.mesh order, right-hand normal outward) and the three pairs
@@ -119,6 +119,47 @@ class BaudetCorrection(Term):
     conservative = False
     scales_with_load = True
     dim = 3
+    kind = "correction"
+    export_name = "baudet_correction"
+    export_label = "Baudet's correction"
+    #: MuJoCo and SOFA carry it as constant forces at load factor 1; VTU only its nodal forces
+    export_formats = ("csv", "json", "mjcf", "sofa", "c")
+    cell_constants = (("correction_factor", "factor", "1", "Baudet's correction factor c, F_perp = c F_i"),)
+
+    def export_count(self) -> int:
+        return int(len(self.factor))
+
+    def export_entry(self) -> dict:
+        return {"kind": self.export_name, "count": self.export_count(), "table": self.export_name,
+                "forces_table": "baudet_correction_forces", "energy": None, "conservative": self.conservative,
+                "scales_with_load": self.scales_with_load}
+
+    def export_note(self, fmt: str) -> str | None:
+        if fmt in self.export_formats:
+            return None
+        return "Baudet's per-cell correction factors (the nodal correction forces are carried)"
+
+    def export_forces(self):
+        return [("baudet_correction", self.nodal, "Baudet's correction forces (N) at load factor 1")]
+
+    def export_tables(self, mesh) -> list[Table]:
+        faces = "; ".join(f"face {f}: local nodes {' '.join(map(str, nodes))}" for f, nodes in enumerate(_HEX_FACES))
+        fc = self.nodal
+        on = np.flatnonzero(np.any(fc != 0, axis=1))
+        return [
+            Table("baudet_correction", "Baudet's orthogonal correction per cube: factor c (F_perp = c F_i) and the "
+                  f"elongation force of each face at load factor 1 ({faces}; msslib.terms.BaudetCorrection)", [
+                      *_cell_columns(mesh.cells, "hexahedron"),
+                      _col("factor", "1", self.factor, "correction factor c"),
+                      *[_col(f"face_force_{f}", "N", self.face_force[:, f], f"elongation force of face {f} (> 0 "
+                                                                            f"tension)") for f in range(6)],
+                  ]),
+            Table("baudet_correction_forces", "nodal forces of Baudet's correction at load factor 1 (they scale "
+                                              "with the load; constant in the reference configuration)", [
+                _col("node", None, on, "node index", int),
+                *[_col(f"f_{a}", "N", fc[on, i], f"force, {a}") for i, a in enumerate("xyz"[:fc.shape[1]])],
+            ]),
+        ]
 
     def __init__(self, mesh, loads, factor):
         if mesh.cell_type != "hexahedron":
@@ -246,6 +287,27 @@ class ElementBaudetCorrection(Term):
     scales_with_load = False
     symmetric = False
     dim = 3
+    kind = "correction"
+    export_name = "baudet_element_correction"
+    export_label = ("Baudet's element-reading correction (non-conservative nodal forces sum_e M_e s_e(x) from "
+                    "each cube's own springs)")
+    cell_constants = (("correction_factor", "factor", "1", "Baudet's correction factor c, F_perp = c F_i"),)
+
+    def export_count(self) -> int:
+        return int(len(self.cells))
+
+    def export_tables(self, mesh) -> list[Table]:
+        return [Table(self.export_name, "Baudet's correction, element reading (msslib.terms.ElementBaudetCorrection): "
+                      "per cube its own 12 edge springs (k_edge) and 4 inner diagonals (k_diagonal), rest lengths the "
+                      "distances of their nodes at rest, and the factor c; the correction force on the cube's nodes "
+                      "is M_e s_e(x), s_e the forces of the cube's own springs, F_perp = c F_i on each face pair, "
+                      "equilibrium form (not proportional to the load, no energy)", [
+                          *_cell_columns(self.cells, "hexahedron"),
+                          _col("k_edge", "N/m", self.k[:, 0], "spring constant of each of the cube's 12 edges"),
+                          _col("k_diagonal", "N/m", self.k[:, 12],
+                               "spring constant of each of the cube's 4 inner diagonals"),
+                          _col("factor", "1", self.factor, "correction factor c"),
+                      ])]
 
     def __init__(self, mesh, k_edge, k_diagonal, factor):
         if mesh.cell_type != "hexahedron":

@@ -15,6 +15,9 @@ class ExternalForce(Term):
     """
 
     scales_with_load = True
+    #: the scene states its loads and gravity itself: the exporters read them from the scene's setup
+    kind = "external"
+    export_formats = ("csv", "json", "vtu", "mjcf", "sofa", "c")
 
     def __init__(self, forces, dim: int):
         forces = np.asarray(forces, dtype=float)

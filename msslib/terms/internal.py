@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import _as_flat, _connectivity, _ElementTerm, _format_bad, _per_element
+from .base import Table, _as_flat, _cell_columns, _col, _connectivity, _ElementTerm, _format_bad, _per_element
 from .loops import (
     _hex_energy_loop,
     _hex_gradient_loop,
@@ -39,6 +39,12 @@ class Springs(_ElementTerm):
         distance of the nodes in the mesh prestrains the spring (e.g. Lloyd's squares).
     dim : 2 or 3.
     """
+
+    kind = "springs"
+    export_name = "springs"
+    export_label = "springs"
+    export_energy = "k/2 (|x_j - x_i| - L)^2"
+    export_formats = ("csv", "json", "vtu", "mjcf", "sofa", "c")
 
     def __init__(self, pairs, k, rest_length, dim: int, *, signed: bool = False):
         if dim not in (2, 3):
@@ -154,6 +160,19 @@ class _VolumeTerm(_ElementTerm):
     _cells = ""  # name of the connectivity argument
     _nodes = 0
     _coefficient = ""  # name of the coefficient
+    kind = "volume"
+    _solid = ""
+    _coefficient_unit = ""
+    _table_description = ""
+    _V0_description = ""
+
+    def export_tables(self, mesh) -> list[Table]:
+        return [Table(self.export_name, self._table_description, [
+            *_cell_columns(self.conn, self._solid),
+            _col(self._coefficient, self._coefficient_unit, self._p,
+                 f"volume coefficient {self._coefficient} (may be negative)"),
+            _col("V0", "m^3", self.V0, self._V0_description),
+        ])]
 
     def __init__(self, cells, coefficient, V0):
         name = type(self).__name__
@@ -177,6 +196,15 @@ class TetVolume(_VolumeTerm):
     """
 
     _cells, _nodes, _coefficient = "tets", 4, "k_v"
+    _solid, _coefficient_unit = "tetrahedron", "J"
+    export_name = "tet_volume"
+    export_label = "Lloyd's tetrahedron volume energy k_v/(2 V0^2) (V - V0)^2"
+    export_energy = "k_v/(2 V0^2) (V - V0)^2, V signed tetrahedron volume"
+    _table_description = ("Lloyd's tetrahedron volume energy k_v/(2 V0^2) (V - V0)^2, V the signed volume of "
+                          "(node_0, ..., node_3) (C: msslib_tet_signed_volume)")
+    _V0_description = "rest volume of the cell"
+    cell_constants = (("k_volume", "k_v", "J", "volume constant k_V of Lloyd's tetrahedron, energy k_V/(2 V0^2) (V - V0)^2"),
+                      ("rest_volume", "V0", "m3", "rest volume of the cell"))
     _loops = (_tet_energy_loop, _tet_gradient_loop, _tet_hessian_loop)
 
     def __init__(self, tets, k_v, V0):
@@ -197,6 +225,15 @@ class HexVolume(_VolumeTerm):
     """
 
     _cells, _nodes, _coefficient = "hexes", 8, "kappa"
+    _solid, _coefficient_unit = "hexahedron", "Pa"
+    export_name = "hex_volume"
+    export_label = "Golec's volume energy kappa/(2 V0) (V - V0)^2"
+    export_energy = "kappa/(2 V0) (V - V0)^2, V averaged-edge-vector hexahedron volume"
+    _table_description = ("Golec's volume energy kappa/(2 V0) (V - V0)^2, V the averaged-edge-vector volume of the "
+                          "hexahedron (node_0, ..., node_7) in VTK order (C: msslib_hex_averaged_volume)")
+    _V0_description = "rest (averaged) volume of the cell"
+    cell_constants = (("kappa", "kappa", "Pa", "Golec's volume coefficient kappa, energy kappa/(2 V0) (V - V0)^2"),
+                      ("rest_volume", "V0", "m3", "rest (averaged-edge) volume of the cell"))
     _loops = (_hex_energy_loop, _hex_gradient_loop, _hex_hessian_loop)
 
     def __init__(self, hexes, kappa, V0):
