@@ -486,7 +486,8 @@ def _cmd_export(args) -> int:
     for fmt in chosen:
         missing = export.not_carried(exp, fmt) if fmt in export.SPRINGS_ONLY_FORMATS else []
         if missing:
-            warnings.warn(f"{scene.name}: the {fmt} output does not carry {'; '.join(missing)} (said in the file; "
+            warnings.warn(f"{scene.name}: the {fmt} output of model {scene.model} does not carry {'; '.join(missing)} "
+                          f"(said in the file; "
                           f"the csv and json outputs carry everything)", MsslibWarning, stacklevel=2)
     # every file or none, with a manifest; a new folder appears whole; never over a file not the export's
     export_files.write_outputs(exp, stem, planned)
