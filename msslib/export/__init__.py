@@ -11,7 +11,10 @@ displacements, the loads and gravity. The writers turn it into
     mass), ``springs``, ``fixed`` (fixed axes and prescribed displacements), ``loads`` (surface
     loads at load factor 1), ``gravity``, and when the model has them ``tet_volume`` (Lloyd),
     ``hex_volume`` (Golec), ``baudet_correction`` (factor and face forces per cell) and
-    ``baudet_correction_forces`` (the nodal forces it adds at load factor 1). Node indices are
+    ``baudet_correction_forces`` (the nodal forces it adds at load factor 1),
+    ``baudet_element_correction`` (Baudet's element reading: k_edge, k_diagonal, factor per cube),
+    ``delingette_triangle`` (Delingette's six constants and rest squared lengths per triangle): each
+    term gives its own tables (:meth:`msslib.terms.Term.export_tables`). Node indices are
     0-based. Floats are written with ``repr`` (they read back bit for bit): :func:`msslib.export.text.read_csv`.
 ``json``
     One document with the same tables, a schema name and version (:data:`SCHEMA`,
@@ -42,6 +45,11 @@ displacements, the loads and gravity. The writers turn it into
     The generated C headers (:mod:`derivations.codegen`): ``msslib_mss.h``, which includes one
     header per derivation module (``msslib_<module>.h``: its spring-constant formulas, or the energy,
     gradient and Hessian kernels), all copied beside the outputs (:func:`c_header_paths`).
+
+One entry per format (name, files, writer, what it carries, help) is
+:data:`msslib.export.files.FORMAT_TABLE`; which terms a format carries each term says itself
+(:attr:`msslib.terms.Term.export_formats`), and a format that leaves one out says so in the file and
+on the command line, naming the model and the term.
 
 Units are SI throughout. The writers are in :mod:`msslib.export.text` (CSV, JSON, VTU) and
 :mod:`msslib.export.simulators` (MuJoCo, SOFA); :mod:`msslib.export.files` chooses formats and
