@@ -1,0 +1,156 @@
+"""Explicit steps of a general 3D spring network (any mesh): symplectic Euler with the spring
+forces and the position update fused in one pass over the nodes.
+
+Layout: every spring is stored once, under its lower node ``a`` (``a < b``), the springs sorted by
+``a`` then ``b`` (``rowptr`` offsets by node, ``ib`` the other ends, ``kl`` the constants and rest
+lengths interleaved).  A pass visits the nodes in order; the force on node ``a`` is complete once
+its own row is done, because every spring ``(c, a)`` with ``c < a`` was visited in an earlier row
+and scattered into ``acc[a]``.  The node is then advanced at once (``v = damp v + w F``,
+``x += h v``) while it is in cache: later rows only read nodes ``b > a``, which are not advanced
+yet, so the pass computes the forces of one state and advances it, exactly as the two-pass scheme
+(forces of every spring, then every node).  One pass reads each spring's 20 bytes once and each
+node's state once.
+
+The scheme is that of :func:`msslib.solvers.integrate` with ``method="symplectic_euler"`` and
+mass-proportional damping: ``v+ = v + h M^-1 (F(x) - alpha M v)``, ``x+ = x + h v+``, written as
+``v+ = damp v + w F`` with ``damp = 1 - h alpha`` on free dofs and ``w = h / m`` (0 on fixed dofs,
+which keep their position: prescribed motion sets them between steps).
+
+Each force pass also writes what the divergence detector of :mod:`msslib.solvers.dynamics` needs
+for the step whose end state it evaluates (``v.M v``, ``F.M^-1 F_prev``, ``v.(F - F_prev)``,
+``F.M^-1 F`` over the free dofs and ``max |x - x_ref|``), and the support reactions ``-F`` on the
+fixed dofs, so that the state, the force and the reaction are current after every call.
+
+Node order matters for large networks (the scatter's locality): a mesh renumbered with
+:func:`msslib.mesh.reorder_nodes` runs up to twice as fast above 10^5 springs.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from msslib.terms.jit import _U
+
+# fast-math without nnan/ninf: the monitor must see a non-finite state
+_FAST = {"nsz", "arcp", "contract", "afn"}
+
+__all__ = ["network_layout", "network_steps", "network_forces", "N_MONITOR"]
+
+N_MONITOR = 5  # columns of a monitor row: q, pf, ku, r, dmax
+
+
+def network_layout(conn, k, rest_length, n_nodes: int):
+    """``(rowptr, ib, kl)`` of springs ``conn`` (s, 2) with constants ``k`` and rest lengths: each
+    spring under its lower node, sorted by lower then upper node (see the module docstring)."""
+    conn = np.asarray(conn, dtype=np.int64).reshape(-1, 2)
+    a = np.minimum(conn[:, 0], conn[:, 1])
+    b = np.maximum(conn[:, 0], conn[:, 1])
+    if len(conn) and (np.any(a == b) or a.min() < 0 or b.max() >= n_nodes):
+        raise ValueError("springs must join two different nodes of the network")
+    order = np.lexsort((b, a))
+    rowptr = np.zeros(n_nodes + 1, dtype=np.int64)
+    np.cumsum(np.bincount(a, minlength=n_nodes), out=rowptr[1:])
+    kl = np.empty(2 * len(conn))
+    kl[0::2] = np.asarray(k, dtype=float)[order]
+    kl[1::2] = np.asarray(rest_length, dtype=float)[order]
+    idx_t = np.int32 if n_nodes < 2**31 else np.int64
+    return rowptr, np.ascontiguousarray(b[order], dtype=idx_t), kl
+
+
+@njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
+def _pass(x, v, F, Fp, rowptr, ib, kl, w, damp, h, fext, acc, x_ref, mass, inv_m, react, mon, row, advance):
+    """One pass: the force ``F`` at ``x`` (springs + ``acc``, which holds the other forces and is
+    zeroed, + ``fext``), the monitor row ``mon[row]``, the reactions; then, if ``advance``, the
+    symplectic Euler update of each node as soon as its force is complete."""
+    q = 0.0
+    pf = 0.0
+    ku = 0.0
+    r = 0.0
+    dmax = 0.0
+    for na in range(rowptr.shape[0] - 1):
+        a = 3 * na
+        xa0 = x[a]
+        xa1 = x[a + 1]
+        xa2 = x[a + 2]
+        ga0 = acc[a]
+        ga1 = acc[a + 1]
+        ga2 = acc[a + 2]
+        for s in range(rowptr[na], rowptr[na + 1]):
+            b = 3 * ib[_U(s)]
+            d0 = x[_U(b)] - xa0
+            d1 = x[_U(b + 1)] - xa1
+            d2 = x[_U(b + 2)] - xa2
+            l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            c = kl[_U(2 * s)] * (l - kl[_U(2 * s + 1)]) / l
+            f0 = d0 * c
+            f1 = d1 * c
+            f2 = d2 * c
+            ga0 += f0
+            ga1 += f1
+            ga2 += f2
+            acc[_U(b)] -= f0
+            acc[_U(b + 1)] -= f1
+            acc[_U(b + 2)] -= f2
+        for i in range(3):
+            j = a + i
+            fj = (ga0 if i == 0 else (ga1 if i == 1 else ga2)) + fext[j]
+            acc[j] = 0.0
+            fo = F[j]
+            Fp[j] = fo
+            F[j] = fj
+            vj = v[j]
+            dj = abs(x[j] - x_ref[j])
+            if dj > dmax or dj != dj:
+                dmax = dj if dj == dj else np.inf
+            if w[j] != 0.0:
+                q += mass[j] * vj * vj
+                pf += fj * fo * inv_m[j]
+                ku += vj * (fj - fo)
+                r += fj * fj * inv_m[j]
+                if advance:
+                    vj = damp * vj + w[j] * fj
+                    v[j] = vj
+                    x[j] += h * vj
+            else:
+                react[j] = -fj
+    mon[row, 0] = q
+    mon[row, 1] = pf
+    mon[row, 2] = ku
+    mon[row, 3] = r
+    mon[row, 4] = dmax
+
+
+@njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
+def _advance(x, v, F, w, damp, h):
+    """The update of every node from the current force ``F`` (no force evaluation)."""
+    for j in range(x.shape[0]):
+        if w[j] != 0.0:
+            vj = damp * v[j] + w[j] * F[j]
+            v[j] = vj
+            x[j] += h * vj
+
+
+@njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
+def _steps(x, v, F, Fp, rowptr, ib, kl, w, damp, h, fext, acc, x_ref, mass, inv_m, react, mon, n_steps):
+    _advance(x, v, F, w, damp, h)
+    for p in range(n_steps):
+        _pass(x, v, F, Fp, rowptr, ib, kl, w, damp, h, fext, acc, x_ref, mass, inv_m, react, mon, p,
+              p + 1 < n_steps)
+
+
+def network_forces(state, layout, acc, mon, row: int = 0):
+    """Evaluate the force at the current positions (no update): ``state`` = ``(x, v, F, Fp, w,
+    damp, h, fext, x_ref, mass, inv_m, react)``; ``F`` becomes the force, ``Fp`` the previous one."""
+    x, v, F, Fp, w, damp, h, fext, x_ref, mass, inv_m, react = state
+    rowptr, ib, kl = layout
+    _pass(x, v, F, Fp, rowptr, ib, kl, w, damp, h, fext, acc, x_ref, mass, inv_m, react, mon, row, False)
+
+
+def network_steps(state, layout, acc, mon, n_steps: int):
+    """``n_steps`` symplectic Euler steps from a state whose force ``F`` is current; the force,
+    the reactions and ``mon[0:n_steps]`` (the monitor of each step's end state) are current
+    after the call.  ``acc`` must be zero (spring-only networks)."""
+    x, v, F, Fp, w, damp, h, fext, x_ref, mass, inv_m, react = state
+    rowptr, ib, kl = layout
+    _steps(x, v, F, Fp, rowptr, ib, kl, w, damp, h, fext, acc, x_ref, mass, inv_m, react, mon, int(n_steps))
