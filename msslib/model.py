@@ -437,6 +437,25 @@ class Model:
         x[self.fixed] = self.x0[self.fixed] + load * self.prescribed[self.fixed]
         return x
 
+    def stiffness_row_bound(self, x, load: float, isq: np.ndarray) -> np.ndarray:
+        """Row sums of ``|D K D|`` at ``x`` with ``D = diag(isq)`` (``isq`` = ``1/sqrt(m)`` on the
+        free dofs, 0 on the fixed ones), a bound of each row's sum over the terms (Gershgorin;
+        :mod:`msslib.terms.bounds`): from the terms themselves when each can, else from the
+        assembled stiffness."""
+        from msslib.terms.bounds import csr_abs_rows
+
+        x = np.asarray(x, dtype=float).ravel()
+        isq = np.ascontiguousarray(isq, dtype=float)
+        out = np.zeros(self.n_dof)
+        for t in self.terms:
+            s = self._scale(t, load)
+            if s != 0.0 and not t.abs_row_sums(x, s, isq, out):
+                K = self.stiffness(x, load)
+                out[:] = 0.0
+                csr_abs_rows(K.indptr, K.indices, K.data, isq, out)
+                break
+        return out
+
     def reaction(self, x, load: float = 1.0) -> np.ndarray:
         """Support reactions ``(n_nodes, dim)`` (N), zero on free dofs.
 

@@ -74,6 +74,7 @@ from .hygiene import (
     loose_parts,
     resolve_coincident_nodes,
 )
+from .reorder import reorder_nodes
 from .structured import (
     equilateral_rows,
     hex_grid,
@@ -121,6 +122,7 @@ __all__ = [
     "cone_mesh",
     "l_block_tet",
     "read",
+    "reorder_nodes",
     "materials_from_groups",
     "facet_cell_counts",
     "readable_suffixes",

@@ -96,9 +96,11 @@ Dynamics
 --------
 :func:`integrate` advances ``M dv/dt = force(x, load) - C v`` with symplectic Euler, velocity
 Verlet or implicit Euler. Constrained dofs keep their initial position and have zero velocity.
-An explicit run first computes the stability limit of the model at rest (:func:`check_time_step`:
-``2 / omega_max`` from :func:`explicit_stability_limit`, lowered by the damping where it does,
-:func:`critical_time_step`) and refuses a larger ``dt`` with
+An explicit run first checks its step against the stability limit of the model at rest
+(:func:`check_time_step`: ``2 / omega_max``, lowered by the damping where it does,
+:func:`critical_time_step`; ``omega_max`` from the cheap Gershgorin bound
+:func:`omega_max_bound` when the step is within the limit it gives, else from Lanczos,
+:func:`explicit_stability_limit`, kept for a model and state that did not change) and refuses a larger ``dt`` with
 :class:`msslib.errors.StabilityError` unless ``allow_unstable=True``. After every step the state
 is checked: a non-finite velocity, a displacement ``max |x - x0|`` beyond ``blowup * size``
 (``size`` the bounding-box diagonal of ``x0``), or, for the explicit schemes, the signature of
@@ -216,6 +218,7 @@ from .stability import (  # noqa: F401
     check_time_step,
     critical_time_step,
     explicit_stability_limit,
+    omega_max_bound,
 )
 from .statics import _ETA_MAX, _forcing_term, static_solve  # noqa: F401
 
@@ -229,6 +232,7 @@ __all__ = [
     "convergence_threshold",
     "critical_time_step",
     "explicit_stability_limit",
+    "omega_max_bound",
     "integrate",
     "roundoff_floor",
     "static_solve",

@@ -181,6 +181,12 @@ class Term:
         rows, cols = self.hessian_pattern()
         return rows, cols, self.hessian_values(x)
 
+    def abs_row_sums(self, x, scale: float, isq: np.ndarray, out: np.ndarray) -> bool:
+        """Add the row sums of ``|scale H|`` scaled by ``isq`` (``1/sqrt(m)``, 0 on fixed dofs) at
+        ``x`` to ``out`` (see :mod:`msslib.terms.bounds`) and return True, or return False when
+        the term cannot (the caller then bounds the assembled stiffness)."""
+        return False
+
 
 class _ElementTerm(Term):
     """A term made of elements with ``conn`` (m, nodes), parameters ``p`` and ``q`` per element,

@@ -47,6 +47,9 @@ class ExternalForce(Term):
     def gradient(self, x) -> np.ndarray:
         return -self.vector.copy()
 
+    def abs_row_sums(self, x, scale, isq, out) -> bool:
+        return type(self).hessian_values is Term.hessian_values  # a dead load has no stiffness
+
 
 class NodalForces(ExternalForce):
     """Dead nodal loads ``f`` of shape ``(n_nodes, dim)`` (N)."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bounds import spring3d_abs_rows
 from .base import Table, _as_flat, _cell_columns, _col, _connectivity, _ElementTerm, _format_bad, _per_element
 from .loops import (
     _hex_energy_loop,
@@ -127,6 +128,12 @@ class Springs(_ElementTerm):
             raise IndexError(f"x has {x.size} entries, the springs refer to node {len(rowptr) - 2}")
         _spring3d_gradient_fast(x, rowptr, ib, k, L0, g)
         return g
+
+    def abs_row_sums(self, x, scale, isq, out) -> bool:
+        if self.dim != 3:
+            return False
+        spring3d_abs_rows(_as_flat(x), self.conn, self.k, self.rest_length, float(scale), isq, out)
+        return True
 
     def gradient_reference(self, x) -> np.ndarray:
         """Gradient through the generated scalar kernel (the plain loop); for tests/benchmarks."""
