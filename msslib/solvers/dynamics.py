@@ -145,154 +145,237 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
     ``allow_unstable`` is False; DivergenceError when the run diverges; ConvergenceError when the
     implicit Newton iteration fails.
     """
-    t_start = time.perf_counter()
-    methods = ("symplectic_euler", "velocity_verlet", "implicit_euler")
-    if method not in methods:
-        raise ValueError(f"method must be one of {methods}, got {method!r}")
     if not (dt > 0) or not (t_end >= 0):
         raise ValueError("dt must be positive and t_end non-negative")
     if save_every < 1:
         raise ValueError("save_every must be >= 1")
-    n = int(problem.n_dof)
-    free = protocol._free_mask(problem)
-    mass = _mass_vector(problem)
-    if np.any(mass[free] <= 0):
-        raise ValueError("masses of free dofs must be positive")
-    alpha, beta = _resolve_damping(problem, damping)
-    x = np.array(x0, dtype=float).reshape(-1)
-    v = np.array(v0, dtype=float).reshape(-1)
-    if x.shape != (n,) or v.shape != (n,):
-        raise ValueError(f"x0 and v0 must have {n} entries")
-    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
-        raise ValueError("x0 and v0 must be finite")
-    v[~free] = 0.0
-    x_ref = x.copy()
-    bound = blowup * _bbox_size(problem, x_ref)
-    symmetric = bool(getattr(problem, "symmetric", True))
-    explicit = method in EXPLICIT_METHODS
+    stepper = Integrator(problem, x0, v0, dt=dt, method=method, damping=damping, load=load,
+                         newton_tol=newton_tol, newton_max_iter=newton_max_iter, linear_solver=linear_solver,
+                         blowup=blowup, allow_unstable=allow_unstable)
     n_steps = int(np.ceil(t_end / dt - 1e-9)) if t_end > 0 else 0
-    stats = {"n_steps": n_steps, "dt": dt, "method": method, "n_force_evals": 0,
-             "n_newton_iterations": 0, "n_linear_solves": 0, "damping": (alpha, beta),
-             "stability_limit": None, "stability_limit_undamped": None, "omega_max": None,
-             "dt_over_limit": None, "allow_unstable": bool(allow_unstable)}
-    limit = None
-    if explicit:
-        with np.errstate(all="ignore"):
-            stats.update(check_time_step(problem, x, dt, method=method, damping=(alpha, beta), load=load,
-                                         allow_unstable=allow_unstable))
-        limit = stats["stability_limit"]
-    conservative = protocol._is_conservative(problem, x, load)
-    mf = mass[free]
-    inv_m = 1.0 / mf
-    messages: list[str] = []
-    if explicit and stats["dt_over_limit"] > 1.0:
-        messages.append(f"dt = {dt:.6g} s is {stats['dt_over_limit']:.3g} x the explicit stability limit "
-                        f"{limit:.6g} s of the model at rest (allow_unstable)")
-
-    def force(xx):
-        stats["n_force_evals"] += 1
-        return np.asarray(problem.force(xx, load), dtype=float)[free]
-
-    # the plans of the free-dof submatrices and, for implicit Euler, the kept AMG hierarchy
-    solver_context = _solver_context(problem, x, free)
-
-    def damping_force(xx, vf):
-        """-(alpha M + beta K) v on the free dofs, ``vf`` the free velocities."""
-        out = -alpha * mf * vf if alpha else np.zeros_like(vf)
-        if beta:
-            out = out - beta * (_submatrix(problem.stiffness(xx, load), free, plans=solver_context) @ vf)
-        return out
-
-    f_scale = magnitude = None
-    if method == "implicit_euler":
-        f_load = protocol._load_vector(problem, x)
-        f_scale = protocol._force_scale(problem, x, free, f_load)
-        with np.errstate(all="ignore"):
-            K0 = _submatrix(problem.stiffness(x, load), free, plans=solver_context)
-            magnitude = _force_magnitude(K0, x[free], np.nan_to_num(np.abs(load * f_load[free])))
-
+    stepper.stats["n_steps"] = n_steps
     ts, xs, vs, kes, pes = [], [], [], [], []
 
     def save(step, t):
         ts.append(t)
-        xs.append(x.copy())
-        vs.append(v.copy())
-        kes.append(0.5 * float(mass[free] @ (v[free] ** 2)))
-        if conservative:
-            pes.append(protocol._energy_or_none(problem, x, load))
+        xs.append(stepper.x.copy())
+        vs.append(stepper.v.copy())
+        kes.append(stepper.kinetic_energy())
+        if stepper.conservative:
+            pes.append(protocol._energy_or_none(problem, stepper.x, load))
         if progress is not None:
             progress({"step": step, "t": t, "n_steps": n_steps})
 
-    # divergence detector (explicit methods): see _GROWTH_MIN
-    omega = stats["omega_max"] or 0.0
-    j_floor = (omega**4 * float(mf.sum()) * (_FLOOR_SIZE * _bbox_size(problem, x_ref)) ** 2
-               if explicit and np.isfinite(omega) else 0.0)
-    j_min = None
-    growth = _growth_threshold(stats["dt_over_limit"]) if explicit else None
-    flips = 0  # steps in a row whose force flipped sign
-    zeros = np.zeros(int(free.sum()))
-
     save(0, 0.0)
-    t = 0.0
-    with np.errstate(all="ignore"):
-        f = force(x) if explicit else None  # the explicit schemes evaluate the force after each drift
-        if explicit and not np.any(v[free]):  # from rest: J_0 = a.M a
-            j_min = float(np.sum(f * f * inv_m))
-            j_min = j_min if np.isfinite(j_min) else None
-        for step in range(1, n_steps + 1):
-            h = dt if step < n_steps else t_end - (n_steps - 1) * dt
-            x_prev, v_prev = x, v  # not modified below (x and v are replaced by new arrays)
-            vf = v[free]
-            jterms = None  # (velocity u, f_late, f_early, f for a.M a, step h): K u = -(f_late - f_early) / h
-            if method == "symplectic_euler":
-                a = (f + damping_force(x, vf)) * inv_m
-                vf = vf + h * a
-                x = x.copy()
-                x[free] += h * vf
-                f_old, f = f, force(x)  # at x_n, for the next step and the monitor
-                jterms = (vf, f, f_old, f, h)
-            elif method == "velocity_verlet":
-                a = (f + damping_force(x, vf)) * inv_m
-                v_half = vf + 0.5 * h * a
-                x = x.copy()
-                x[free] += h * v_half
-                f_old, f = f, force(x)
-                jterms = (v_half, f, f_old, f, h)
-                # second half-kick: mass-proportional damping at v+ (implicit), beta K at v_half
-                g = f - beta * (_submatrix(problem.stiffness(x, load), free, plans=solver_context) @ v_half) if beta else f
-                vf = (v_half + 0.5 * h * inv_m * g) / (1.0 + 0.5 * h * alpha)
-            else:
-                vf = _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, newton_tol,
-                                          newton_max_iter, f_scale, linear_solver, symmetric, stats,
-                                          messages, step, t + h, solver_context, magnitude)
-                x = x.copy()
-                x[free] += h * vf
-            v = np.zeros(n)
-            v[free] = vf
-            t = step * dt if step < n_steps else float(t_end)
-            u_j, f_late, f_early, f_r, h_j = jterms if jterms is not None else (zeros, zeros, zeros, zeros, 1.0)
-            q, pf, ku, r, dmax = _monitor(vf, u_j, f_late, f_early, f_r, mf, x, x_ref)
-            if not (np.isfinite(q) and dmax <= bound):
-                _check_state(problem, x, v, x_ref, bound, step, t, dt, method, x_prev, v_prev, limit)
-            if explicit:
-                if jterms is not None:
-                    flips = flips + 1 if pf < 0.0 else 0
-                    J = r - ku / h_j
-                    J = J if J == J else float("inf")
-                    j_min = J if j_min is None else min(j_min, J)
-                    j_ref = max(j_min, j_floor, TINY)
-                    if (J > growth * j_ref and flips >= 1) or J > _GROWTH_ANY * j_ref:
-                        _raise_growth(x, x_ref, step, t, dt, method, x_prev, v_prev, limit, J / j_ref, flips)
-            if step % save_every == 0 or step == n_steps:
-                save(step, t)
-
-    stats["wall_time"] = time.perf_counter() - t_start
-    stats["messages"] = messages
+    for step in range(1, n_steps + 1):
+        h = dt if step < n_steps else t_end - (n_steps - 1) * dt
+        stepper.step(h, t_new=step * dt if step < n_steps else float(t_end))
+        if step % save_every == 0 or step == n_steps:
+            save(step, stepper.t)
+    stats = stepper.stats
+    stats["wall_time"] = time.perf_counter() - stepper.t_start
+    stats["messages"] = stepper.messages
     return DynamicResult(
-        t=np.array(ts), x=np.array(xs), v=np.array(vs), x_final=x.copy(), v_final=v.copy(),
-        kinetic_energy=np.array(kes), potential_energy=np.array(pes, dtype=float) if conservative else None,
+        t=np.array(ts), x=np.array(xs), v=np.array(vs), x_final=stepper.x.copy(), v_final=stepper.v.copy(),
+        kinetic_energy=np.array(kes), potential_energy=np.array(pes, dtype=float) if stepper.conservative else None,
         stats=stats,
     )
+
+
+class Integrator:
+    """The time stepper of :func:`integrate`, one step at a time: the engine of
+    :class:`msslib.simulator.Simulator` for every model and scheme (the fused spring-network
+    kernel aside).
+
+    Built from the state ``x0, v0`` (copied) with the arguments of :func:`integrate`; the
+    stability check of the explicit schemes runs here, once.  :meth:`step` advances by ``h`` and
+    runs the divergence checks of :func:`integrate`.  Between steps a caller may change
+    ``load`` (the load factor), ``extra`` (nodal forces added to ``problem.force``, ``(n_dof,)``
+    or None) and, through ``drive`` (called as ``drive(t, x)`` after each drift, before the force
+    at the new state is evaluated), the positions of the dofs that are not free.  ``free``
+    (optional) is a mask of the dofs that move; it may hold fewer dofs than the problem's (driven
+    dofs), never more.
+    """
+
+    def __init__(self, problem, x0, v0, *, dt: float, method: str = "symplectic_euler", damping=None,
+                 load: float = 1.0, newton_tol: float = 1e-8, newton_max_iter: int = 30, linear_solver="auto",
+                 blowup: float = 1e3, allow_unstable: bool = False, free=None, drive=None):
+        self.t_start = time.perf_counter()
+        methods = ("symplectic_euler", "velocity_verlet", "implicit_euler")
+        if method not in methods:
+            raise ValueError(f"method must be one of {methods}, got {method!r}")
+        if not (dt > 0):
+            raise ValueError("dt must be positive")
+        self.problem, self.method, self.dt, self.load = problem, method, float(dt), load
+        self.newton_tol, self.newton_max_iter, self.linear_solver = newton_tol, newton_max_iter, linear_solver
+        n = int(problem.n_dof)
+        model_free = protocol._free_mask(problem)
+        if free is None:
+            free = model_free
+        else:
+            free = np.asarray(free, dtype=bool).reshape(-1)
+            if free.shape != (n,) or np.any(free & ~model_free):
+                raise ValueError("free must be a mask of the problem's free dofs")
+        self.free = free
+        mass = _mass_vector(problem)
+        if np.any(mass[free] <= 0):
+            raise ValueError("masses of free dofs must be positive")
+        self.mass = mass
+        self.alpha, self.beta = _resolve_damping(problem, damping)
+        x = np.array(x0, dtype=float).reshape(-1)
+        v = np.array(v0, dtype=float).reshape(-1)
+        if x.shape != (n,) or v.shape != (n,):
+            raise ValueError(f"x0 and v0 must have {n} entries")
+        if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
+            raise ValueError("x0 and v0 must be finite")
+        v[~free] = 0.0
+        self.x_ref = x.copy()
+        self.bound = blowup * _bbox_size(problem, self.x_ref)
+        self.symmetric = bool(getattr(problem, "symmetric", True))
+        self.explicit = method in EXPLICIT_METHODS
+        self.extra = None
+        self.drive = drive
+        self.t = 0.0
+        self.n_taken = 0
+        stats = {"n_steps": 0, "dt": dt, "method": method, "n_force_evals": 0, "n_newton_iterations": 0,
+                 "n_linear_solves": 0, "damping": (self.alpha, self.beta), "stability_limit": None,
+                 "stability_limit_undamped": None, "omega_max": None, "dt_over_limit": None,
+                 "stability_estimate": None, "allow_unstable": bool(allow_unstable)}
+        self.stats = stats
+        if drive is not None:
+            drive(0.0, x)
+        self.limit = None
+        if self.explicit:
+            t_check = time.perf_counter()
+            with np.errstate(all="ignore"):
+                stats.update(check_time_step(problem, x, dt, method=method, damping=(self.alpha, self.beta),
+                                             load=load, allow_unstable=allow_unstable))
+            stats["stability_check_time"] = time.perf_counter() - t_check
+            self.limit = stats["stability_limit"]
+        self.conservative = protocol._is_conservative(problem, x, load)
+        self.mf = mass[free]
+        self.inv_m = 1.0 / self.mf
+        self.messages: list[str] = []
+        if self.explicit and stats["dt_over_limit"] > 1.0:
+            self.messages.append(f"dt = {dt:.6g} s is {stats['dt_over_limit']:.3g} x the explicit stability limit "
+                                 f"{self.limit:.6g} s of the model at rest (allow_unstable)")
+        # the plans of the free-dof submatrices and, for implicit Euler, the kept AMG hierarchy
+        self.solver_context = _solver_context(problem, x, free)
+        self.f_scale = self.magnitude = None
+        if method == "implicit_euler":
+            f_load = protocol._load_vector(problem, x)
+            self.f_scale = protocol._force_scale(problem, x, free, f_load)
+            with np.errstate(all="ignore"):
+                K0 = _submatrix(problem.stiffness(x, load), free, plans=self.solver_context)
+                self.magnitude = _force_magnitude(K0, x[free], np.nan_to_num(np.abs(load * f_load[free])))
+        # divergence detector (explicit methods): see _GROWTH_MIN
+        omega = stats["omega_max"] or 0.0
+        self.j_floor = (omega**4 * float(self.mf.sum()) * (_FLOOR_SIZE * _bbox_size(problem, self.x_ref)) ** 2
+                        if self.explicit and np.isfinite(omega) else 0.0)
+        self.j_min = None
+        self.growth = _growth_threshold(stats["dt_over_limit"]) if self.explicit else None
+        self.flips = 0  # steps in a row whose force flipped sign
+        self._zeros = np.zeros(int(free.sum()))
+        self.x, self.v = x, v
+        with np.errstate(all="ignore"):
+            self.f = self.force(x) if self.explicit else None  # explicit schemes: the force after each drift
+            if self.explicit and not np.any(v[free]):  # from rest: J_0 = a.M a
+                j = float(np.sum(self.f * self.f * self.inv_m))
+                self.j_min = j if np.isfinite(j) else None
+
+    def force(self, xx):
+        """The force on the free dofs at ``xx`` (with ``load`` and ``extra``)."""
+        self.stats["n_force_evals"] += 1
+        f = np.asarray(self.problem.force(xx, self.load), dtype=float)
+        if self.extra is not None:
+            f = f + self.extra
+        return f[self.free]
+
+    def full_force(self):
+        """The total nodal force ``(n_dof,)`` at the current state (one force evaluation)."""
+        f = np.asarray(self.problem.force(self.x, self.load), dtype=float)
+        return f + self.extra if self.extra is not None else f
+
+    def kinetic_energy(self) -> float:
+        return 0.5 * float(self.mass[self.free] @ (self.v[self.free] ** 2))
+
+    def _damping_force(self, xx, vf):
+        """-(alpha M + beta K) v on the free dofs, ``vf`` the free velocities."""
+        out = -self.alpha * self.mf * vf if self.alpha else np.zeros_like(vf)
+        if self.beta:
+            out = out - self.beta * (_submatrix(self.problem.stiffness(xx, self.load), self.free,
+                                                plans=self.solver_context) @ vf)
+        return out
+
+    def _drift(self, x, w, h, t_new):
+        x = x.copy()
+        x[self.free] += h * w
+        if self.drive is not None:
+            self.drive(t_new, x)
+        return x
+
+    def step(self, h: float | None = None, t_new: float | None = None) -> None:
+        """Advance by ``h`` (default ``dt``) to ``t_new`` (default ``t + h``), then check the state."""
+        h = self.dt if h is None else float(h)
+        t_new = self.t + h if t_new is None else float(t_new)
+        step = self.n_taken + 1
+        free, alpha, beta, inv_m = self.free, self.alpha, self.beta, self.inv_m
+        x, v, f = self.x, self.v, self.f
+        x_prev, v_prev = x, v  # not modified below (x and v are replaced by new arrays)
+        with np.errstate(all="ignore"):
+            vf = v[free]
+            jterms = None  # (velocity u, f_late, f_early, f for a.M a, step h): K u = -(f_late - f_early) / h
+            if self.method == "symplectic_euler":
+                a = (f + self._damping_force(x, vf)) * inv_m
+                vf = vf + h * a
+                x = self._drift(x, vf, h, t_new)
+                f_old, f = f, self.force(x)  # at x_n, for the next step and the monitor
+                jterms = (vf, f, f_old, f, h)
+            elif self.method == "velocity_verlet":
+                a = (f + self._damping_force(x, vf)) * inv_m
+                v_half = vf + 0.5 * h * a
+                x = self._drift(x, v_half, h, t_new)
+                f_old, f = f, self.force(x)
+                jterms = (v_half, f, f_old, f, h)
+                # second half-kick: mass-proportional damping at v+ (implicit), beta K at v_half
+                g = f - beta * (_submatrix(self.problem.stiffness(x, self.load), free, plans=self.solver_context)
+                                @ v_half) if beta else f
+                vf = (v_half + 0.5 * h * inv_m * g) / (1.0 + 0.5 * h * alpha)
+            else:
+                xd = self._drift(x, np.zeros_like(vf), 0.0, t_new)  # the driven dofs at t_new
+                if self.extra is not None:
+                    raise ValueError("implicit_euler takes no extra nodal forces; use the load factor")
+                vf = _implicit_euler_step(self.problem, xd, vf, h, free, self.mf, alpha, beta, self.load,
+                                          self.newton_tol, self.newton_max_iter, self.f_scale, self.linear_solver,
+                                          self.symmetric, self.stats, self.messages, step, t_new,
+                                          self.solver_context, self.magnitude)
+                x = xd.copy()
+                x[free] += h * vf
+            v = np.zeros(v.size)
+            v[free] = vf
+            self.x, self.v, self.f = x, v, f
+            self.t = t_new
+            self.n_taken = step
+            self.stats["n_steps"] = max(self.stats["n_steps"], step)
+            u_j, f_late, f_early, f_r, h_j = jterms if jterms is not None else (self._zeros,) * 4 + (1.0,)
+            q, pf, ku, r, dmax = _monitor(vf, u_j, f_late, f_early, f_r, self.mf, x, self.x_ref)
+            self.observe(q, pf, ku, r, dmax, h_j, step, t_new, x_prev, v_prev, jterms is not None)
+
+    def observe(self, q, pf, ku, r, dmax, h, step, t, x_prev, v_prev, explicit_terms=True):
+        """The divergence checks of one step from its monitor values (see :func:`_monitor`);
+        raises :class:`DivergenceError`."""
+        if not (np.isfinite(q) and dmax <= self.bound):
+            _check_state(self.problem, self.x, self.v, self.x_ref, self.bound, step, t, self.dt, self.method,
+                         x_prev, v_prev, self.limit)
+        if self.explicit and explicit_terms:
+            self.flips = self.flips + 1 if pf < 0.0 else 0
+            J = r - ku / h
+            J = J if J == J else float("inf")
+            self.j_min = J if self.j_min is None else min(self.j_min, J)
+            j_ref = max(self.j_min, self.j_floor, TINY)
+            if (J > self.growth * j_ref and self.flips >= 1) or J > _GROWTH_ANY * j_ref:
+                _raise_growth(self.x, self.x_ref, step, t, self.dt, self.method, x_prev, v_prev, self.limit,
+                              J / j_ref, self.flips)
 
 
 def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, max_iter, f_scale,
