@@ -94,31 +94,59 @@ def _solve_mss_linear(setup: Setup):
 
 
 def _solve_mss_dynamic(setup: Setup, report):
-    from msslib.solvers import integrate
+    from msslib.simulator import Simulator
+    from msslib.solvers import protocol
 
     model, s = setup.model, setup.scene.solver
-    x_start = model.apply_prescribed(model.x0, 1.0)
-
-    def cb(info):
-        n = max(info["n_steps"], 1)
-        report(info["step"] / n, f"t = {info['t']:.4g} s")
-
-    res = integrate(model, x_start, np.zeros(model.n_dof), dt=s["dt"], t_end=s["t_end"], method=s["method"],
-                    damping=s["damping"], save_every=s["save_every"], progress=cb,
-                    allow_unstable=s.get("allow_unstable", False))
+    curve = s.get("load_curve")
+    sim = Simulator(model, dt=s["dt"], method=s["method"], damping=s["damping"],
+                    allow_unstable=s.get("allow_unstable", False), load=1.0 if curve is None else curve)
+    dt, t_end, every = s["dt"], s["t_end"], s["save_every"]
+    n_steps = int(np.ceil(t_end / dt - 1e-9)) if t_end > 0 else 0
     n, dim = model.n_nodes, model.dim
-    u = (res.x_final - model.x0).reshape(n, dim)
-    out = {"displacement": u, "reaction": model.reaction(res.x_final, 1.0),
-           "stats": {"type": "dynamic", **res.stats}, "extra_attrs": {}}
-    if setup.scene.output["history"]:
-        n_t = len(res.t)
-        out["history"] = {"time": res.t, "displacement": (res.x - model.x0).reshape(n_t, n, dim),
-                          "velocity": res.v.reshape(n_t, n, dim),
-                          "reaction": np.stack([model.reaction(x, 1.0) for x in res.x]) if n_t else
-                          np.zeros((0, n, dim))}
-        extra = {"kinetic_energy": (("time",), res.kinetic_energy, {"units": "J", "long_name": "kinetic energy"})}
-        if res.potential_energy is not None:
-            extra["potential_energy"] = (("time",), res.potential_energy,
+    keep = setup.scene.output["history"]
+    stepper = sim._stepper
+    ts, xs, vs, rs, kes, pes = [], [], [], [], [], []
+
+    def save(step):
+        ts.append(sim.t)
+        if keep:
+            xs.append(sim.x.copy())
+            vs.append(sim.v.copy())
+            rs.append(np.array(sim.reaction))
+            kes.append(stepper.kinetic_energy())
+            if stepper.conservative:
+                pes.append(protocol._energy_or_none(model, stepper.x, stepper.load))
+        report(step / max(n_steps, 1), f"t = {sim.t:.4g} s")
+
+    save(0)
+    done = 0
+    while done < n_steps:  # the steps between two saved states in one call
+        k = min(every - done % every, n_steps - done)
+        last = done + k == n_steps
+        if last and k > 1:
+            sim.step(k - 1)
+        if last:  # the last step is shortened to end exactly at t_end
+            sim.step(1, h=t_end - (n_steps - 1) * dt, t_new=float(t_end))
+        else:
+            sim.step(k)
+        done += k
+        stepper = sim._stepper
+        save(done)
+    stats = dict(stepper.stats)
+    stats["wall_time"] = sim._wall
+    stats["messages"] = stepper.messages
+    stats["engine"] = sim.engine
+    stats["n_steps"] = n_steps
+    out = {"displacement": sim.displacement.copy(), "reaction": np.array(sim.reaction),
+           "stats": {"type": "dynamic", **stats}, "extra_attrs": {}}
+    if keep:
+        n_t = len(ts)
+        out["history"] = {"time": np.array(ts), "displacement": (np.array(xs) - model.x0.reshape(n, dim)),
+                          "velocity": np.array(vs).reshape(n_t, n, dim), "reaction": np.array(rs).reshape(n_t, n, dim)}
+        extra = {"kinetic_energy": (("time",), np.array(kes), {"units": "J", "long_name": "kinetic energy"})}
+        if stepper.conservative:
+            extra["potential_energy"] = (("time",), np.array(pes, dtype=float),
                                          {"units": "J", "long_name": "potential energy (internal minus load work)"})
         out["extra_vars"] = extra
     return out

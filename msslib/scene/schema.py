@@ -330,7 +330,7 @@ def _solver(path, value, model):
             "max_iter": _integer(f"{path}.max_iter", value.get("max_iter", 50 if model in MSS_MODELS else 30),
                                  maximum=MAX_NEWTON_ITERATIONS, why=" (Newton converges in tens of iterations or not at all)"),
         }
-    _mapping(path, value, ("type", "method", "dt", "t_end", "damping", "save_every", "allow_unstable"),
+    _mapping(path, value, ("type", "method", "dt", "t_end", "damping", "save_every", "allow_unstable", "load_curve"),
              required=("dt", "t_end"))
     if model in FEM_MODELS:
         _fail(f"{path}.type", f"dynamic runs need an MSS model; {model} is static only")
@@ -349,12 +349,29 @@ def _solver(path, value, model):
         "damping": damping,
         "save_every": _integer(f"{path}.save_every", value.get("save_every", 1)),
         "allow_unstable": _boolean(f"{path}.allow_unstable", value.get("allow_unstable", False)),
+        "load_curve": _load_curve(f"{path}.load_curve", value.get("load_curve")),
     }
     n_steps = out["t_end"] / out["dt"]
     if n_steps > MAX_TIME_STEPS:
         _fail(f"{path}.dt", f"t_end / dt = {n_steps:.3g} time steps, more than the {MAX_TIME_STEPS:.0e} a run may take "
               f"(dt = {_show(value['dt'])} s, t_end = {_show(value['t_end'])} s); use a larger dt or a shorter t_end")
     return out
+
+
+def _load_curve(path, value):
+    """``[[t, factor], ...]``: the load factor of a dynamic run against time (None: 1)."""
+    if value is None:
+        return None
+    from msslib.simulator.loads import Curve
+
+    try:
+        Curve(value, path)
+    except (ValueError, TypeError) as exc:
+        text = str(exc) if str(exc).startswith(path) else f"{path}: {exc}"
+        _fail(path, text.removeprefix(f"{path}: ") + "; expected rows [t (s), load factor] with increasing t")
+    if len(value[0]) != 2:
+        _fail(path, f"expected rows [t (s), load factor], got rows of {len(value[0])} numbers")
+    return [[float(a) for a in row] for row in value]
 
 
 def _output(path, value):

@@ -1,0 +1,174 @@
+"""The fused spring-network engine of the stepping API: :class:`NetworkStepper` runs the steps of
+:class:`msslib.solvers.dynamics.Integrator` (symplectic Euler, mass-proportional damping) with
+the kernels of :mod:`msslib.explicit.network`, and the same stability check and divergence
+detector."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from msslib.errors import DivergenceError
+from msslib.explicit.network import N_MONITOR, _advance, _pass, _steps, network_layout
+from msslib.solvers.dynamics import Integrator
+
+
+def network_terms(model):
+    """``(springs, others, why)``: the 3D spring terms (which the kernel runs), the other
+    internal terms (their forces are added before each pass), or ``why`` the model cannot run on
+    the network engine (None when it can)."""
+    if getattr(model, "dim", None) != 3:
+        return [], [], "the network engine is 3D"
+    springs, others = [], []
+    for t in model.terms:
+        if t.kind == "springs" and getattr(t, "dim", 3) == 3 and hasattr(t, "rest_length"):
+            springs.append(t)
+        elif t.kind == "external" and t.abs_row_sums(np.zeros(0), 1.0, np.zeros(0), np.zeros(0)):
+            continue  # dead loads: in the external force
+        elif t.scales_with_load:
+            return [], [], f"{type(t).__name__} scales with the load and is not a dead load"
+        else:
+            others.append(t)
+    if not springs:
+        return [], [], "the model has no springs"
+    return springs, others, None
+
+
+class NetworkStepper(Integrator):
+    """:class:`Integrator` for ``symplectic_euler`` on a 3D spring model, with the fused kernel.
+
+    The state arrays ``x``, ``v`` (flat), the total force ``F`` at ``x`` and the reactions
+    ``react`` (``-F`` on the dofs that do not move, 0 elsewhere) are updated in place and stay
+    current after every step."""
+
+    def __init__(self, model, x0, v0, *, dt, damping=None, load=1.0, blowup=1e3, allow_unstable=False,
+                 free=None, drive=None):
+        springs, others, why = network_terms(model)
+        if why is not None:
+            raise ValueError(f"network engine: {why}")
+        super().__init__(model, x0, v0, dt=dt, method="symplectic_euler", damping=damping, load=load,
+                         blowup=blowup, allow_unstable=allow_unstable, free=free, drive=drive)
+        if self.beta:
+            raise ValueError("network engine: mass-proportional damping only (beta = 0)")
+        n = model.n_dof
+        conn = np.concatenate([s.conn for s in springs])
+        k = np.concatenate([s.k for s in springs])
+        rest = np.concatenate([s.rest_length for s in springs])
+        self.layout = network_layout(conn, k, rest, model.n_nodes)
+        self.n_springs = len(conn)
+        self.others = others
+        self._external = model.external_force(1.0) if hasattr(model, "external_force") else np.zeros(n)
+        self.x = np.ascontiguousarray(self.x)
+        self.v = np.ascontiguousarray(self.v)
+        self.F = np.zeros(n)
+        self.Fp = np.zeros(n)
+        self.react = np.zeros(n)
+        self.acc = np.zeros(n)
+        self.fext = np.zeros(n)
+        self.inv_m_all = np.where(self.free, 1.0 / np.where(self.mass > 0, self.mass, 1.0), 0.0)
+        self._h = None
+        self._set_step(self.dt)
+        self._x_prev = np.empty(n)
+        self._v_prev = np.empty(n)
+        self.mon = np.zeros((1, N_MONITOR))
+        self.evaluate()
+
+    def _set_step(self, h):
+        if h != self._h:
+            self._h = float(h)
+            self.w = np.where(self.free, self._h * self.inv_m_all, 0.0)
+            self.damp = 1.0 - self._h * self.alpha
+
+    def _update_external(self):
+        np.multiply(self._external, self.load, out=self.fext)
+        if self.extra is not None:
+            self.fext += self.extra
+
+    def _preload(self):
+        self.acc[:] = 0.0
+        for t in self.others:
+            self.acc -= t.gradient(self.x)
+
+    def evaluate(self):
+        """The force, reactions and monitor at the current state (no step): after a change of the
+        loads or of the driven dofs' positions made outside :meth:`step`."""
+        self._update_external()
+        self._preload()
+        x, v, F, Fp = self.x, self.v, self.F, self.Fp
+        rowptr, ib, kl = self.layout
+        _pass(x, v, F, Fp, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self.acc, self.x_ref,
+              self.mass, self.inv_m_all, self.react, self.mon, 0, False)
+        self.stats["n_force_evals"] += 1
+        self.f = F[self.free]
+
+    def full_force(self):
+        return self.F
+
+    def step(self, h=None, t_new=None):
+        self.steps(1, h, t_new)
+
+    def steps(self, n: int, h=None, t_new=None):
+        """``n`` steps of ``h`` (default ``dt``); ``t_new`` the time after the last one.  Runs them
+        in one kernel call when nothing changes in between (no ``drive``, no other terms)."""
+        n = int(n)
+        if n < 1:
+            return
+        h = self.dt if h is None else float(h)
+        self._set_step(h)
+        end = self.t + n * h if t_new is None else float(t_new)
+        rowptr, ib, kl = self.layout
+        if self.drive is None and not self.others:
+            if self.mon.shape[0] < n:
+                self.mon = np.zeros((n, N_MONITOR))
+            np.copyto(self._x_prev, self.x)
+            np.copyto(self._v_prev, self.v)
+            snapshot = (self.j_min, self.flips)
+            _steps(self.x, self.v, self.F, self.Fp, rowptr, ib, kl, self.w, self.damp, h, self.fext, self.acc,
+                   self.x_ref, self.mass, self.inv_m_all, self.react, self.mon, n)
+            self.stats["n_force_evals"] += n
+            t0 = self.t
+            try:
+                for i in range(n):
+                    self._observe_row(i, h, self.n_taken + i + 1, t0 + (i + 1) * h if i + 1 < n else end,
+                                      None, None)
+            except DivergenceError:
+                self._replay(n, h, t0, end, snapshot)
+                raise
+            self.n_taken += n
+            self.t = end
+        else:
+            for i in range(n):
+                np.copyto(self._x_prev, self.x)
+                np.copyto(self._v_prev, self.v)
+                t_step = self.t + h if i + 1 < n else end
+                _advance(self.x, self.v, self.F, self.w, self.damp, h)
+                if self.drive is not None:
+                    self.drive(t_step, self.x)
+                self.evaluate()
+                self.n_taken += 1
+                self.t = t_step
+                self._observe_row(0, h, self.n_taken, t_step, self._x_prev, self._v_prev)
+        self.f = self.F[self.free]
+        self.stats["n_steps"] = max(self.stats["n_steps"], self.n_taken)
+
+    def _observe_row(self, i, h, step, t, x_prev, v_prev):
+        q, pf, ku, r, dmax = self.mon[i]
+        self.observe(q, pf, ku, r, dmax, h, step, t, x_prev, v_prev, True)
+
+    def _replay(self, n, h, t0, end, snapshot):
+        """After a divergence found in a multi-step call: rerun from the saved start (the scheme is
+        deterministic) to get the states around the failing step, and raise with them."""
+        self.j_min, self.flips = snapshot
+        start_x, start_v = self._x_prev.copy(), self._v_prev.copy()
+        self.x[:] = start_x
+        self.v[:] = start_v
+        self.evaluate()
+        self.j_min, self.flips = snapshot
+        for i in range(n):
+            np.copyto(self._x_prev, self.x)
+            np.copyto(self._v_prev, self.v)
+            t_step = t0 + (i + 1) * h if i + 1 < n else end
+            _advance(self.x, self.v, self.F, self.w, self.damp, h)
+            self.evaluate()
+            self.n_taken += 1
+            self.t = t_step
+            self._observe_row(0, h, self.n_taken, t_step, self._x_prev.copy(), self._v_prev.copy())
