@@ -74,3 +74,86 @@ def test_generic_orientation_fills_every_matrix():
         R = sparsity.rotation(2 if name.startswith("square") else 3)
         np.testing.assert_allclose(R @ R.T, np.eye(len(R)), atol=1e-12)
         assert sparsity.numerical_mask(sparsity.simulator(name, R)).all(), name
+
+
+# ------------------------------------------------------------------------------------------------
+# one-point quadrature of bilinear quads (the "constant strain rectangle" of Sec. 5.3)
+# ------------------------------------------------------------------------------------------------
+
+from msslib import fem as F  # noqa: E402
+from msslib import mesh as MESH  # noqa: E402
+from msslib.errors import MsslibWarning  # noqa: E402
+
+
+def distorted_grid(n=4, side=0.05, amount=0.003, seed=1):
+    mesh = MESH.quad_grid(side, side, n, n)
+    p = mesh.points.copy()
+    inner = (p[:, 0] > 1e-9) & (p[:, 0] < side - 1e-9) & (p[:, 1] > 1e-9) & (p[:, 1] < side - 1e-9)
+    p[inner] += np.random.default_rng(seed).uniform(-amount, amount, (inner.sum(), 2))
+    return MESH.Mesh(p, mesh.cells, "quad"), inner
+
+
+def test_one_point_quads_pass_the_patch_test():
+    mesh, inner = distorted_grid()
+    p = mesh.points
+    exact = np.column_stack([1e-3 * p[:, 0] + 2e-3 * p[:, 1], -0.5e-3 * p[:, 0] + 3e-3 * p[:, 1]]) + [1e-4, -2e-4]
+    fixed = np.zeros((mesh.n_nodes, 2), dtype=bool)
+    fixed[~inner] = True
+    r = F.solve_linear(mesh, E, 1 / 3, fixed=fixed, prescribed=exact, thickness=T, quadrature="one_point")
+    np.testing.assert_allclose(r.displacement, exact, atol=1e-12 * np.abs(exact).max())
+    assert r.stats["quadrature"] == "one_point"
+    assert abs(r.stats["hourglass_energy_fraction"]) < 1e-10  # a linear field has no hourglass part
+    # the constant strain's energy: E t A / (1 - nu^2) (e_xx^2 + e_yy^2 + 2 nu e_xx e_yy) / 2 + G t A g^2 / 2
+    exx, eyy, gxy, nu = 1e-3, 3e-3, 2e-3 - 0.5e-3, 1 / 3
+    A = 0.05**2
+    energy = E * T * A / (1 - nu**2) * (exx**2 + eyy**2 + 2 * nu * exx * eyy) / 2 + E / (2 * (1 + nu)) * T * A * gxy**2 / 2
+    assert r.strain_energy == pytest.approx(energy, rel=1e-10)
+
+
+def test_one_point_element_has_two_hourglass_modes():
+    m1 = MESH.quad_grid(0.01, 0.01, 1, 1)
+    cell = m1.cells[0]  # corners counter-clockwise
+    full = np.linalg.eigvalsh(F.element_stiffness("quad", m1.points[cell], E, 1 / 3, thickness=T))
+    hourglass = np.zeros((4, 2))
+    hourglass[cell, 0] = np.array([1.0, -1.0, 1.0, -1.0]) * 1e-4  # the x hourglass mode
+    fixed = np.ones((4, 2), dtype=bool)
+    with pytest.warns(MsslibWarning, match="hourglass"):
+        r = F.solve_linear(m1, E, 1 / 3, fixed=fixed, prescribed=hourglass, thickness=T, quadrature="one_point")
+    assert r.strain_energy == pytest.approx(0.0, abs=1e-12 * E * T * 1e-8)
+    assert r.stats["hourglass_energy_fraction"] == pytest.approx(1.0)
+    assert (full < 1e-10 * full.max()).sum() == 3  # the fully integrated element: rigid modes only
+    assert F.solve_linear(m1, E, 1 / 3, fixed=fixed, prescribed=hourglass, thickness=T).strain_energy > 0
+
+
+def test_one_point_singular_supports_and_wrong_cells_stop_with_one_line():
+    m1 = MESH.quad_grid(0.05, 0.05, 1, 1)
+    fixed = np.zeros((4, 2), dtype=bool)
+    fixed[np.isclose(m1.points[:, 1], 0.0)] = True  # bottom fixed: the fully integrated quad is stable
+    f = np.zeros((4, 2))
+    f[2:] = [1.0, 0.0]
+    F.solve_linear(m1, E, 1 / 3, fixed=fixed, nodal_forces=f, thickness=T)
+    with pytest.raises(np.linalg.LinAlgError, match="hourglass"):
+        F.solve_linear(m1, E, 1 / 3, fixed=fixed, nodal_forces=f, thickness=T, quadrature="one_point")
+    tri = MESH.Mesh(np.array([[0, 0], [1, 0], [0, 1.0]]), np.array([[0, 1, 2]]), "triangle")
+    with pytest.raises(ValueError, match="bilinear quads"):
+        F.solve_linear(tri, E, 1 / 3, fixed=np.ones((3, 2), bool), quadrature="one_point")
+    with pytest.raises(ValueError, match="quadrature must be"):
+        F.solve_linear(m1, E, 1 / 3, fixed=fixed, quadrature="two_point")
+
+
+def test_one_point_reference_is_softer_in_shear_and_says_how_much():
+    """Sec. 5.3's 5 x 5 membrane, bottom fixed, sheared: the one-point system is regular, softer than
+    the bilinear one, and names the share of the hourglass energy."""
+    mesh = MESH.quad_grid(0.05, 0.05, 5, 5)
+    fixed = np.zeros((mesh.n_nodes, 2), dtype=bool)
+    fixed[np.isclose(mesh.points[:, 1], 0.0)] = True
+    top = np.isclose(mesh.points[:, 1], 0.05)
+    f = np.zeros((mesh.n_nodes, 2))
+    f[top, 0] = 1.0
+    full = F.solve_linear(mesh, E, 1 / 3, fixed=fixed, nodal_forces=f, thickness=T)
+    with pytest.warns(MsslibWarning, match="hourglass"):
+        one = F.solve_linear(mesh, E, 1 / 3, fixed=fixed, nodal_forces=f, thickness=T, quadrature="one_point")
+    # reactions balance the load (an independent number: the applied total)
+    np.testing.assert_allclose(one.reaction.sum(axis=0), -f.sum(axis=0), atol=1e-9)
+    assert one.strain_energy > full.strain_energy  # same load, fewer constraints on the energy: softer
+    assert 0.05 < one.stats["hourglass_energy_fraction"] < 1

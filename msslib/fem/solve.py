@@ -13,6 +13,7 @@ import scipy.sparse.linalg as spla
 
 from msslib.fem.materials import _cell_materials, _check_plane, _law, lame
 from msslib.fem.space import _boundary, _Geometry, _linear_stiffness, _skfem_linear_stiffness
+from msslib.errors import MsslibWarning
 from msslib.mesh import CELL_TYPES, Mesh
 from msslib.models.fem import warn_locking
 
@@ -75,6 +76,7 @@ def solve_linear(
     tractions=(),
     linear_solver="auto",
     volumetric: str = "full",
+    quadrature: str = "full",
 ) -> FemResult:
     """Small-strain isotropic linear elasticity on ``mesh``.
 
@@ -95,6 +97,13 @@ def solve_linear(
     element's shape functions. ``linear_solver``: ``"auto"`` (the policy of
     :mod:`msslib.solvers`: banded Cholesky, SuperLU or AMG-preconditioned CG), ``"direct"`` or
     ``"cg"``.
+
+    ``quadrature``: ``"full"`` (default) or ``"one_point"``, bilinear quads (order 1) integrated at
+    their centre only: the element whose strain is the constant one at its centre. Its stiffness
+    does not resist the two hourglass modes of each quad; a system they leave singular raises
+    :class:`numpy.linalg.LinAlgError` naming them, and ``stats["hourglass_energy_fraction"]`` is
+    the share of the solution's full-quadrature (bilinear) energy that the one-point element does
+    not see, with a :class:`~msslib.errors.MsslibWarning` above :data:`HOURGLASS_WARN`.
     """
     from msslib.fem.newton import SOLVER, linear_solve
 
@@ -110,7 +119,15 @@ def solve_linear(
     w = thickness if mesh.dim == 2 else 1.0
     if assembly == "skfem" and (order != 1 or volumetric != "full"):
         raise ValueError("assembly='skfem' is for linear elements (order=1) with volumetric='full'")
-    if assembly == "fast":
+    if quadrature not in QUADRATURES:
+        raise ValueError(f"quadrature must be one of {QUADRATURES}, got {quadrature!r}")
+    if quadrature == "one_point" and (mesh.cell_type != "quad" or order != 1 or volumetric != "full" or assembly != "fast"):
+        raise ValueError("quadrature='one_point' is for bilinear quads (cell type quad, order=1, volumetric='full', "
+                         f"assembly='fast'), got {mesh.cell_type} cells, order={order}, volumetric={volumetric!r}, "
+                         f"assembly={assembly!r}")
+    if quadrature == "one_point":
+        K = _linear_stiffness(_Geometry(mesh, 1, quadrature=ONE_POINT_QUAD), lam_c, mu_c) * w
+    elif assembly == "fast":
         K = sum(_linear_stiffness(g, lam_q[:, 0], mu_q[:, 0])
                 for g, lam_q, mu_q in _parts(mesh, geo, lam_c, mu_c, volumetric, plane if mesh.dim == 2 else None)) * w
     elif assembly == "skfem":
@@ -125,7 +142,7 @@ def solve_linear(
     how = "none (no free dof)"
     if free.any():
         rhs = f[free] - K[free][:, cons] @ presc[cons]
-        u[free], how = linear_solve(K, rhs, free, geo.points, mesh.dim, linear_solver)
+        u[free], how = _solve_free(K, rhs, free, geo, linear_solver, quadrature)
     t2 = time.perf_counter()
 
     Ku = K @ u
@@ -141,8 +158,49 @@ def solve_linear(
         "assembly": assembly,
         "plane": plane if d == 2 else None,
         "order": order,
+        "quadrature": quadrature,
     }
+    if quadrature == "one_point":
+        stats["hourglass_energy_fraction"] = _hourglass_fraction(geo, lam_c, mu_c, w, u, float(u @ Ku))
     return _result(geo, u, reaction, float(0.5 * u @ Ku), stats)
+
+
+#: the quadrature options of :func:`solve_linear`; one point: the centre of scikit-fem's reference
+#: square [0, 1]^2, weight 1 (its area)
+QUADRATURES = ("full", "one_point")
+ONE_POINT_QUAD = (np.array([[0.5], [0.5]]), np.array([1.0]))
+#: above this share of the bilinear energy in hourglass modes a one-point solve warns
+HOURGLASS_WARN = 0.01
+
+
+def _solve_free(K, rhs, free, geo, linear_solver, quadrature):
+    """The free dofs' solution; a singular one-point system is named by its hourglass modes."""
+    from msslib.fem.newton import linear_solve
+
+    if quadrature != "one_point":
+        return linear_solve(K, rhs, free, geo.points, geo.dim, linear_solver)
+    A = K.tocsr()[free][:, free]
+    # one-point quads can be singular with every rigid-body mode constrained; a pivoting solver
+    # may still return a finite vector, so the smallest eigenvalue decides
+    lo = spla.eigsh(A, k=1, sigma=-1e-6 * abs(A.diagonal()).max(), which="LM", return_eigenvectors=False)[0] \
+        if A.shape[0] > 2 else np.linalg.eigvalsh(A.toarray())[0]
+    if lo <= 1e-10 * abs(A.diagonal()).max():
+        raise np.linalg.LinAlgError("singular stiffness with quadrature='one_point': the supports leave an hourglass "
+                                    "mode of the quads free (zero energy at the element centres); constrain more "
+                                    "nodes or use quadrature='full'")
+    return linear_solve(K, rhs, free, geo.points, geo.dim, linear_solver)
+
+
+def _hourglass_fraction(geo, lam_c, mu_c, w, u, one_point_energy) -> float:
+    """Share of the solution's full-quadrature energy ``u K_full u`` that one-point quadrature
+    does not see (``(u K_full u - u K_1 u) / u K_full u``), with a warning above HOURGLASS_WARN."""
+    full = float(u @ (_linear_stiffness(geo, lam_c, mu_c) * w @ u))
+    share = (full - one_point_energy) / full if full > 0 else 0.0
+    if share > HOURGLASS_WARN:
+        warnings.warn(MsslibWarning(
+            f"quadrature='one_point': {100 * share:.2g} % of the solution's bilinear (full-quadrature) energy lies in "
+            "hourglass modes, which the one-point quads do not resist; compare with quadrature='full'"), stacklevel=3)
+    return share
 
 
 #: quadrature of the volumetric term with volumetric="reduced": one point on P2 simplices (the

@@ -52,7 +52,7 @@ class _Geometry:
     order 1): prescribed nodal values are carried to every dof by it, and dof forces back to the
     nodes by its transpose (which keeps their sum)."""
 
-    def __init__(self, mesh: Mesh, order: int = 1, intorder: int | None = None):
+    def __init__(self, mesh: Mesh, order: int = 1, intorder: int | None = None, quadrature=None):
         import skfem
 
         if order not in ORDERS:
@@ -64,7 +64,10 @@ class _Geometry:
         self.elem = elem1 if order == 1 else getattr(skfem, _ORDER2[mesh.cell_type])()
         if intorder is None:
             intorder = _INTORDER_ORDER[order][mesh.cell_type]
-        self.basis = skfem.Basis(self.skmesh, self.elem, intorder=intorder)
+        # ``quadrature``: an explicit rule ``(points (dim, q), weights (q,))`` on the reference cell
+        # (scikit-fem takes at least 2 points per direction from ``intorder``)
+        self.basis = (skfem.Basis(self.skmesh, self.elem, quadrature=quadrature) if quadrature is not None
+                      else skfem.Basis(self.skmesh, self.elem, intorder=intorder))
         nb = self.basis.Nbfun
         nodal = np.asarray(self.basis.nodal_dofs).ravel()
         n_sk = nodal.size  # scikit-fem drops trailing unused nodes

@@ -11,7 +11,8 @@ INPUTS = ["results/lloyd/studies/ratio_causes.nc"]
 SHORT = {"baseline": "nothing (the experiment file)", "equal_forces": "equal nodal forces",
          "mss_strain": "load from the MSS strain", "flipped": "mesh upside down",
          "flipped_equal_forces": "mesh upside down, equal forces", "cst_slash": "reference CST, diagonals up",
-         "cst_backslash": "reference CST, diagonals down", "cst_crossed": "reference CST, both diagonals"}
+         "cst_backslash": "reference CST, diagonals down", "cst_crossed": "reference CST, both diagonals",
+         "q1_one_point": "reference Q1, one-point quadrature"}
 
 
 def main(argv=None):
@@ -21,7 +22,8 @@ def main(argv=None):
         ("**Lloyd Secs. 5.1 and 5.3: what sets the ratio mean/max error** (one factor changed at a time "
          "from the experiment files' set-up; strains along the load at the top corner node and in the middle "
          "of the top edge; the paper: 11.2-13.6 % at these two points in Fig. 9a; CST: the squares split into "
-         "constant-strain triangles along one diagonal, up = lower left to upper right, or both)"),
+         "constant-strain triangles along one diagonal, up = lower left to upper right, or both; Q1 one-point: "
+         "bilinear quads integrated at their centre, the constant strain rectangle)"),
         ["Sec.", "case", "changed", "load (Pa)", "strain corner / middle, FEM (%)", "ours max (mm)", "ours mean/max",
          "published max (mm)", "published mean/max", "ours - published, mean/max"])
     for r in script.rows(ds, "run"):
