@@ -17,7 +17,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__)
     ap.add_argument("--quick", action="store_true", help="reduced sizes (< 60 s)")
     ap.add_argument("--out", default="results/benchmarks.json", help="JSON output file")
-    ap.add_argument("--only", default="", help="comma-separated sections: springs,scaling,cantilever,dynamics,scenes")
+    ap.add_argument("--only", default="", help="comma-separated sections: springs,scaling,cantilever,dynamics,scenes,stepping")
     args = ap.parse_args(argv)
 
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")
@@ -40,13 +40,14 @@ def main(argv=None):
     print(f"threads: BLAS/OpenMP pools pinned to 1 ({pools}); numba threads {numba.get_num_threads()}; "
           f"cpu count {os.cpu_count()}; load average {os.getloadavg()[0]:.1f}", flush=True)
     res = Results()
-    sections = [s for s in args.only.split(",") if s] or ["springs", "cantilever", "dynamics", "scaling", "scenes"]
-    from . import dynamics, scenes, springs, statics
+    sections = [s for s in args.only.split(",") if s] or ["springs", "cantilever", "dynamics", "scaling", "scenes", "stepping"]
+    from . import dynamics, scenes, springs, statics, stepping
 
     t0 = time.perf_counter()
     for sec in sections:
         {"springs": springs.run, "scaling": statics.run_scaling, "cantilever": statics.run_cantilever,
-         "dynamics": dynamics.run, "scenes": scenes.run}[sec](res, args.quick)
+         "dynamics": dynamics.run, "scenes": scenes.run,
+         "stepping": stepping.run}[sec](res, args.quick)
     try:
         import pyamg
         amg = pyamg.__version__

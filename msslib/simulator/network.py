@@ -126,13 +126,15 @@ class NetworkStepper(Integrator):
                    self.x_ref, self.mass, self.inv_m_all, self.react, self.mon, n)
             self.stats["n_force_evals"] += n
             t0 = self.t
+            failed = False
             try:
                 for i in range(n):
                     self._observe_row(i, h, self.n_taken + i + 1, t0 + (i + 1) * h if i + 1 < n else end,
                                       None, None)
             except DivergenceError:
+                failed = True
+            if failed:  # raised again by the replay, with the states around the failing step
                 self._replay(n, h, t0, end, snapshot)
-                raise
             self.n_taken += n
             self.t = end
         else:
