@@ -157,3 +157,31 @@ def test_one_point_reference_is_softer_in_shear_and_says_how_much():
     np.testing.assert_allclose(one.reaction.sum(axis=0), -f.sum(axis=0), atol=1e-9)
     assert one.strain_energy > full.strain_energy  # same load, fewer constraints on the energy: softer
     assert 0.05 < one.stats["hourglass_energy_fraction"] < 1
+
+
+# ------------------------------------------------------------------------------------------------
+# Sec. 5.1 with the paper's counts
+# ------------------------------------------------------------------------------------------------
+
+
+def _springs_and_triangles(mesh):
+    pairs = {tuple(sorted((int(c[a]), int(c[b])))) for c in mesh.cells for a, b in ((0, 1), (1, 2), (2, 0))}
+    return len(pairs), len(mesh.cells)
+
+
+def test_counts_mesh_has_the_papers_39_nodes_and_92_springs():
+    from experiments.lloyd.studies import ratio_causes as rc
+
+    mesh = rc.membrane("5.1", counts=True)
+    assert mesh.n_nodes == 39
+    springs, triangles = _springs_and_triangles(mesh)
+    assert springs == 92 and triangles == 54  # Euler: springs = nodes + triangles - 1
+    edges = np.linalg.norm(np.diff(mesh.points[mesh.cells][:, [0, 1, 2, 0]], axis=1), axis=2)
+    np.testing.assert_allclose(edges, edges.mean(), rtol=1e-9)  # equilateral
+    assert np.ptp(mesh.points[:, 1]) == pytest.approx(0.052, abs=5e-5)  # "5.2 cm high"
+    # the file's mesh: same nodes, one triangle more, hence 93 springs
+    file_mesh = rc.membrane("5.1")
+    assert file_mesh.n_nodes == 39 and _springs_and_triangles(file_mesh) == (93, 55)
+    # the MSS built on the counts mesh has one spring per mesh edge
+    springs_terms = rc.lloyd_triangle_springs(mesh, [(E, 1 / 3)], T)
+    assert sum(len(t.k) for t in springs_terms) == 92

@@ -12,8 +12,12 @@ stated deformation in the FEM) one factor is changed at a time:
 * ``mss_strain``: the load that gives the stated deformation in the MSS instead of the FEM;
 * Sec. 5.1 ``flipped``: the equilateral mesh upside down, so that the top row has 7 nodes with one
   in the middle (the paper measures the strain "at corner or middle node on top boundary"; the
-  file's mesh, like the paper's, has 39 nodes and 92 springs either way), and, as the one
+  file's mesh has 39 nodes and 93 springs either way), and, as the one
   combination, ``flipped_equal_forces``;
+* Sec. 5.1 ``counts_mesh``: a mesh with the paper's counts (the file's mesh has 39 nodes and 93
+  springs, 55 triangles: rows of 7, 6, 7, 6, 7, 6 nodes, edge 1.2 cm; 92 springs with 39 nodes
+  means 54 triangles, which rows of equilateral triangles give only as 6, 5, 6, 5, 6, 5, 6 nodes:
+  edge 1 cm, 5 cm wide and, with six rows of triangles, the stated 5.2 cm high);
 * Sec. 5.3, the reference the paper calls "constant strain rectangle elements": bilinear quads
   (Q1, the file's) or constant-strain triangles, each square split along one diagonal
   (``cst_slash``: lower left to upper right, ``cst_backslash``: the other) or along both with a
@@ -62,7 +66,7 @@ PUBLISHED = {
 TARGET = {("5.1", "stretch"): 0.124, ("5.1", "compression"): 0.124, ("5.1", "shear"): 0.13,
           ("5.3", "stretch"): 0.12, ("5.3", "compression"): 0.12, ("5.3", "shear"): 0.13}
 DIRECTION = {"stretch": (0.0, 1.0), "compression": (0.0, -1.0), "shear": (1.0, 0.0)}
-FACTORS = {"5.1": ["baseline", "equal_forces", "mss_strain", "flipped", "flipped_equal_forces"],
+FACTORS = {"5.1": ["baseline", "equal_forces", "mss_strain", "flipped", "flipped_equal_forces", "counts_mesh"],
            "5.3": ["baseline", "equal_forces", "mss_strain", "cst_slash", "cst_backslash", "cst_crossed", "q1_one_point"]}
 FACTOR_TEXT = {
     "baseline": "as the experiment file: consistent forces, reference on the same mesh, load from the FEM strain",
@@ -70,6 +74,7 @@ FACTOR_TEXT = {
     "mss_strain": "load from the strain of the MSS",
     "flipped": "equilateral mesh upside down (7 nodes on the top edge)",
     "flipped_equal_forces": "both: mesh upside down and equal nodal forces",
+    "counts_mesh": "equilateral mesh with the paper's counts (39 nodes, 92 springs; edge 1 cm, rows of 6 and 5 nodes)",
     "cst_slash": "reference: constant-strain triangles, squares split lower left - upper right",
     "cst_backslash": "reference: constant-strain triangles, squares split lower right - upper left",
     "cst_crossed": "reference: constant-strain triangles, squares split along both diagonals (centre node)",
@@ -77,10 +82,15 @@ FACTOR_TEXT = {
 }
 
 
-def membrane(section, flipped=False):
-    """Mesh of the experiment (Sec. 5.1: 39-node equilateral membrane; 5.3: 5 x 5 squares)."""
+#: Sec. 5.1 with the paper's counts: 5 edges of 1.0008 cm across, six rows of triangles 5.2 cm high
+COUNTS_MESH = (0.05004, 0.0521, 5)
+
+
+def membrane(section, flipped=False, counts=False):
+    """Mesh of the experiment (Sec. 5.1: 39-node equilateral membrane, the file's or with the paper's
+    counts; 5.3: 5 x 5 squares)."""
     if section == "5.1":
-        mesh = M.triangle_grid_equilateral(0.0720534, 0.0521, 6)
+        mesh = M.triangle_grid_equilateral(*(COUNTS_MESH if counts else (0.0720534, 0.0521, 6)))
         if flipped:
             p = mesh.points.copy()
             p[:, 1] = p[:, 1].max() - p[:, 1]
@@ -139,7 +149,7 @@ def measure(section, case, mesh, u):
 
 
 def run(section, case, factor):
-    mesh = membrane(section, flipped=factor.startswith("flipped"))
+    mesh = membrane(section, flipped=factor.startswith("flipped"), counts=factor == "counts_mesh")
     fixed = np.zeros((mesh.n_nodes, 2), dtype=bool)
     fixed[np.isclose(mesh.points[:, 1], mesh.points[:, 1].min())] = True
     f1 = loads(mesh, case, equal=factor.endswith("equal_forces"))
@@ -189,7 +199,8 @@ def run(section, case, factor):
     return {"load": t, "error_max": e.max, "error_mean": e.mean, "ratio": e.mean / e.max,
             "reference_max": float(np.linalg.norm(ur, axis=1).max()),
             "corner_fem": c_fem, "middle_fem": m_fem, "corner_mss": c_mss, "middle_mss": m_mss,
-            "hourglass_energy_fraction": hourglass[-1] if hourglass else np.nan}
+            "hourglass_energy_fraction": hourglass[-1] if hourglass else np.nan,
+            "n_nodes": mesh.n_nodes, "n_springs": sum(len(t.k) for t in springs)}
 
 
 def main(argv=None):
@@ -224,6 +235,8 @@ def main(argv=None):
         ds[key] = ("run", np.array([r[key] for r in rows], dtype=float), {"units": unit, "long_name": long})
     ds["published_ratio"] = ("run", ds.published_mean.values / ds.published_max.values, {"units": "1", "long_name": "published mean / max"})
     base = {(r["section"], r["case"]): r["ratio"] for r in rows if r["factor"] == "baseline"}
+    ds["n_nodes"] = ("run", np.array([r["n_nodes"] for r in rows], dtype=float), {"units": "1", "long_name": "nodes of the mesh"})
+    ds["n_springs"] = ("run", np.array([r["n_springs"] for r in rows], dtype=float), {"units": "1", "long_name": "springs of the MSS"})
     ds["max_over_published"] = ("run", ds.error_max.values / ds.published_max.values,
                                 {"units": "1", "long_name": "maximum error / published maximum error"})
     ds["ratio_change"] = ("run", np.array([r["ratio"] - base[(r["section"], r["case"])] for r in rows]),

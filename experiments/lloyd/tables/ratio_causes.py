@@ -10,7 +10,7 @@ ROOT = Path(__file__).resolve().parents[3]
 INPUTS = ["results/lloyd/studies/ratio_causes.nc"]
 SHORT = {"baseline": "nothing (the experiment file)", "equal_forces": "equal nodal forces",
          "mss_strain": "load from the MSS strain", "flipped": "mesh upside down",
-         "flipped_equal_forces": "mesh upside down, equal forces", "cst_slash": "reference CST, diagonals up",
+         "flipped_equal_forces": "mesh upside down, equal forces", "counts_mesh": "mesh with 39 nodes, 92 springs", "cst_slash": "reference CST, diagonals up",
          "cst_backslash": "reference CST, diagonals down", "cst_crossed": "reference CST, both diagonals",
          "q1_one_point": "reference Q1, one-point quadrature"}
 
