@@ -152,16 +152,11 @@ class Simulator:
 
     def _nodes(self, selection) -> np.ndarray:
         mesh = getattr(self.model, "mesh", None)
-        if isinstance(selection, dict):
-            if "group" in selection:
-                groups = getattr(mesh, "node_groups", {}) or {}
-                if selection["group"] not in groups:
-                    raise ValueError(f"no node group {selection['group']!r}; the mesh has {sorted(groups)}")
-                return np.asarray(groups[selection["group"]], dtype=np.int64)
-            from msslib.mesh import select_nodes
+        if isinstance(selection, dict):  # the scene's selection syntax (group, plane, box)
+            from msslib.scene.selection import _select
 
-            nodes = select_nodes(mesh, box=selection.get("box"), plane=selection.get("plane"))
-            nodes = np.flatnonzero(nodes) if np.asarray(nodes).dtype == bool else np.asarray(nodes)
+            size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if mesh.n_nodes else 1.0
+            nodes = np.asarray(_select("selection", mesh, selection, max(1e-8 * size, 1e-15)))
         else:
             a = np.asarray(selection)
             nodes = np.flatnonzero(a) if a.dtype == bool else a.astype(np.int64).reshape(-1)
