@@ -68,9 +68,14 @@ def sweep(shape, forces):
     return mss, lin
 
 
-def slope(forces, disp, side):
-    """Least-squares slope (m/N) of a line through the origin fitted to one side's points."""
-    sel = forces <= 0 if side == "compression" else forces >= 0
+#: fractions of F_MAX over which the lines are fitted as well (the paper gives no force range)
+RANGES = (0.25, 0.5, 0.75, 1.0)
+
+
+def slope(forces, disp, side, limit=np.inf):
+    """Least-squares slope (m/N) of a line through the origin fitted to one side's points with
+    ``|F| <= limit``."""
+    sel = (forces <= 0 if side == "compression" else forces >= 0) & (np.abs(forces) <= limit * (1 + 1e-12))
     F, d = forces[sel], disp[sel]
     return float(F @ d / (F @ F))
 
@@ -98,12 +103,17 @@ def main(argv=None):
             "slope_compression": (("shape",), sc, {"units": "m/N", "long_name": "slope of the line fitted to the compression points (F <= 0)"}),
             "slope_stretch": (("shape",), ss, {"units": "m/N", "long_name": "slope of the line fitted to the stretch points (F >= 0)"}),
             "slope_ratio": (("shape",), sc / ss, {"units": "1", "long_name": "compression slope over stretch slope"}),
+            "slope_ratio_range": (("shape", "force_range"),
+                                  np.array([[slope(forces, disp[j], "compression", r * F_MAX) / slope(forces, disp[j], "stretch", r * F_MAX)
+                                             for r in RANGES] for j in range(2)]),
+                                  {"units": "1", "long_name": "compression slope over stretch slope, fitted up to |F| = force_range F_MAX"}),
             "fem_slope": (("shape",), np.array([slope(forces, lin[j], "stretch") for j in range(2)]),
                           {"units": "m/N", "long_name": "slope of the linear FEM response"}),
         },
         coords={
             "shape": ("shape", shapes, {"units": "1", "long_name": "element shape"}),
             "force": ("force", forces, {"units": "N", "long_name": "vertical force on each top node"}),
+            "force_range": ("force_range", np.array(RANGES), {"units": "1", "long_name": "largest |force| of the fit over F_MAX"}),
         },
         attrs={"title": "Lloyd et al. Fig. 1: force-displacement non-linearity", "E": E, "nu": NU,
                "thickness": THICKNESS, "edge_length": EDGE, "force_max": F_MAX, "quick": int(args.quick)},
