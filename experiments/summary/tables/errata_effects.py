@@ -45,7 +45,7 @@ def main():
                      f"{1e3 * float(cv.error_max.sel(variant='printed').max()):.3g} mm",
                      f"{1e3 * float(cv.error_max.sel(variant='derived').max()):.3g} mm (the formulas agree at nu = 1/4; they differ elsewhere)",
                      "results/lloyd/cylinder_volume/comparison.nc"))
-    rows.append(("Golec correction force (kappa (V - V0) dV/dP)", "not a force (N m^4): cannot be simulated as printed",
+    rows.append(("Golec correction force (kappa (V - V0) dV/dP)", "not a force (N m^3 with kappa in Pa): cannot be simulated as printed",
                  "-(kappa/V0)(V - V0) dV/dP: see the volumes of the compression experiment", "results/golec/compression"))
     lines = ["| erratum | with the printed formula | with the derived formula | source |", "|---|---|---|---|"]
     lines += [f"| {a_} | {b_} | {c_} | `{d_}` |" for a_, b_, c_, d_ in rows]
