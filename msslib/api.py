@@ -8,18 +8,17 @@ given, through :func:`msslib.scene.run_scene`.  A model built here is therefore 
 ``python -m msslib run`` builds from the same scene, with the same checks and the same messages
 (which name the scene key, e.g. ``scene.boundary[0].select``), and a result is the same dataset.
 
-A :class:`msslib.mesh.Mesh` object reaches the scene machinery, which reads meshes from files, as
-a VTU file in a temporary directory that exists for the length of the call (the node positions
-are kept exactly); the result's ``scene`` attribute describes it as an in-memory mesh.  A mesh file
-path or a scene ``geometry`` mapping (``{"generator": "hex_grid", "args": {...}}``) is passed on
-as it is.
+A :class:`msslib.mesh.Mesh` object reaches the scene machinery as the object itself (the scene's
+``geometry: {mesh: ...}``, which only the API can give), with its groups, so that materials keyed
+by group and selections by group work as from its file; the result's ``scene`` attribute
+describes it as an in-memory mesh.  A mesh file path or a scene ``geometry`` mapping
+(``{"generator": "hex_grid", "args": {...}}``) is passed on as it is.
 """
 
 from __future__ import annotations
 
 import copy
 import os
-import tempfile
 from collections.abc import Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field, fields
@@ -27,7 +26,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from msslib import mesh as _mesh
 from msslib import scene as _scene
@@ -113,10 +111,6 @@ def _source(name, materials, fixed, loads, thickness, solver, checks, options) -
     return raw
 
 
-def _describe(mesh: _mesh.Mesh) -> str:
-    return f"in-memory msslib.mesh.Mesh: {mesh.n_nodes} nodes, {mesh.n_cells} {mesh.cell_type} cells"
-
-
 def _with_geometry(raw: dict, geometry) -> dict:
     return {"name": raw["name"], "geometry": geometry, **raw}  # the keys in the order of a scene file
 
@@ -124,27 +118,10 @@ def _with_geometry(raw: dict, geometry) -> dict:
 @contextmanager
 def _loaded(raw: dict, geometry, base_dir=None):
     """The validated :class:`msslib.scene.Scene` of ``raw`` with ``geometry`` (a relative mesh
-    file found from ``base_dir``, default the current directory); a Mesh object is a VTU file in a
-    temporary directory until the block ends."""
-    if isinstance(geometry, _mesh.Mesh):
-        groups = [k for k in ("cell_groups", "facet_groups", "node_groups") if getattr(geometry, k, None)]
-        if geometry.n_cells == 0:
-            raise ValueError(f"build_model: the mesh has no cells ({geometry.n_nodes} nodes); allowed: a mesh with cells")
-        if groups:
-            raise ValueError(f"build_model: the mesh has named groups ({', '.join(groups)}), which an in-memory "
-                             f"mesh does not pass on yet; give the mesh file's path instead of the Mesh")
-        with tempfile.TemporaryDirectory(prefix="msslib-api-") as tmp:
-            path = _mesh.write_vtu(Path(tmp) / "mesh.vtu", geometry)
-            try:
-                scene = _scene.load_scene(_with_geometry(raw, {"file": str(path)}))
-                text = yaml.safe_load(scene.text)  # the recorded scene names the mesh, not the temporary file
-                text["geometry"] = {"mesh": _describe(geometry)}
-                scene.text = yaml.safe_dump(text, sort_keys=False)
-                yield scene
-            except ValueError as exc:  # a message names the mesh, not the temporary file
-                if str(path) not in str(exc):
-                    raise
-                raise ValueError(str(exc).replace(str(path), "the in-memory mesh")) from None
+    file found from ``base_dir``, default the current directory; a Mesh object is passed as it is,
+    with its groups, and the scene's record names it)."""
+    if isinstance(geometry, _mesh.Mesh):  # the mesh object itself goes to the scene (no file)
+        yield _scene.load_scene(_with_geometry(raw, {"mesh": geometry}), base_dir=base_dir)
     elif isinstance(geometry, (str, os.PathLike)):
         yield _scene.load_scene(_with_geometry(raw, {"file": os.fspath(geometry)}), base_dir=base_dir)
     elif isinstance(geometry, Mapping):

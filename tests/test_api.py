@@ -218,7 +218,7 @@ def _one_line(exc_info, *parts):
      ["scene.solver.dt", "required"]),
     (lambda m: msslib.spring_constants(m), ["spring_constants", "Mesh"]),
     (lambda m: msslib.build_model("golec_cube", msslib.mesh.Mesh(m.points, m.cells[:0], "hexahedron"), STEEL),
-     ["build_model: the mesh has no cells"]),
+     ["scene.geometry.mesh: the mesh has no cells"]),
     (lambda m: msslib.build_model("golec_cube", msslib.mesh.Mesh(m.points * [1, 1, 2], m.cells, "hexahedron"), STEEL,
                                   fixed="all"), ["scene.model: golec_cube", "not cubes"]),
     (lambda m: msslib.write_result("a.nc", "b.nc"), ["write_result", "str and str"]),

@@ -107,14 +107,29 @@ def _generator_function(name):
     return getattr(_mesh, name)
 
 
-def _geometry(path, value, base_dir: Path):
-    _mapping(path, value, ("generator", "args", "file", "refine"))
-    has_gen, has_file = "generator" in value, "file" in value
-    if has_gen == has_file:
+def mesh_description(mesh) -> str:
+    """How a scene's record names an in-memory mesh."""
+    return f"in-memory msslib.mesh.Mesh: {mesh.n_nodes} nodes, {mesh.n_cells} {mesh.cell_type} cells"
+
+
+def _geometry(path, value, base_dir: Path, mesh_obj=None):
+    _mapping(path, value, ("generator", "args", "file", "refine", "mesh"))
+    if "mesh" in value:  # only through the API: {"mesh": a msslib.mesh.Mesh}
+        if mesh_obj is None:
+            _fail(f"{path}.mesh", "an in-memory msslib.mesh.Mesh (given through the Python API); a scene file "
+                  "names a mesh by 'file' or 'generator'")
+        if len(value) != 1 and set(value) != {"mesh", "refine"}:
+            _fail(path, "give 'mesh' alone (with an optional 'refine')")
+        if mesh_obj.n_cells == 0:
+            _fail(f"{path}.mesh", f"the mesh has no cells ({mesh_obj.n_nodes} nodes); allowed: a mesh with cells")
+    elif ("generator" in value) == ("file" in value):
         _fail(path, "give exactly one of 'generator' (with 'args') or 'file'")
+    has_file = "file" in value
     # uniform midpoint refinements of the mesh (msslib.mesh.refine.uniform); only stored when asked for
     refine = {"refine": _integer(f"{path}.refine", value["refine"], minimum=0, maximum=8,
                                  why=" (each multiplies the cells by 4 or 8)")} if "refine" in value else {}
+    if "mesh" in value:
+        return {"mesh": mesh_obj, **refine}
     if has_file:
         if "args" in value:
             _fail(f"{path}.args", "only used with 'generator'")
@@ -426,6 +441,8 @@ def _check_size(root, geometry, model, solver, output, checks, n_nodes=None, dim
         what = f"{root}.geometry"
         if "generator" in geometry:
             what += f" ({geometry['generator']} with {', '.join(f'{k}={v}' for k, v in geometry['args'].items())})"
+        elif "mesh" in geometry:
+            what += " (the in-memory mesh)"
         else:
             what += f".file ({geometry['file'].name})"
         what += f": {n_nodes:.3g} nodes"
@@ -443,7 +460,12 @@ def load_scene(source, *, base_dir=None) -> Scene:
     """
     if isinstance(source, Scene):
         return source
+    mesh_obj = None
     if isinstance(source, Mapping):
+        geo = source.get("geometry")
+        if isinstance(geo, Mapping) and isinstance(geo.get("mesh"), _mesh.Mesh):  # an in-memory mesh (the API)
+            mesh_obj = geo["mesh"]
+            source = {**source, "geometry": {**geo, "mesh": mesh_description(mesh_obj)}}
         raw = _plain(source)
         path = None
         text = yaml.safe_dump(raw, sort_keys=False)
@@ -464,7 +486,7 @@ def load_scene(source, *, base_dir=None) -> Scene:
     name = _string(f"{root}.name", name) if name is not None else (path.stem if path else "scene")
     description = raw.get("description")
     description = "" if description is None else _string(f"{root}.description", description)
-    geometry = _geometry(f"{root}.geometry", raw["geometry"], base)
+    geometry = _geometry(f"{root}.geometry", raw["geometry"], base, mesh_obj)
     materials, material_groups = _materials(f"{root}.materials", raw["materials"])
     if material_groups is not None and "generator" in geometry:
         _fail(f"{root}.materials", f"keyed by mesh group ({', '.join(material_groups)}), but the generated mesh "

@@ -24,6 +24,11 @@ def _build_mesh(scene: Scene) -> _mesh.Mesh:
         _check_size("scene", geo, scene.model, scene.solver, scene.output, scene.checks, n_nodes=mesh.n_nodes,
                     dim=mesh.dim)
         mesh = _mesh.orient(mesh)
+    elif "mesh" in geo:  # an in-memory mesh (the API): used as given, oriented like a file's
+        mesh = geo["mesh"]
+        _check_size("scene", geo, scene.model, scene.solver, scene.output, scene.checks, n_nodes=mesh.n_nodes,
+                    dim=mesh.dim)
+        mesh = _mesh.orient(mesh)
     else:
         fn = _generator_function(geo["generator"])
         try:
@@ -39,7 +44,8 @@ def _build_mesh(scene: Scene) -> _mesh.Mesh:
     groups = scene.material_groups
     if groups is not None:
         if not mesh.cell_groups:
-            what = f"the mesh file {geo['file'].name}" if "file" in geo else f"the generated mesh ({geo['generator']})"
+            what = (f"the mesh file {geo['file'].name}" if "file" in geo else "the in-memory mesh" if "mesh" in geo
+                    else f"the generated mesh ({geo['generator']})")
             _fail("scene.materials", f"keyed by mesh group ({', '.join(groups)}), but {what} has no groups of its "
                   f"{mesh.cell_type} cells (its groups: {_group_names(mesh)}); allowed: a list of materials, or a "
                   f"mesh file with physical groups or cell sets of its cells")
