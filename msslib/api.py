@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from msslib import mesh as _mesh
+from msslib import models as _models
 from msslib import scene as _scene
 
 __all__ = ["ModelSetup", "read_mesh", "build_model", "spring_constants", "solve_static", "solve_dynamic",
@@ -157,7 +158,8 @@ def build_model(name: str, mesh, materials, *, fixed=None, loads=None, thickness
         :func:`solve_dynamic`; ``{"type": "dynamic", "dt": ..., "t_end": ...}`` lets a body move
         freely (a static model must be held; its damping becomes the model's).
     checks : the scene's ``checks`` mapping.
-    **options : the model options ``published``, ``A``, ``terms``, ``plane``.
+    **options : the model options ``published`` and ``terms`` (every model) and each model's own:
+        {model_options} (:mod:`msslib.scene`, key ``model``, says what each does).
 
     Returns a :class:`ModelSetup`: ``.model`` is the :class:`msslib.model.Model`.  Bad arguments
     raise a one-line ValueError naming the scene key (``scene.materials[0].nu: must be < 0.5``).
@@ -173,6 +175,18 @@ def build_model(name: str, mesh, materials, *, fixed=None, loads=None, thickness
         setup = _scene.prepare(scene)
     values = {f.name: getattr(setup, f.name) for f in fields(_scene.Setup)}
     return ModelSetup(**values, source=raw, geometry=mesh, base_dir=base_dir)
+
+
+def _model_options_text() -> str:
+    """The model-specific options with the models that take them, from the model registry."""
+    takers: dict[str, list[str]] = {}
+    for name in _models.names():
+        for option in _models.get(name).options:
+            takers.setdefault(option.name, []).append(name)
+    return ", ".join(f"``{o}`` ({', '.join(m)})" for o, m in takers.items())
+
+
+build_model.__doc__ = build_model.__doc__.replace("{model_options}", _model_options_text())
 
 
 # --------------------------------------------------------------------------------------------

@@ -107,8 +107,6 @@ def test_readme_element_list_is_the_derivation_registry():
     assert sorted(listed) == sorted(derivations.names("elements"))
 
 
-@pytest.mark.xfail(strict=True, reason="build_model's docstring (msslib/api.py) names the options published, "
-                                       "A, terms and plane, not fit (lloyd_rectangle) or correction (baudet_cube)")
 def test_api_docstring_lists_every_build_model_option():
     doc = msslib.api.build_model.__doc__
     keywords = [p.name for p in inspect.signature(msslib.api.build_model).parameters.values()
