@@ -116,7 +116,7 @@ def _solve_mss_dynamic(setup: Setup, report):
             rs.append(np.array(sim.reaction))
             kes.append(stepper.kinetic_energy())
             if stepper.conservative:
-                pes.append(protocol._energy_or_none(model, stepper.x, stepper.load))
+                pes.append(protocol._energy_or_none(model, np.ravel(stepper.x), stepper.load))
         report(step / max(n_steps, 1), f"t = {sim.t:.4g} s")
 
     save(0)

@@ -128,13 +128,14 @@ class Simulator:
         if st is not None:
             st.load = lam
         model = self.model
+        x2 = x.reshape(-1, self.dim)  # a view of a flat array, or the network engine's (n, 3) view
         prescribed = getattr(model, "prescribed", None)
         if prescribed is not None:
-            fixed = ~model.free
-            x[fixed] = model.x0[fixed] + lam * prescribed[fixed]
+            fixed = np.flatnonzero(~model.free)
+            x2[fixed // self.dim, fixed % self.dim] = model.x0[fixed] + lam * prescribed[fixed]
         for dofs, fn, _ in self._paths.values():
             u = np.asarray(fn(t), dtype=float)
-            x[dofs] = model.x0[dofs] + np.resize(u, dofs.size)
+            x2[dofs // self.dim, dofs % self.dim] = model.x0[dofs] + np.resize(u, dofs.size)
         if st is None:
             return
         if self._forces:
@@ -272,7 +273,7 @@ class Simulator:
 
     @property
     def displacement(self) -> np.ndarray:
-        return (self._stepper.x - self.model.x0).reshape(-1, self.dim)
+        return np.asarray(self._stepper.x).reshape(-1, self.dim) - self.model.x0.reshape(-1, self.dim)
 
     @property
     def reaction(self) -> np.ndarray:
@@ -281,7 +282,7 @@ class Simulator:
         st = self._stepper
         if self.engine == "network":
             return self._view(st.react)
-        f = st.full_force() if st.explicit else np.asarray(self.model.force(st.x, st.load), dtype=float)
+        f = st.full_force() if st.explicit else np.asarray(self.model.force(np.ravel(st.x), st.load), dtype=float)
         return np.where(st.free, 0.0, -f).reshape(-1, self.dim)
 
     @property

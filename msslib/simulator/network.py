@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from msslib.errors import DivergenceError
-from msslib.explicit.network import N_MONITOR, _advance, _pass, _steps, network_layout
+from msslib.explicit.network import N_MONITOR, _advance, _pass, _steps, network_layout, records
 from msslib.solvers.dynamics import Integrator
 
 
@@ -57,17 +57,16 @@ class NetworkStepper(Integrator):
         self.n_springs = len(conn)
         self.others = others
         self._external = model.external_force(1.0) if hasattr(model, "external_force") else np.zeros(n)
-        self.x = np.ascontiguousarray(self.x)
+        self.R = records(self.x)  # positions and force accumulators, one record per node
+        self.x = self.R[:, :3]  # a view: the state lives in the records
         self.v = np.ascontiguousarray(self.v)
         self.F = np.zeros(n)
-        self.Fp = np.zeros(n)
         self.react = np.zeros(n)
-        self.acc = np.zeros(n)
         self.fext = np.zeros(n)
         self.inv_m_all = np.where(self.free, 1.0 / np.where(self.mass > 0, self.mass, 1.0), 0.0)
         self._h = None
         self._set_step(self.dt)
-        self._x_prev = np.empty(n)
+        self._x_prev = np.empty((model.n_nodes, 3))
         self._v_prev = np.empty(n)
         self.mon = np.zeros((1, N_MONITOR))
         self.evaluate()
@@ -84,21 +83,27 @@ class NetworkStepper(Integrator):
             self.fext += self.extra
 
     def _preload(self):
-        self.acc[:] = 0.0
+        if not self.others:
+            return
+        flat = self.x.reshape(-1)  # a copy (the records interleave the accumulators)
+        g = np.zeros(flat.size)
         for t in self.others:
-            self.acc -= t.gradient(self.x)
+            g += t.gradient(flat)
+        self.R[:, 3:] = -g.reshape(-1, 3)
+
+    def _flat_x(self):
+        return self.x.reshape(-1)
 
     def evaluate(self):
         """The force, reactions and monitor at the current state (no step): after a change of the
         loads or of the driven dofs' positions made outside :meth:`step`."""
         self._update_external()
         self._preload()
-        x, v, F, Fp = self.x, self.v, self.F, self.Fp
         rowptr, ib, kl = self.layout
-        _pass(x, v, F, Fp, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self.acc, self.x_ref,
-              self.mass, self.inv_m_all, self.react, self.mon, 0, False)
+        _pass(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self.x_ref, self.react,
+              self.mon, 0, False)
         self.stats["n_force_evals"] += 1
-        self.f = F[self.free]
+        self.f = self.F[self.free]
 
     def full_force(self):
         return self.F
@@ -122,8 +127,8 @@ class NetworkStepper(Integrator):
             np.copyto(self._x_prev, self.x)
             np.copyto(self._v_prev, self.v)
             snapshot = (self.j_min, self.flips)
-            _steps(self.x, self.v, self.F, self.Fp, rowptr, ib, kl, self.w, self.damp, h, self.fext, self.acc,
-                   self.x_ref, self.mass, self.inv_m_all, self.react, self.mon, n)
+            _steps(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self.x_ref, self.react,
+                   self.mon, n)
             self.stats["n_force_evals"] += n
             t0 = self.t
             failed = False
@@ -142,13 +147,13 @@ class NetworkStepper(Integrator):
                 np.copyto(self._x_prev, self.x)
                 np.copyto(self._v_prev, self.v)
                 t_step = self.t + h if i + 1 < n else end
-                _advance(self.x, self.v, self.F, self.w, self.damp, h)
+                _advance(self.R, self.v, self.F, self.w, self.damp, h)
                 if self.drive is not None:
                     self.drive(t_step, self.x)
                 self.evaluate()
                 self.n_taken += 1
                 self.t = t_step
-                self._observe_row(0, h, self.n_taken, t_step, self._x_prev, self._v_prev)
+                self._observe_row(0, h, self.n_taken, t_step, self._x_prev.reshape(-1), self._v_prev)
         self.f = self.F[self.free]
         self.stats["n_steps"] = max(self.stats["n_steps"], self.n_taken)
 
@@ -169,8 +174,8 @@ class NetworkStepper(Integrator):
             np.copyto(self._x_prev, self.x)
             np.copyto(self._v_prev, self.v)
             t_step = t0 + (i + 1) * h if i + 1 < n else end
-            _advance(self.x, self.v, self.F, self.w, self.damp, h)
+            _advance(self.R, self.v, self.F, self.w, self.damp, h)
             self.evaluate()
             self.n_taken += 1
             self.t = t_step
-            self._observe_row(0, h, self.n_taken, t_step, self._x_prev.copy(), self._v_prev.copy())
+            self._observe_row(0, h, self.n_taken, t_step, self._x_prev.reshape(-1), self._v_prev.copy())

@@ -365,7 +365,7 @@ class Integrator:
         """The divergence checks of one step from its monitor values (see :func:`_monitor`);
         raises :class:`DivergenceError`."""
         if not (np.isfinite(q) and dmax <= self.bound):
-            _check_state(self.problem, self.x, self.v, self.x_ref, self.bound, step, t, self.dt, self.method,
+            _check_state(self.problem, self._flat_x(), self.v, self.x_ref, self.bound, step, t, self.dt, self.method,
                          x_prev, v_prev, self.limit)
         if self.explicit and explicit_terms:
             self.flips = self.flips + 1 if pf < 0.0 else 0
@@ -374,8 +374,12 @@ class Integrator:
             self.j_min = J if self.j_min is None else min(self.j_min, J)
             j_ref = max(self.j_min, self.j_floor, TINY)
             if (J > self.growth * j_ref and self.flips >= 1) or J > _GROWTH_ANY * j_ref:
-                _raise_growth(self.x, self.x_ref, step, t, self.dt, self.method, x_prev, v_prev, self.limit,
+                _raise_growth(self._flat_x(), self.x_ref, step, t, self.dt, self.method, x_prev, v_prev, self.limit,
                               J / j_ref, self.flips)
+
+    def _flat_x(self):
+        """The positions as a flat array (the network engine keeps them in node records)."""
+        return self.x
 
 
 def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, max_iter, f_scale,
