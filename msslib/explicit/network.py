@@ -94,7 +94,7 @@ def _pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, adv
         ga1 = R[na, 4]
         ga2 = R[na, 5]
         for s in range(rowptr[na], rowptr[na + 1]):
-            b = ib[s]
+            b = _U(ib[_U(s)])
             d0 = R[b, 0] - xa0
             d1 = R[b, 1] - xa1
             d2 = R[b, 2] - xa2
