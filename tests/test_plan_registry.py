@@ -12,7 +12,7 @@ from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
 from msslib import solvers as S
 from msslib.model import Model
-from msslib.solvers import direct, memo, plans
+from msslib.solvers import direct, memo, submatrices as plans
 from msslib.solvers.context import ATTRIBUTE
 from msslib.terms import Gravity
 

@@ -105,7 +105,7 @@ def solve_linear(
     the share of the solution's full-quadrature (bilinear) energy that the one-point element does
     not see, with a :class:`~msslib.errors.MsslibWarning` above :data:`HOURGLASS_WARN`.
     """
-    from msslib.fem.newton import SOLVER, linear_solve
+    from msslib.fem.newton import SOLVER
 
     t0 = time.perf_counter()
     _check_plane(plane, mesh.dim)

@@ -111,7 +111,7 @@ energy of the time derivative of the motion, grows far beyond what a stable step
 Modules (each imports only those above it)
 -------------------------------------------
 :mod:`~msslib.solvers.protocol` (reading a problem, results, ``F_ref``),
-:mod:`~msslib.solvers.memo` (the process-wide memo of plans), :mod:`~msslib.solvers.plans`
+:mod:`~msslib.solvers.memo` (the process-wide memo of plans), :mod:`~msslib.solvers.submatrices`
 (free-dof submatrices by cached plans, :class:`PlanCache`),
 :mod:`~msslib.solvers.amg_kernels`, :mod:`~msslib.solvers.amg_cycle`, :mod:`~msslib.solvers.amg`
 (smoothed-aggregation AMG: compiled kernels, V-cycle, set-up),
@@ -138,12 +138,12 @@ from . import (  # noqa: F401 - the modules, for monkeypatching where a name is 
     displacement,
     dynamics,
     linear,
-    plans,
     policy,
     protocol,
     roundoff,
     stability,
     statics,
+    submatrices,
 )
 from .amg import (  # noqa: F401
     _SA_OPTIONS,
@@ -189,7 +189,7 @@ from .direct import (  # noqa: F401
 )
 from .dynamics import integrate
 from .linear import _linear_solve, _pcg  # noqa: F401
-from .plans import (  # noqa: F401
+from .submatrices import (  # noqa: F401
     PlanCache,
     _bsr_entry,
     _eccentricity,

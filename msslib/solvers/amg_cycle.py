@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from . import amg_kernels as kernels
-from .plans import _same_readonly
+from .submatrices import _same_readonly
 
 
 class _BlockGaussSeidel:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .plans import _U
+from .submatrices import _U
 
 
 @njit(cache=True, nogil=True)

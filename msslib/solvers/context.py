@@ -2,7 +2,7 @@
 
 A :class:`SolverContext` holds what the Newton systems of one problem have in common: the
 spatial dimension and the coordinates of the free nodes (AMG near-null space, band orderings),
-the plans of the free-dof submatrices and band orderings (:class:`~msslib.solvers.plans.PlanCache`,
+the plans of the free-dof submatrices and band orderings (:class:`~msslib.solvers.submatrices.PlanCache`,
 backed by the process-wide memo of plans :data:`msslib.solvers.memo.PLANS`),
 the kept AMG hierarchy (``cache``), the matrix of the Newton systems whose values are refilled
 (``K``) and the banded factorisation arrays.  It is a dict (its entries are the state) with the
@@ -22,7 +22,7 @@ import threading
 
 import numpy as np
 
-from .plans import PlanCache
+from .submatrices import PlanCache
 
 ATTRIBUTE = "_msslib_solver_context"  # where a problem keeps the context of its last static solve
 

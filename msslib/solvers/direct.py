@@ -10,8 +10,8 @@ import scipy.sparse.linalg as spla
 
 from msslib.solvers.blas_threads import BLOCKED_BANDWIDTH, one_blas_thread
 
-from . import plans as _plans
-from .plans import _plans_of, _same_readonly
+from . import submatrices as _plans
+from .submatrices import _plans_of, _same_readonly
 from .protocol import TINY
 
 BAND_PLAN_MAX_DOFS = 50_000  # no bandwidth-reducing ordering is computed above this size
@@ -31,7 +31,7 @@ def _band_plan(A, context):
     reverse Cuthill-McKee, and, for node-aligned dofs with known coordinates, slices across the
     longest side of the bounding box (node by node, dofs of a node together).  The one with the
     smallest bandwidth wins.  Returns None when the estimated cost ``n (b + 1)^2`` exceeds
-    ``BAND_COST_MAX``.  The plan is kept in the :class:`~msslib.solvers.plans.PlanCache` of
+    ``BAND_COST_MAX``.  The plan is kept in the :class:`~msslib.solvers.submatrices.PlanCache` of
     ``context`` (a solver context), if it has one, and in the process-wide memo of plans
     (:data:`msslib.solvers.memo.PLANS`), keyed by everything it is computed from: the pattern,
     the free-node coordinates, the dimension and the cost limit.  Each context gets its own copy

@@ -15,7 +15,7 @@ from msslib.errors import ConvergenceError, DivergenceError
 from . import protocol
 from .context import _solver_context
 from .linear import _linear_solve
-from .plans import _submatrix
+from .submatrices import _submatrix
 from .protocol import TINY, DynamicResult
 from .roundoff import _force_magnitude, convergence_threshold, roundoff_floor
 from .stability import EXPLICIT_METHODS, _mass_vector, _resolve_damping, check_time_step

@@ -1,7 +1,7 @@
 """A bounded, process-wide memo of the symbolic plans of sparsity patterns.
 
 The free-dof plans of a solve (free-free index arrays, node-block index arrays, band orderings;
-:mod:`msslib.solvers.plans`) are pure functions of index arrays -- the pattern of a tangent, a
+:mod:`msslib.solvers.submatrices`) are pure functions of index arrays -- the pattern of a tangent, a
 free mask, the coordinates the geometric band ordering reads -- and of a few settings.  A new
 model of a pattern met before (a rebuilt model, the next case of a sweep) finds them here instead
 of computing them again; its solver context then keeps its own reference, as before.
@@ -124,4 +124,4 @@ class PatternMemo:
         return value
 
 
-PLANS = PatternMemo()  # the memo of msslib.solvers.plans
+PLANS = PatternMemo()  # the memo of msslib.solvers.submatrices

@@ -17,7 +17,7 @@ from collections.abc import Callable
 import scipy.sparse as sp
 
 from .direct import BAND_PLAN_MAX_DOFS, _band_plan
-from .plans import _bsr_entry, _eccentricity, _submatrix
+from .submatrices import _bsr_entry, _eccentricity, _submatrix
 
 ITERATIVE_THRESHOLD = 2_000  # free dofs above which "auto" may use preconditioned CG (symmetric)
 BAND_AUTO_COST = 1.5e8  # ... unless the banded Cholesky costs at most this n (b + 1)^2

@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .plans import _submatrix
+from .submatrices import _submatrix
 
 EPS = np.finfo(float).eps
 ROUNDOFF_FACTOR = 1.0  # the floor is ROUNDOFF_FACTOR * eps * (force magnitude scale)

@@ -8,7 +8,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .plans import _submatrix
+from .submatrices import _submatrix
 from .protocol import _free_mask
 
 

@@ -11,7 +11,7 @@ from msslib.errors import ConvergenceError
 
 from .context import _release_context, _solver_context, _static_context
 from .linear import _linear_solve
-from .plans import _submatrix, _submatrix_bsr
+from .submatrices import _submatrix, _submatrix_bsr
 from .policy import _wants_blocks
 from .protocol import (
     StaticResult,

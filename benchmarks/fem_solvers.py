@@ -1,5 +1,5 @@
 """FEM reference solves before and after moving them onto msslib.solvers:
-``python -m benchmarks.fem`` (single thread).
+``python -m benchmarks.fem_solvers`` (single thread).
 
 A clamped block of n^3 hexahedra (Q1) or 6 n^3 tetrahedra (P1) under gravity: the free-dof
 system of linear elasticity solved by SuperLU (the references' solver before, MMD_AT_PLUS_A
