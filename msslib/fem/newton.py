@@ -35,7 +35,7 @@ def linear_solve(K, rhs, free, points, dim: int, linear_solver="auto"):
     Raises :class:`numpy.linalg.LinAlgError` for a singular matrix."""
     from msslib.solvers import context as _context
     from msslib.solvers.linear import _linear_solve
-    from msslib.solvers.plans import _submatrix
+    from msslib.solvers.submatrices import _submatrix
     from msslib.solvers.policy import _band_is_cheap, choose_linear_solver
     from msslib.solvers.protocol import _NewtonFailure
 
