@@ -110,20 +110,24 @@ def test_nodal_force_and_load_curve_reach_the_static_solution(column):
     assert sim.reaction[:, 0].sum() == pytest.approx(-total[0], rel=1e-6)
 
 
-def test_a_step_over_the_limit_is_refused_and_an_allowed_one_stopped_with_the_state_before(column):
+@pytest.mark.parametrize("load", [1.0, [[0.0, 1.0], [1.0, 2.0]]], ids=["constant", "load curve"])
+def test_a_step_over_the_limit_is_refused_and_an_allowed_one_stopped_with_the_state_before(column, load):
+    """Many steps per call, one per call, constant loads or a curve (the network engine then
+    steps one at a time): the same failing step and the same state before it as the generic engine."""
     model, limit = column
     with pytest.raises(StabilityError):
         Simulator(model, dt=1.2 * limit)
     errors = {}
-    for engine, calls in (("network", [400]), ("generic", [1] * 400)):
-        sim = Simulator(model, dt=1.2 * limit, allow_unstable=True, engine=engine)
+    for engine, calls in (("network", [400]), ("network", [1] * 400), ("generic", [1] * 400)):
+        sim = Simulator(model, dt=1.2 * limit, allow_unstable=True, engine=engine, load=load)
         with pytest.raises(DivergenceError) as info:
             for n in calls:
                 sim.step(n)
-        errors[engine] = info.value
-    a, b = errors["network"], errors["generic"]
-    assert a.step == b.step and a.quantity == b.quantity
-    assert np.abs(a.x_last - b.x_last).max() <= 1e-9 * np.abs(b.x_last).max()
+        errors[(engine, len(calls))] = info.value
+    b = errors[("generic", 400)]
+    for a in (errors[("network", 1)], errors[("network", 400)]):
+        assert a.step == b.step and a.quantity == b.quantity
+        assert np.abs(a.x_last - b.x_last).max() <= 1e-9 * np.abs(b.x_last).max()
 
 
 def test_reset_and_views(column):

@@ -66,8 +66,6 @@ class NetworkStepper(Integrator):
         self.inv_m_all = np.where(self.free, 1.0 / np.where(self.mass > 0, self.mass, 1.0), 0.0)
         self._h = None
         self._set_step(self.dt)
-        self._x_prev = np.empty((model.n_nodes, 3))
-        self._v_prev = np.empty(n)
         self.mon = np.zeros((1, N_MONITOR))
         self.evaluate()
 
@@ -111,6 +109,16 @@ class NetworkStepper(Integrator):
     def step(self, h=None, t_new=None):
         self.steps(1, h, t_new)
 
+    # A divergence is reported with the state before the failing step.  Instead of copying the
+    # state before every step, a checkpoint (state, time, detector) is kept at most every
+    # _CHECKPOINT_EVERY steps with the steps taken since; a failure replays them (the scheme is
+    # deterministic: the same loads, the same driven positions at the same times).
+    _CHECKPOINT_EVERY = 64
+
+    def _checkpoint(self):
+        self._ckpt = (self.x.copy(), self.v.copy(), self.t, self.n_taken, self.j_min, self.flips)
+        self._since = []  # (n, h, end) of the calls since the checkpoint
+
     def steps(self, n: int, h=None, t_new=None):
         """``n`` steps of ``h`` (default ``dt``); ``t_new`` the time after the last one.  Runs them
         in one kernel call when nothing changes in between (no ``drive``, no other terms)."""
@@ -120,62 +128,65 @@ class NetworkStepper(Integrator):
         h = self.dt if h is None else float(h)
         self._set_step(h)
         end = self.t + n * h if t_new is None else float(t_new)
+        if getattr(self, "_ckpt", None) is None or self.n_taken - self._ckpt[3] >= self._CHECKPOINT_EVERY:
+            self._checkpoint()
+        self._since.append((n, h, end))
         rowptr, ib, kl = self.layout
+        failed = False
         if self.drive is None and not self.others:
             if self.mon.shape[0] < n:
                 self.mon = np.zeros((n, N_MONITOR))
-            np.copyto(self._x_prev, self.x)
-            np.copyto(self._v_prev, self.v)
-            snapshot = (self.j_min, self.flips)
             _steps(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self.x_ref, self.react,
                    self.mon, n)
             self.stats["n_force_evals"] += n
             t0 = self.t
-            failed = False
             try:
                 for i in range(n):
                     self._observe_row(i, h, self.n_taken + i + 1, t0 + (i + 1) * h if i + 1 < n else end,
                                       None, None)
             except DivergenceError:
                 failed = True
-            if failed:  # raised again by the replay, with the states around the failing step
-                self._replay(n, h, t0, end, snapshot)
             self.n_taken += n
             self.t = end
         else:
-            for i in range(n):
-                np.copyto(self._x_prev, self.x)
-                np.copyto(self._v_prev, self.v)
-                t_step = self.t + h if i + 1 < n else end
-                _advance(self.R, self.v, self.F, self.w, self.damp, h)
-                if self.drive is not None:
-                    self.drive(t_step, self.x)
-                self.evaluate()
-                self.n_taken += 1
-                self.t = t_step
-                self._observe_row(0, h, self.n_taken, t_step, self._x_prev.reshape(-1), self._v_prev)
+            try:
+                for i in range(n):
+                    self._one(h, self.t + h if i + 1 < n else end)
+                    self._observe_row(0, h, self.n_taken, self.t, None, None)
+            except DivergenceError:
+                failed = True
+        if failed:  # raised again by the replay, with the states around the failing step
+            self._replay()
         self.f = self.F[self.free]
         self.stats["n_steps"] = max(self.stats["n_steps"], self.n_taken)
+
+    def _one(self, h, t_step):
+        """One step without the detector: advance, move the driven dofs, evaluate."""
+        _advance(self.R, self.v, self.F, self.w, self.damp, h)
+        if self.drive is not None:
+            self.drive(t_step, self.x)
+        self.evaluate()
+        self.n_taken += 1
+        self.t = t_step
 
     def _observe_row(self, i, h, step, t, x_prev, v_prev):
         q, pf, ku, r, dmax = self.mon[i]
         self.observe(q, pf, ku, r, dmax, h, step, t, x_prev, v_prev, True)
 
-    def _replay(self, n, h, t0, end, snapshot):
-        """After a divergence found in a multi-step call: rerun from the saved start (the scheme is
-        deterministic) to get the states around the failing step, and raise with them."""
-        self.j_min, self.flips = snapshot
-        start_x, start_v = self._x_prev.copy(), self._v_prev.copy()
-        self.x[:] = start_x
-        self.v[:] = start_v
+    def _replay(self):
+        """Rerun the steps since the checkpoint one by one, keeping the state before each, until
+        the detector raises again (with that state)."""
+        x, v, t, n_taken, j_min, flips = self._ckpt
+        self.x[:] = x
+        self.v[:] = v
+        self.t, self.n_taken, self.j_min, self.flips = t, n_taken, j_min, flips
+        if self.drive is not None:
+            self.drive(t, self.x)
         self.evaluate()
-        self.j_min, self.flips = snapshot
-        for i in range(n):
-            np.copyto(self._x_prev, self.x)
-            np.copyto(self._v_prev, self.v)
-            t_step = t0 + (i + 1) * h if i + 1 < n else end
-            _advance(self.R, self.v, self.F, self.w, self.damp, h)
-            self.evaluate()
-            self.n_taken += 1
-            self.t = t_step
-            self._observe_row(0, h, self.n_taken, t_step, self._x_prev.reshape(-1), self._v_prev.copy())
+        for n, h, end in self._since:
+            self._set_step(h)
+            for i in range(n):
+                x_prev, v_prev = self.x.reshape(-1), self.v.copy()
+                self._one(h, self.t + h if i + 1 < n else end)
+                self._observe_row(0, h, self.n_taken, self.t, x_prev, v_prev)
+        raise RuntimeError("the replay did not find the divergence again")  # pragma: no cover
