@@ -101,7 +101,6 @@ class NetworkStepper(Integrator):
         _pass(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self.x_ref, self.react,
               self.mon, 0, False)
         self.stats["n_force_evals"] += 1
-        self.f = self.F[self.free]
 
     def full_force(self):
         return self.F
@@ -157,7 +156,6 @@ class NetworkStepper(Integrator):
                 failed = True
         if failed:  # raised again by the replay, with the states around the failing step
             self._replay()
-        self.f = self.F[self.free]
         self.stats["n_steps"] = max(self.stats["n_steps"], self.n_taken)
 
     def _one(self, h, t_step):
