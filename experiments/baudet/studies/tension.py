@@ -2,7 +2,8 @@
 
 A cube (one element) and a beam of 4 x 4 x 12 cubes (one eighth modelled, symmetry planes
 x = y = z = 0) pulled along z by a dead traction P on the free z face, up to 20 % axial strain,
-for nu in {0.1, 0.2, 0.3, 0.4, 0.499}, with the derived correction factor -(4 nu - 1)/2 and the
+for nu in {0.1, 0.2, 0.25, 0.3, 0.4, 0.499} (0.25: where the paper places the sign change of the
+Poisson error and where the correction vanishes), with the derived correction factor -(4 nu - 1)/2 and the
 printed -(4 nu - 1)/16 (resultants per face), each under the two readings of the correction force
 (dimension ``reading``): ``boundary`` (driven by the loads on the body's loaded faces) and ``element``
 (every cube driven by the forces acting on it from outside, msslib.terms.baudet). E = P / eps_z
@@ -22,6 +23,9 @@ from msslib.metrics import mean_displacement_gradient
 
 GEOMETRIES = {"cube": (1, 1, 1), "beam": (2, 2, 6)}
 LEVELS = {"eps05": 0.05, "eps10": 0.10, "eps14": 0.14, "eps15": 0.15, "eps20": 0.20}
+# the shared nu values and 1/4, where Baudet place the sign change of the Poisson error (Sec. 5)
+NUS = tuple(sorted(C.NUS + (0.25,)))
+NU_LABELS = tuple(f"{v:g}" for v in NUS)
 
 
 def run(n, nu, published, strains, reading="boundary"):
@@ -48,7 +52,7 @@ def main():
     args = C.parse(__doc__)
     t0 = time.perf_counter()
     strains = np.round(np.arange(0.005, 0.2001, 0.005 if not args.quick else 0.01), 6)
-    shape = (len(C.READINGS), len(GEOMETRIES), len(C.FACTORS), len(C.NUS), len(strains))
+    shape = (len(C.READINGS), len(GEOMETRIES), len(C.FACTORS), len(NUS), len(strains))
     E = np.full(shape, np.nan)
     NU = np.full(shape, np.nan)
     E_lin = np.full(shape[:4], np.nan)
@@ -56,15 +60,15 @@ def main():
     for r, reading in enumerate(C.READINGS):
         for g, n in enumerate(GEOMETRIES.values()):
             for f, fac in enumerate(C.FACTORS):
-                for k, nu in enumerate(C.NUS):
+                for k, nu in enumerate(NUS):
                     E_i, nu_i, (e1, n1), nl = run(n, nu, fac == "printed", strains, reading)
                     E[r, g, f, k], NU[r, g, f, k] = E_i, nu_i
                     E_lin[r, g, f, k], NU_lin[r, g, f, k] = e1, n1
                     print(f"{reading} {list(GEOMETRIES)[g]} {fac} nu={nu}: {nl} load levels, E(eps->0)={e1:.4g}, "
                           f"nu={n1:.4g}", flush=True)
-    nu_in = np.array(C.NUS)[None, None, None, :, None]
+    nu_in = np.array(NUS)[None, None, None, :, None]
     coords = {"reading": list(C.READINGS), "geometry": list(GEOMETRIES), "factor": list(C.FACTORS),
-              "nu": list(C.NU_LABELS), "strain": strains}
+              "nu": list(NU_LABELS), "strain": strains}
     ds = xr.Dataset(coords=coords)
     ds["strain"].attrs = {"units": "1", "long_name": "axial engineering strain"}
     ds["nu"].attrs = {"units": "1", "long_name": "input Poisson's ratio (label)"}
@@ -72,7 +76,7 @@ def main():
     ds["factor"].attrs = {"long_name": "correction factor: derived -(4nu-1)/2 or printed -(4nu-1)/16"}
     ds["reading"].attrs = {"long_name": "correction force driven by the loaded boundary faces or, per cube, by the "
                                         "forces from outside it"}
-    ds["nu_value"] = ("nu", np.array(C.NUS), {"units": "1", "long_name": "input Poisson's ratio"})
+    ds["nu_value"] = ("nu", np.array(NUS), {"units": "1", "long_name": "input Poisson's ratio"})
     dims = ("reading", "geometry", "factor", "nu", "strain")
     ds["youngs_modulus"] = (dims, E, {"units": "Pa", "long_name": "measured Young's modulus P/eps (secant)"})
     ds["poisson_ratio"] = (dims, NU, {"units": "1", "long_name": "measured Poisson's ratio -eps_lat/eps"})
@@ -97,8 +101,22 @@ def main():
         d = abs(v.sel(geometry="beam") - v.sel(geometry="cube")).max(("nu", "strain"))
         d.attrs = {"units": "1", "long_name": f"largest |{name} error (beam) - {name} error (cube)| over strains and nu"}
         ds[f"{name}_beam_cube_max_difference"] = d
+    # the sign of the Poisson error over the strain range (Baudet: thinning overestimated for nu >= 1/4,
+    # underestimated below) and the strain at which |nu error| first exceeds 5 % (Fig. 5's bound)
+    v = ds["nu_error_by_reading"]
+    for name, red in (("min", v.min("strain", skipna=True)), ("max", v.max("strain", skipna=True))):
+        red.attrs = {"units": "1", "long_name": f"{name}imum over the strains of the signed relative nu error"}
+        ds[f"nu_error_{name}_by_reading"] = red
+    strain = ds["strain"].values
+    over = np.abs(v.values) > 0.05
+    first = np.where(over.any(-1), strain[np.argmax(over, axis=-1)], np.nan)
+    ds["nu_error_5pc_strain_by_reading"] = (v.dims[:-1], first, {
+        "units": "1", "long_name": "first sampled axial strain with |nu error| > 5 % (NaN: never up to 20 %)"})
+    for name in ("nu_error_min", "nu_error_max", "nu_error_5pc_strain"):  # the boundary slice, as split_readings
+        ds[name] = ds[f"{name}_by_reading"].sel(reading="boundary", drop=True)
+        ds[name].attrs = {**ds[f"{name}_by_reading"].attrs, "reading": "boundary"}
     ds["E_input"] = ((), C.E0, {"units": "Pa", "long_name": "input Young's modulus"})
-    ds["lattice_nu"] = ("nu", 1.0 / (4 * np.array(C.NUS) + 3),
+    ds["lattice_nu"] = ("nu", 1.0 / (4 * np.array(NUS) + 3),
                         {"units": "1", "long_name": "Poisson's ratio of the uncorrected lattice, 1/(4 nu + 3)"})
     ds.attrs.update(title="Baudet Figs. 4-5: E and nu errors in tension", quick=int(args.quick),
                     cube_edge_m=C.A0)

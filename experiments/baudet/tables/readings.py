@@ -50,6 +50,17 @@ def main():
         return f"max {pc(np.abs(v).max(), '.2f')}", bool(np.all(np.abs(v) < 0.05))
     row("Fig. 5: nu error of a cube below 5 % up to 14 % strain, nu in [0.3, 0.5]", "< 5", nu_under_5)
 
+    def sign_change(r):
+        lo = t["nu_error_min_by_reading"].sel(reading=r, geometry="cube", factor="derived")
+        hi = t["nu_error_max_by_reading"].sel(reading=r, geometry="cube", factor="derived")
+        labels = [str(v) for v in lo["nu"].values]
+        signs = ["-" if float(hi.sel(nu=k)) < 0 else "+" if float(lo.sel(nu=k)) > 0 else "+-" for k in labels]
+        text = ", ".join(f"{k}: {s}" for k, s in zip(labels, signs))
+        ok = all((s == "+") == (float(k) >= 0.25) and s != "+-" for k, s in zip(labels, signs))
+        return f"sign of the error at every strain, {text}", ok
+    row("Sec. 5: nu error negative for nu < 1/4, positive for nu >= 1/4 (cube, all strains)", "sign change at 1/4",
+        sign_change)
+
     def same_as_cube(r):
         d = 0.0
         for name in ("E_error_by_reading", "nu_error_by_reading"):
