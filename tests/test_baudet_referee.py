@@ -50,3 +50,23 @@ def test_cube_is_exact_at_small_strain_with_the_derived_factor(nu):
     assert nu_bare == pytest.approx(1.0 / (4 * nu + 3), rel=1e-5)
     E, nu_m, _ = _small_strain_moduli(nu)
     assert (E, nu_m) == pytest.approx((C.E0, nu), rel=1e-5)
+
+
+@pytest.mark.parametrize("load", ["line", "face"])
+@pytest.mark.parametrize("model", ["fem_linear", {"type": "baudet_cube", "correction": "element"}])
+def test_l_block_loads_carry_the_same_total_force(load, model):
+    """The L-block of study l_block_load under the line load and under the face traction: the
+    support reactions balance the stated total force (20 N along +x), for FEM and the MSS; the line
+    load's nodal forces on the clamped base (q h / 2 at the foot of the four edges that reach it)
+    are left out, so that load balances 20 N less those."""
+    from experiments.baudet import make_l_block as LB
+    from experiments.baudet.studies import l_block_load as S
+
+    n = 2
+    r = S.run(model, n, load)
+    R = r["reaction_force"].transpose("node", "axis").values.sum(axis=0)
+    h = 4.0 / n
+    q = 20.0 / (2 * (4.0 + 2.0 + 2.0))  # at y = 0 and y = 4 the edges x = 0 (4 m), x = 2 (2 m), x = 4 (2 m)
+    expected = 20.0 - (4 * q * h / 2 if load == "line" else 0.0)  # feet: x = 0 and x = 4 at y = 0 and 4
+    assert LB.F == 20.0
+    np.testing.assert_allclose(R, [-expected, 0.0, 0.0], rtol=0, atol=1e-8 * LB.F)
