@@ -32,8 +32,14 @@ from msslib.simulator import Simulator
 STEPS = 100
 
 
+_MESHES = {}
+
+
 def lloyd_network(h, reorder=False):
-    mesh = M.cylinder_mesh(0.05, 0.2, h)
+    if h not in _MESHES:  # gmsh takes tens of seconds at 10^6 springs: once per size
+        _MESHES.clear()
+        _MESHES[h] = M.cylinder_mesh(0.05, 0.2, h)
+    mesh = _MESHES[h]
     if reorder:
         mesh = M.reorder_nodes(mesh)
     return msslib.build_model("lloyd_tetrahedron", mesh, msslib.Material(1e6, 0.25, density=1000.0),
