@@ -19,7 +19,7 @@ def main():
         x, w = C.section_deflection(C.open_result(p))
         ax.plot(x * 1e3, w * 1e3, "o-", color=c, ms=4, label=f"MSS {r}")
     ax.set_xlabel("x (mm)")
-    ax.set_ylabel("deflection of the neutral axis, downwards (mm)")
+    ax.set_ylabel("neutral-axis deflection,\ndownwards (mm)")  # two lines: the label fits the figure
     ax.invert_yaxis()
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
