@@ -193,18 +193,20 @@ class JaxLattice:
                 alpha = a
         return float(alpha)
 
-    def reset(self, x, v, h: float, alpha: float | None = None, allow_unstable: bool = False):
+    def reset(self, x, v, h: float, alpha: float | None = None, allow_unstable: bool = False,
+              omega_max: float | None = None):
         """Start from the flat model-layout state ``x``, ``v`` (velocities of fixed dofs set to
-        0) with steps of ``h``; the stability check of :meth:`LatticeExplicit.run` (StabilityError
-        above the limit unless ``allow_unstable``)."""
+        0) with steps of ``h``; the stability check of :func:`msslib.solvers.check_time_step` (the
+        cheap bound first, Lanczos only when ``h`` is above the bound's limit; StabilityError
+        above the limit unless ``allow_unstable``; ``omega_max``: a value computed earlier for
+        the same state, or an upper bound of it)."""
         from msslib.solvers import check_time_step
 
         alpha = self._alpha(alpha)
         if not (np.isfinite(h) and h > 0) or alpha < 0:
             raise ValueError(f"need h > 0 and alpha >= 0, got h = {h!r}, alpha = {alpha!r}")
         self.stability = check_time_step(self.model, x, float(h), method="symplectic_euler", damping=alpha,
-                                         load=self.load, allow_unstable=allow_unstable,
-                                         omega_max=self._cpu._omega_max(x))
+                                         load=self.load, allow_unstable=allow_unstable, omega_max=omega_max)
         vv = np.array(v, dtype=float).reshape(-1)
         vv[~self._cpu.free_flat] = 0.0
         self.h, self.alpha = float(h), alpha
