@@ -206,6 +206,18 @@ def scene_case(rows, min_wall):
            "Lloyd tetrahedra")
     steps, wall = timed(lambda k: [net.steps(1) for _ in range(k)], net.block, min_wall)
     report(rows, "scene 1 step/call", net.n_springs, steps, wall, cpu_rate, "", "one device call per step")
+    # agreement on this device: fp64 against numba, fp32 forces against fp64, after 1,000 steps from rest
+    size = float(np.ptp(model.x0.reshape(-1, 3), axis=0).max())
+    ref = CpuNetwork.from_model(model, h, 1.0).steps(1000).positions()
+    x64 = JaxNetwork.from_model(model, h, 1.0).steps(1000).positions()
+    x32 = JaxNetwork.from_model(model, h, 1.0, precision="single").steps(1000).positions()
+    moved = np.abs(ref - model.x0).max() / size
+    e64, e32 = np.abs(x64 - ref).max() / size, np.abs(x32 - ref).max() / size
+    rows.append(dict(case="scene agreement after 1000 steps", fp64_vs_numba=e64, fp32_vs_numba=e32, motion=moved))
+    print(f"scene after 1000 steps (motion {moved:.2g} of the body's size): fp64 JAX vs numba {e64:.2g}, "
+          f"fp32 forces vs numba {e32:.2g} of the body's size", flush=True)
+    if not e64 <= 1e-12:
+        raise SystemExit(f"benchmarks.gpu: fp64 JAX differs from numba by {e64:.3g} of the body's size")
 
 
 def main(argv=None):
