@@ -13,7 +13,7 @@ proportional damping, gravity, bottom face clamped, fp64):
 
 Each case prints springs, steps/s, spring-steps/s and the ratio to the numba path on one CPU
 thread (numba and BLAS pinned to 1 thread) measured on the same network in the same run, beside
-the targets of issue 26 on one H100 (>= 10 G spring-steps/s generic at >= 10 M springs, >= 50 G
+the targets on one H100 (>= 10 G spring-steps/s generic at >= 10 M springs, >= 50 G
 lattice, >= 10 k steps/s at 10 k springs).  Without a GPU the sizes are smaller (the script says
 so) and the figures are JAX's CPU backend: "no GPU: CPU figures only".  The lattices are built
 directly from Golec's cube constants (a uniform grid: each pair's constant is the cube constant
@@ -252,13 +252,29 @@ def main(argv=None):
     generic_case(rows, n_generic, min_wall)
     lattice_case(rows, n_lattice, min_wall)
     scene_case(rows, min_wall)
-    print("targets (issue 26, one H100): generic >= 10 G spring-steps/s at >= 10 M springs; lattice >= 50 G; "
+    print("targets (one H100): generic >= 10 G spring-steps/s at >= 10 M springs; lattice >= 50 G; "
           "10 k-spring scene >= 10 k steps/s" + ("" if gpu else "  [no GPU: CPU figures only]"))
     wall = time.perf_counter() - t0
     print(f"wall {wall:.0f} s")
-    if args.out:
-        with open(args.out, "w", encoding="utf-8") as f:
-            json.dump({"backend": reason, "gpu": gpu, "quick": args.quick, "wall_s": wall, "cases": rows}, f, indent=1)
+    if args.out:  # atomic: no partial file
+        from msslib.results import write_text
+
+        write_text(args.out, json.dumps({"backend": reason, "gpu": gpu, "quick": args.quick, "wall_s": wall,
+                                         "cases": rows}, indent=1))
+    return rows
+
+
+def run(res, quick: bool):
+    """The GPU cases as figures of ``python -m benchmarks`` (called there when JAX sees a GPU)."""
+    for row in main(["--quick"] if quick else []):
+        if "spring_steps_per_s" not in row:  # the agreement row
+            res.add("gpu_scene_fp64_vs_numba", row["fp64_vs_numba"], "of the body size", None, None,
+                    f"after 1000 steps (motion {row['motion']:.2g}); fp32 forces: {row['fp32_vs_numba']:.2g}")
+            continue
+        res.add(f"gpu_{row['case']}", row["spring_steps_per_s"] / 1e9, "G spring-steps/s",
+                row["ratio_to_numba_1core"], "numba, 1 CPU core, same network",
+                f"{row['springs']} springs, {row['steps_per_s']:.4g} steps/s; target on one H100: {row['target']}"
+                + (f"; {row['note']}" if row["note"] else ""))
 
 
 if __name__ == "__main__":

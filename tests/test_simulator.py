@@ -209,3 +209,27 @@ def test_every_model_steps_as_integrate_does(name, cell, make):
         sim.step(60)
     assert sim.engine == ("network" if dim == 3 and name != "baudet_cube" else "generic")
     assert _rel(sim.x, ref.x_final, model) < 1e-12
+
+
+def test_jax_engine_equals_the_network_engine_and_refuses_what_it_cannot_run(column, monkeypatch):
+    """engine='jax' (JAX's CPU backend here): the same steps to 1e-12; time-varying loads are
+    refused in one line; without JAX a warning names the reason and the network engine runs."""
+    pytest.importorskip("jax")
+    model, limit = column
+    dt = 0.8 * limit
+    a = Simulator(model, dt=dt, damping=3.0, engine="jax")
+    b = Simulator(model, dt=dt, damping=3.0, engine="network")
+    assert a.engine == "jax"
+    a.step(150)
+    a.step(50)
+    b.step(200)
+    assert _rel(a.x, b.x, model) < 1e-12
+    assert np.abs(a.reaction - b.reaction).max() < 1e-12 * np.abs(b.reaction).max()
+    with pytest.raises(ValueError, match="engine='jax' runs constant loads"):
+        Simulator(model, dt=dt, engine="jax", load=[[0.0, 0.0], [0.1, 1.0]])
+    from msslib.explicit.jax_backend import device
+
+    monkeypatch.setattr(device, "available", lambda: (False, "jax cannot be imported (test)"))
+    with pytest.warns(msslib.errors.MsslibWarning, match="jax cannot be imported"):
+        c = Simulator(model, dt=dt, damping=3.0, engine="jax")
+    assert c.engine == "network"

@@ -11,7 +11,7 @@ from msslib.solvers.dynamics import Integrator
 from .loads import time_function
 from .network import NetworkStepper, network_terms
 
-ENGINES = ("auto", "network", "generic")
+ENGINES = ("auto", "network", "generic", "jax")
 
 
 class Simulator:
@@ -43,8 +43,12 @@ class Simulator:
     ``engine``: ``"network"`` runs symplectic Euler on 3D spring models with the fused kernel of
     :mod:`msslib.explicit.network` (other internal terms added before each pass; many steps in
     one call when nothing changes in between); ``"generic"`` runs
-    :class:`msslib.solvers.dynamics.Integrator` on any model and scheme; ``"auto"`` (default)
-    takes ``network`` where it applies.  Both run the same scheme and agree to round-off.
+    :class:`msslib.solvers.dynamics.Integrator` on any model and scheme; ``"jax"`` runs 3D
+    spring networks with constant loads on :mod:`msslib.explicit.jax_backend` (the first GPU
+    JAX sees, else its CPU; without JAX a warning names the reason and ``network`` runs; the
+    state lives on the device, so reading it copies, see :mod:`msslib.simulator.accelerated`);
+    ``"auto"`` (default) takes ``network`` where it applies.  They run the same scheme and agree
+    to round-off.
     """
 
     def __init__(self, model, *, dt: float, method: str = "symplectic_euler", damping=None, load=1.0,
@@ -76,6 +80,14 @@ class Simulator:
     def _engine(self):
         if self._engine_request == "generic":
             return "generic"
+        if self._engine_request == "jax":
+            from msslib.explicit.jax_backend import use_jax
+
+            if self._varies() or self._forces or self._paths:
+                raise ValueError("engine='jax' runs constant loads: a load curve, nodal forces or prescribed paths "
+                                 "run on the network engine (engine='network')")
+            if use_jax("jax"):  # else a warning names the reason and the network engine runs
+                return "jax"
         _, _, why = network_terms(self.model)
         alpha_beta = self._options["damping"]
         if why is None and self._options["method"] != "symplectic_euler":
@@ -109,6 +121,10 @@ class Simulator:
                   drive=drive)
         if self.engine == "network":
             stepper = NetworkStepper(self.model, x, v, **kw)
+        elif self.engine == "jax":
+            from .accelerated import JaxStepper
+
+            stepper = JaxStepper(self.model, x, v, **kw)
         else:
             stepper = Integrator(self.model, x, v, method=self._options["method"], **kw, **self._implicit)
         stepper.t = t
@@ -116,7 +132,7 @@ class Simulator:
         holder.append(stepper)
         self._stepper = stepper
         self._apply(t, stepper.x, stepper)
-        if self.engine == "network":
+        if self.engine in ("network", "jax"):
             stepper.evaluate()
         else:
             stepper.f = stepper.force(stepper.x) if stepper.explicit else None
@@ -227,7 +243,7 @@ class Simulator:
         st = self._stepper
         if h is not None and not (0 < h <= self._options["dt"] * (1 + 1e-12)):
             raise ValueError(f"h must lie in (0, dt = {self._options['dt']:.6g} s], got {h!r}")
-        if self.engine == "network":
+        if self.engine in ("network", "jax"):
             st.steps(n, h, t_new)
         else:
             for i in range(int(n)):
