@@ -218,7 +218,7 @@ def run(res, quick: bool):
     cases = [("lloyd_16k", lambda r: lloyd_network(0.0085, r)), ("lloyd_122k", lambda r: lloyd_network(0.0042, r)),
              ("golec_95k", lambda r: golec_network(19, r))]
     if not quick:
-        cases += [("lloyd_945k", lambda r: lloyd_network(0.00213, r)), ("golec_740k", lambda r: golec_network(39, r))]
+        cases += [("lloyd_945k", lambda r: lloyd_network(0.00208, r)), ("golec_740k", lambda r: golec_network(39, r))]
     for name, build in cases:
         print(f"[stepping] {name} ...", flush=True)
         model, dt = throughput(res, name, build, quick)
