@@ -75,6 +75,15 @@ def _interrupted_at(n: int, action) -> tuple[bool, int]:
 
 @pytest.mark.skipif(not hasattr(signal, "SIGINT") or sys.gettrace() is not None, reason="needs SIGINT and no tracer")
 def test_sigint_at_every_line_of_a_staged_write_leaves_nothing_behind(tmp_path):
+    # Python's own handler (a process started in the background by a shell inherits SIGINT ignored)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        _sigint_at_every_line(tmp_path)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _sigint_at_every_line(tmp_path):
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
     outcomes = set()
     n = 0
