@@ -344,13 +344,9 @@ class LatticeExplicit:
         ``x`` and kept) raises :class:`msslib.errors.StabilityError` unless ``allow_unstable``.
         The numba loop itself has no per-step divergence detector (it would cost the loop its
         vectorisation): a non-finite final state raises :class:`msslib.solvers.DivergenceError`."""
-        if alpha is None:
-            alpha = self.model.damping if self.model.damping is not None else 0.0
-            if np.ndim(alpha) != 0:
-                a, beta = alpha
-                if beta:
-                    raise ValueError("LatticeExplicit.run supports mass-proportional damping only (beta = 0)")
-                alpha = a
+        from msslib.solvers.stability import mass_proportional_alpha
+
+        alpha = mass_proportional_alpha(self.model, alpha, "LatticeExplicit.run")
         if not (h > 0) or n_steps < 0 or save_every < 1:
             raise ValueError("need h > 0, n_steps >= 0 and save_every >= 1")
         from msslib.solvers import DivergenceError, check_time_step

@@ -41,9 +41,31 @@ from msslib.terms.jit import _U
 # fast-math without nnan/ninf: the monitor must see a non-finite state
 _FAST = {"nsz", "arcp", "contract", "afn"}
 
-__all__ = ["network_layout", "records", "network_steps", "network_forces", "N_MONITOR"]
+__all__ = ["network_terms", "network_layout", "records", "network_steps", "network_forces", "N_MONITOR"]
 
 N_MONITOR = 5  # columns of a monitor row: q, pf, ku, r, dmax
+
+
+def network_terms(model):
+    """``(springs, others, why)``: the 3D spring terms (which the kernel runs), the other
+    internal terms (their forces are added before each pass), or ``why`` the model cannot run on
+    the network kernels (None when it can).  Dead external loads (no stiffness) go into the
+    constant external force."""
+    if getattr(model, "dim", None) != 3:
+        return [], [], "the network engine is 3D"
+    springs, others = [], []
+    for t in model.terms:
+        if t.kind == "springs" and getattr(t, "dim", 3) == 3 and hasattr(t, "rest_length"):
+            springs.append(t)
+        elif t.kind == "external" and t.abs_row_sums(np.zeros(0), 1.0, np.zeros(0), np.zeros(0)):
+            continue  # dead loads: in the external force
+        elif t.scales_with_load:
+            return [], [], f"{type(t).__name__} scales with the load and is not a dead load"
+        else:
+            others.append(t)
+    if not springs:
+        return [], [], "the model has no springs"
+    return springs, others, None
 
 
 def network_layout(conn, k, rest_length, n_nodes: int):

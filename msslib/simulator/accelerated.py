@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from msslib.solvers.stability import _resolve_damping
+from msslib.solvers.stability import mass_proportional_alpha
 
 
 class JaxStepper:
@@ -30,9 +30,7 @@ class JaxStepper:
                              "run on the network engine (engine='network')")
         if free is not None and np.any(np.asarray(free) != np.asarray(model.free)):
             raise ValueError("engine='jax' keeps the model's supports: prescribed paths run on the network engine")
-        alpha, beta = _resolve_damping(model, damping)
-        if beta:
-            raise ValueError("engine='jax' runs mass-proportional damping only (beta = 0)")
+        alpha = mass_proportional_alpha(model, damping, "engine='jax'")
         self.net = JaxNetwork.from_model(model, dt, alpha, load=load, x0=x0, v0=v0, allow_unstable=allow_unstable)
         self.model, self.dt, self.load, self.extra = model, float(dt), load, None
         self.free = np.asarray(model.free, dtype=bool)

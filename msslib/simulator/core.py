@@ -9,7 +9,9 @@ import numpy as np
 from msslib.solvers.dynamics import Integrator
 
 from .loads import time_function
-from .network import NetworkStepper, network_terms
+from msslib.explicit.network import network_terms
+
+from .network import NetworkStepper
 
 ENGINES = ("auto", "network", "generic", "jax")
 

@@ -8,29 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from msslib.errors import DivergenceError
-from msslib.explicit.network import N_MONITOR, _advance, _pass, _steps, network_layout, records
+from msslib.explicit.network import N_MONITOR, _advance, _pass, _steps, network_layout, network_terms, records
 from msslib.solvers.dynamics import Integrator
-
-
-def network_terms(model):
-    """``(springs, others, why)``: the 3D spring terms (which the kernel runs), the other
-    internal terms (their forces are added before each pass), or ``why`` the model cannot run on
-    the network engine (None when it can)."""
-    if getattr(model, "dim", None) != 3:
-        return [], [], "the network engine is 3D"
-    springs, others = [], []
-    for t in model.terms:
-        if t.kind == "springs" and getattr(t, "dim", 3) == 3 and hasattr(t, "rest_length"):
-            springs.append(t)
-        elif t.kind == "external" and t.abs_row_sums(np.zeros(0), 1.0, np.zeros(0), np.zeros(0)):
-            continue  # dead loads: in the external force
-        elif t.scales_with_load:
-            return [], [], f"{type(t).__name__} scales with the load and is not a dead load"
-        else:
-            others.append(t)
-    if not springs:
-        return [], [], "the model has no springs"
-    return springs, others, None
 
 
 class NetworkStepper(Integrator):

@@ -284,6 +284,15 @@ def _limit_origin(limit, undamped, omega):
     return text
 
 
+def mass_proportional_alpha(problem, damping, who: str) -> float:
+    """``alpha`` of a damping that must be mass-proportional (``damping`` as :func:`integrate`
+    takes it; None: ``problem.damping``); a Rayleigh ``beta`` is a ValueError naming ``who``."""
+    alpha, beta = _resolve_damping(problem, damping)
+    if beta:
+        raise ValueError(f"{who} supports mass-proportional damping only (beta = 0)")
+    return alpha
+
+
 def _resolve_damping(problem, damping):
     if damping is None:
         damping = getattr(problem, "damping", None)

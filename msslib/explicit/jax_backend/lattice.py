@@ -184,14 +184,9 @@ class JaxLattice:
     # ---- dynamics ----------------------------------------------------------------------------
 
     def _alpha(self, alpha):
-        if alpha is None:
-            alpha = self.model.damping if self.model.damping is not None else 0.0
-            if np.ndim(alpha) != 0:
-                a, beta = alpha
-                if beta:
-                    raise ValueError("JaxLattice supports mass-proportional damping only (beta = 0)")
-                alpha = a
-        return float(alpha)
+        from msslib.solvers.stability import mass_proportional_alpha
+
+        return mass_proportional_alpha(self.model, alpha, "JaxLattice")
 
     def reset(self, x, v, h: float, alpha: float | None = None, allow_unstable: bool = False,
               omega_max: float | None = None):

@@ -35,21 +35,13 @@ def network_arrays(model, load: float = 1.0):
     """``dict(x0, conn, k, rest_length, mass, free, fext)`` of a 3D model whose internal terms are
     :class:`msslib.terms.Springs` and whose other terms are dead external loads (at the load
     factor ``load``; fixed dofs at their prescribed positions); ValueError naming any other term."""
-    if getattr(model, "dim", None) != 3:
-        raise ValueError(f"the spring-network backend needs a 3D model, got dim = {getattr(model, 'dim', None)}")
-    springs, other = [], []
-    for t in model.terms:
-        if t.kind == "springs" and getattr(t, "dim", None) == 3 and hasattr(t, "rest_length"):
-            springs.append(t)
-        elif t.kind == "external" and t.abs_row_sums(np.zeros(0), 1.0, np.zeros(0), np.zeros(0)):
-            continue  # a dead load (no stiffness): in the constant external force
-        else:
-            other.append(type(t).__name__)
-    if other:
-        raise ValueError(f"the spring-network backend runs 3D Springs and dead external loads only; "
-                         f"the model has {', '.join(sorted(set(other)))}")
-    if not springs:
-        raise ValueError("the spring-network backend needs springs; the model has none")
+    from msslib.explicit.network import network_terms
+
+    springs, other, why = network_terms(model)
+    if why is None and other:
+        why = f"the model has {', '.join(sorted({type(t).__name__ for t in other}))}"
+    if why is not None:
+        raise ValueError(f"the spring-network backend runs 3D Springs and dead external loads only: {why}")
     x0 = model.x0
     if hasattr(model, "apply_prescribed"):
         x0 = model.apply_prescribed(x0, load)
@@ -134,13 +126,9 @@ class _NetworkBase:
         external loads at the factor ``load``); ``alpha`` None takes ``model.damping`` (a scalar:
         Rayleigh ``beta`` is refused).  The stability check runs on the model itself."""
         arrays = network_arrays(model, load)
-        if alpha is None:
-            alpha = model.damping if model.damping is not None else 0.0
-            if np.ndim(alpha) != 0:
-                a, beta = alpha
-                if beta:
-                    raise ValueError("the spring-network backend supports mass-proportional damping only (beta = 0)")
-                alpha = a
+        from msslib.solvers.stability import mass_proportional_alpha
+
+        alpha = mass_proportional_alpha(model, alpha, "the spring-network backend")
         if x0 is not None:
             arrays["x0"] = np.array(x0, dtype=float).reshape(-1)
         return cls(**arrays, h=h, alpha=float(alpha), v0=v0, problem=model, load=load, **options)
