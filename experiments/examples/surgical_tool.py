@@ -53,7 +53,7 @@ def press(sim, nodes, depth: float = 0.01, t_push: float = 0.25, t_end: float = 
     displacement and tool force (N) after every step, and the wall time of the stepping."""
     path = [[0.0, 0.0, 0.0, 0.0], [t_push, 0.0, 0.0, -depth]]
     sim.prescribe(nodes, path)
-    n = int(np.ceil(t_end / sim._options["dt"]))
+    n = int(np.ceil(t_end / sim.dt))
     rows = np.empty((n, 5))
     wall = 0.0
     for i in range(n):
@@ -76,7 +76,7 @@ def main(out_dir=".", size: str = "0.02"):
     np.savetxt(out / "tool_force.csv", rows, delimiter=",", header=header, comments="")
     rtf = rows[-1, 0] / wall
     print(f"{model.n_nodes} nodes, {sum(len(t.conn) for t in model.terms if t.kind == 'springs')} springs, "
-          f"{len(rows)} steps of {sim._options['dt'] * 1e6:.1f} us on the {sim.engine} engine; tool of "
+          f"{len(rows)} steps of {sim.dt * 1e6:.1f} us on the {sim.engine} engine; tool of "
           f"{len(nodes)} nodes pressed {-rows[-1, 1] * 1000:.1f} mm: force {rows[-1, 4]:.4g} N; "
           f"{len(rows) / wall:.0f} steps/s, real-time factor {rtf:.2f} (simulated time over wall time)")
     return 0

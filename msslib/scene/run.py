@@ -95,7 +95,6 @@ def _solve_mss_linear(setup: Setup):
 
 def _solve_mss_dynamic(setup: Setup, report):
     from msslib.simulator import Simulator
-    from msslib.solvers import protocol
 
     model, s = setup.model, setup.scene.solver
     curve = s.get("load_curve")
@@ -105,7 +104,6 @@ def _solve_mss_dynamic(setup: Setup, report):
     n_steps = int(np.ceil(t_end / dt - 1e-9)) if t_end > 0 else 0
     n, dim = model.n_nodes, model.dim
     keep = setup.scene.output["history"]
-    stepper = sim._stepper
     ts, xs, vs, rs, kes, pes = [], [], [], [], [], []
 
     def save(step):
@@ -114,9 +112,8 @@ def _solve_mss_dynamic(setup: Setup, report):
             xs.append(sim.x.copy())
             vs.append(sim.v.copy())
             rs.append(np.array(sim.reaction))
-            kes.append(stepper.kinetic_energy())
-            if stepper.conservative:
-                pes.append(protocol._energy_or_none(model, np.ravel(stepper.x), stepper.load))
+            kes.append(sim.kinetic_energy())
+            pes.append(sim.potential_energy())
         report(step / max(n_steps, 1), f"t = {sim.t:.4g} s")
 
     save(0)
@@ -131,11 +128,10 @@ def _solve_mss_dynamic(setup: Setup, report):
         else:
             sim.step(k)
         done += k
-        stepper = sim._stepper
         save(done)
-    stats = dict(stepper.stats)
-    stats["wall_time"] = sim._wall
-    stats["messages"] = stepper.messages
+    stats = dict(sim.stats)
+    stats["wall_time"] = sim.wall_time
+    stats["messages"] = sim.messages
     stats["engine"] = sim.engine
     stats["n_steps"] = n_steps
     out = {"displacement": sim.displacement.copy(), "reaction": np.array(sim.reaction),
@@ -145,7 +141,7 @@ def _solve_mss_dynamic(setup: Setup, report):
         out["history"] = {"time": np.array(ts), "displacement": (np.array(xs) - model.x0.reshape(n, dim)),
                           "velocity": np.array(vs).reshape(n_t, n, dim), "reaction": np.array(rs).reshape(n_t, n, dim)}
         extra = {"kinetic_energy": (("time",), np.array(kes), {"units": "J", "long_name": "kinetic energy"})}
-        if stepper.conservative:
+        if pes and pes[0] is not None:  # a conservative model
             extra["potential_energy"] = (("time",), np.array(pes, dtype=float),
                                          {"units": "J", "long_name": "potential energy (internal minus load work)"})
         out["extra_vars"] = extra

@@ -316,6 +316,35 @@ class Simulator:
         return self._stepper.stats
 
     @property
+    def dt(self) -> float:
+        """The time step (s)."""
+        return self._options["dt"]
+
+    @property
+    def wall_time(self) -> float:
+        """Wall time spent in :meth:`step` since the start or the last :meth:`reset` (s)."""
+        return self._wall
+
+    @property
+    def messages(self) -> list[str]:
+        """What the run noted (a step allowed over the limit, a solver fallback)."""
+        return self._stepper.messages
+
+    def kinetic_energy(self) -> float:
+        """``1/2 v.M v`` over the free dofs (J)."""
+        return self._stepper.kinetic_energy()
+
+    def potential_energy(self) -> float | None:
+        """Internal energy minus the work of the loads at the current load factor (J); None for a
+        model with a non-conservative term."""
+        st = self._stepper
+        if not st.conservative:
+            return None
+        from msslib.solvers import protocol
+
+        return protocol._energy_or_none(self.model, np.ravel(st.x), st.load)
+
+    @property
     def real_time_factor(self) -> float:
         """Simulated time over the wall time spent in :meth:`step` (> 1: faster than real time)."""
         return self.t / self._wall if self._wall > 0 else float("inf")
