@@ -31,14 +31,32 @@ __all__ = ["Comparison", "compare_results", "interpolate", "write_error_field", 
 #: the farthest a result node may lie outside the reference mesh, relative to the reference's
 #: bounding-box diagonal, before the two are taken for different bodies
 MAX_OUTSIDE = 0.05
+#: points located at once in the reference mesh (bounds the element finder's memory)
+PROBE_BLOCK = 256
 
 
 def _probe(ref_mesh, ref_u, points):
-    """Shape-function values of the reference at ``points``: (values, inside mask)."""
+    """Shape-function values of the reference at ``points``: (values, inside mask).
+
+    Points on a reference node (a nested refinement, or the same nodes) take that node's value,
+    which is what the interpolating shape functions give there; the others are located element by
+    element in blocks (:data:`PROBE_BLOCK` points at a time: scikit-fem's element finder holds
+    arrays of points x candidate elements)."""
+    from scipy.spatial import cKDTree
     from skfem import Basis
 
     from msslib.fem import to_skfem
 
+    out = np.empty((len(points), ref_u.shape[1]))
+    inside = np.ones(len(points), dtype=bool)
+    nodes = np.asarray(ref_mesh.points, dtype=float)
+    tol = 1e-10 * max(float(np.ptp(nodes, axis=0).max()), 1e-300)
+    distance, nearest = cKDTree(nodes).query(points)
+    on_node = distance <= tol
+    out[on_node] = ref_u[nearest[on_node]]
+    rest = np.flatnonzero(~on_node)
+    if not len(rest):
+        return out, inside
     skmesh, elem = to_skfem(ref_mesh)
     basis = Basis(skmesh, elem)
 
@@ -46,17 +64,18 @@ def _probe(ref_mesh, ref_u, points):
         P = basis.probes(pts.T)
         return np.column_stack([P @ ref_u[:, d] for d in range(ref_u.shape[1])])
 
-    try:
-        return probe(points), np.ones(len(points), dtype=bool)
-    except ValueError:  # some points lie outside: probe one by one
-        pass
-    out = np.empty((len(points), ref_u.shape[1]))
-    inside = np.ones(len(points), dtype=bool)
-    for i, p in enumerate(points):
+    for start in range(0, len(rest), PROBE_BLOCK):
+        block = rest[start:start + PROBE_BLOCK]
         try:
-            out[i] = probe(p[None, :])[0]
-        except ValueError:
-            inside[i] = False
+            out[block] = probe(points[block])
+            continue
+        except ValueError:  # some points lie outside: probe one by one
+            pass
+        for i in block:
+            try:
+                out[i] = probe(points[i][None, :])[0]
+            except ValueError:
+                inside[i] = False
     return out, inside
 
 

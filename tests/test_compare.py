@@ -70,6 +70,30 @@ def test_other_mesh_uses_the_references_shape_functions(tmp_path, coarse, fine):
     assert c.error.max == pytest.approx((1e-3 * X[:, 0] * (0.1 - X[:, 0])).max(), rel=1e-9)
 
 
+def test_points_on_reference_nodes_and_points_located_in_blocks(monkeypatch):
+    """Points on reference nodes take the node's value; the others are located a block at a time,
+    some inside and some outside the reference, across block boundaries: the affine field is
+    reproduced exactly inside and the outside points are flagged."""
+    import msslib.compare as cmp
+
+    fine = hex_grid(0.1, 0.05, 0.05, 6, 3, 3)
+    u = _affine(fine.points)
+    rng = np.random.default_rng(3)
+    inner = rng.uniform([0, 0, 0], [0.1, 0.05, 0.05], size=(40, 3))
+    outer = np.array([[0.1 + 2e-3, 0.02, 0.02], [0.05, -1e-3, 0.01]])
+    points = np.vstack([fine.points[::3], inner[:20], outer[:1], inner[20:], outer[1:]])
+    monkeypatch.setattr(cmp, "PROBE_BLOCK", 7)
+    values, inside, distance = cmp._interpolate(fine, u, points)
+    flagged = np.zeros(len(points), dtype=bool)
+    n_nodes = len(fine.points[::3])
+    flagged[[n_nodes + 20, len(points) - 1]] = True
+    np.testing.assert_array_equal(~inside, flagged)
+    np.testing.assert_allclose(values[inside], _affine(points[inside]), rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(values[:n_nodes], u[::3])  # on the nodes: the nodes' own values
+    nearest = np.linalg.norm(points[flagged][:, None, :] - fine.points[None, :, :], axis=2).min(axis=1)
+    assert distance[flagged] == pytest.approx(nearest, rel=1e-12)  # outside: to the nearest reference node
+
+
 def test_a_curved_boundary_is_counted_and_different_bodies_refused(tmp_path):
     fine = hex_grid(0.1, 0.05, 0.05, 4, 2, 2)
     ref = _result(tmp_path / "fine.nc", fine, _affine(fine.points))
