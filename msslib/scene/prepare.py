@@ -42,6 +42,24 @@ class Setup:
         return 1.0 if self.mesh.dim == 3 else float(self.scene.thickness or 1.0)
 
 
+def _check_held(scene: Scene, mesh, fixed, terms=()) -> None:
+    """Before a static solve: every part held against its rigid-body modes by its fixed dofs and by
+    the nodes a force term ties to fixed points (:meth:`msslib.terms.Term.held_nodes`)."""
+    if scene.is_dynamic:
+        return
+    held = np.array(fixed, dtype=bool)
+    for t in terms:
+        held[np.asarray(t.held_nodes(), dtype=np.int64)] = True
+    loose = _mesh.loose_parts(mesh, held)
+    if loose:
+        n_modes = 3 if mesh.dim == 2 else 6
+        more = f" (and {len(loose) - 1} more loose part(s))" if len(loose) > 1 else ""
+        fix = (f"fix at least {n_modes} dofs of every part that stop its {n_modes} rigid-body modes"
+               if loose[0].floating else "fix dofs that stop every rigid-body mode of every part")
+        _fail("scene.boundary", f"{loose[0].describe(mesh)}{more}; a static solve needs it held: {fix}, "
+              f"or use a dynamic solver (solver: {{type: dynamic, ...}})")
+
+
 def prepare(scene: Scene) -> Setup:
     """Build the mesh, boundary conditions, loads and (for MSS) the model of a scene.
 
@@ -53,8 +71,8 @@ def prepare(scene: Scene) -> Setup:
     (``checks.coincident_nodes``, :func:`msslib.mesh.resolve_coincident_nodes`), for generated
     meshes too; a material no cell uses is an error; before a static solve, a part of the mesh
     whose fixed dofs leave a rigid-body mode free (floating, or free to slide or turn:
-    :func:`msslib.mesh.loose_parts`) is an error naming the part and the mode (dynamic runs may
-    move freely).
+    :func:`msslib.mesh.loose_parts`; nodes a force term ties to fixed points count as held) is an
+    error naming the part and the mode (dynamic runs may move freely).
     """
     policy = scene.checks.get("coincident_nodes", "merge")
     mesh = _mesh.resolve_coincident_nodes(_build_mesh(scene), policy, source="scene.geometry",
@@ -93,16 +111,6 @@ def prepare(scene: Scene) -> Setup:
             fixed[nodes, a] = True
             prescribed[nodes, a] = disp[a]
             owner[nodes, a] = i
-    if not scene.is_dynamic:
-        loose = _mesh.loose_parts(mesh, fixed)
-        if loose:
-            n_modes = 3 if dim == 2 else 6
-            more = f" (and {len(loose) - 1} more loose part(s))" if len(loose) > 1 else ""
-            fix = (f"fix at least {n_modes} dofs of every part that stop its {n_modes} rigid-body modes"
-                   if loose[0].floating else "fix dofs that stop every rigid-body mode of every part")
-            _fail("scene.boundary", f"{loose[0].describe(mesh)}{more}; a static solve needs it held: {fix}, "
-                  f"or use a dynamic solver (solver: {{type: dynamic, ...}})")
-
     thickness = 1.0 if dim == 3 else float(scene.thickness or 1.0)
     dens = np.array([np.nan if m.density is None else m.density for m in scene.materials])
     cell_density = dens[mesh.material]
@@ -135,12 +143,14 @@ def prepare(scene: Scene) -> Setup:
     setup = Setup(scene=scene, mesh=mesh, fixed=fixed, prescribed=prescribed, surface_forces=surface,
                   gravity=gravity, cell_density=cell_density, masses=masses)
     if scene.is_fem:
+        _check_held(scene, mesh, fixed)
         try:
             _mesh.check_cells(mesh)
         except ValueError as exc:
             _fail("scene.geometry", str(exc))
     else:
         setup.model = _build_model(setup)
+        _check_held(scene, mesh, fixed, setup.model.terms)
     return setup
 
 

@@ -170,6 +170,12 @@ class Term:
         """Largest node id the term refers to (-1 if none); used to check it fits a mesh."""
         return -1
 
+    def held_nodes(self) -> np.ndarray:
+        """Nodes the term ties to fixed points in space in every axis (a support: a tether, a
+        penalty spring to the ground); the check of a static scene for free rigid-body modes counts
+        them as held. None by default."""
+        return np.zeros(0, dtype=np.int64)
+
     def hessian_pattern(self) -> tuple[np.ndarray, np.ndarray]:
         empty = np.zeros(0, dtype=np.int64)
         return empty, empty
