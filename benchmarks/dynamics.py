@@ -35,6 +35,7 @@ from msslib import mesh as M
 from msslib import model as MD
 from msslib import solvers as S
 from msslib import terms as T
+from msslib.terms import loops
 from msslib.explicit import LatticeExplicit
 
 
@@ -45,9 +46,9 @@ def _explicit_run(x, v, free, inv_m, mass, fext, alpha, h, n_steps, save_every,
     j = 0
     for step in range(n_steps):
         g[:] = 0.0
-        T._spring3d_gradient_fast(x, rowptr, ib, k, L0, g)
+        loops._spring3d_gradient_fast(x, rowptr, ib, k, L0, g)
         if hconn.shape[0]:
-            T._hex_gradient_loop(x, hconn, kappa, V0, g)
+            loops._hex_gradient_loop(x, hconn, kappa, V0, g)
         for i in range(x.size):
             if free[i]:
                 v[i] += h * (fext[i] - g[i] - alpha * mass[i] * v[i]) * inv_m[i]

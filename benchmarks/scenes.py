@@ -98,10 +98,10 @@ def _band_threads(res):
 
     raw = _scene("cylinder", 2, "lloyd_tetrahedron")
     model = prepare(load_scene(raw, base_dir=SCENES)).model
-    ctx = S._solver_context(model, model.x0, model.free)
-    A = sp.csr_matrix(S._submatrix(model.stiffness(model.x0, 0.0), model.free))
+    ctx = S.context._solver_context(model, model.x0, model.free)
+    A = sp.csr_matrix(S.submatrices._submatrix(model.stiffness(model.x0, 0.0), model.free))
     A.sort_indices()
-    plan = S._band_plan(A, ctx)
+    plan = S.direct._band_plan(A, ctx)
     n, bw = A.shape[0], plan["bw"]
     ab = np.zeros((bw + 1, n), order="F")
     ab.reshape(-1, order="F")[plan["dst"]] = A.data[plan["src"]]

@@ -10,7 +10,7 @@ import scipy.sparse as sp
 from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
 from msslib import model as MD
-from msslib import terms as T
+from msslib.terms import loops
 
 from .common import median_time
 
@@ -85,7 +85,7 @@ def run(res, quick: bool):
     vals = np.empty((s, 36))
 
     def coo():
-        T._spring3d_hessian_loop(x, springs.conn, springs.k, springs.rest_length, vals)
+        loops._spring3d_hessian_loop(x, springs.conn, springs.k, springs.rest_length, vals)
         return sp.coo_matrix((vals.ravel(), (rows, cols)), shape=(x.size, x.size)).tocsr()
 
     # interleaved rounds: the baseline and the fills are timed side by side, so that a change of

@@ -15,7 +15,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from msslib import mesh as _mesh
-from msslib.terms import ExternalForce, Springs, Term, _ElementTerm
+from msslib.terms import ExternalForce, Springs, Term
+from msslib.terms.base import _ElementTerm
 from msslib.terms.assembly import (
     _block_scatter_bsr,
     _block_scatter_csr,
@@ -469,6 +470,6 @@ class Model:
 
 def _is_block_term(term, dim) -> bool:
     """True for element terms whose Hessian pattern is the dense block of all dofs of their nodes
-    (the default :meth:`msslib.terms._ElementTerm.hessian_pattern`)."""
+    (the default :meth:`msslib.terms.base._ElementTerm.hessian_pattern`)."""
     return (isinstance(term, _ElementTerm) and type(term).hessian_pattern is _ElementTerm.hessian_pattern
             and type(term).hessian_values is _ElementTerm.hessian_values and term.dim == dim)

@@ -145,7 +145,9 @@ def lattice_system(n=8):
     from msslib import mesh as M
     from msslib.model import Model
     from msslib.models.golec import golec_cube_springs
-    from msslib.solvers import _rigid_body_modes, _solver_context, _submatrix_bsr
+    from msslib.solvers.amg import _rigid_body_modes
+    from msslib.solvers.context import _solver_context
+    from msslib.solvers.submatrices import _submatrix_bsr
 
     mesh = M.hex_grid(0.01 * n, 0.01 * n, 0.01 * n, n, n, n)
     fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)

@@ -107,3 +107,16 @@ def test_a_concern_is_a_package_not_prefixed_siblings():
     siblings = [(a, b) for a in names for b in names if b.startswith(a + "_")]
     assert not siblings, siblings
     assert not (top / "paper.py").exists() and not (top / "plotting.py").exists()  # workflow, not library
+
+
+def test_package_faces_export_public_names_only():
+    """A package's ``__init__`` imports no underscore name: internals are imported from the module
+    that defines them, so every name has one path."""
+    bad = []
+    for init in (ROOT / "msslib").rglob("__init__.py"):
+        if "generated" in init.parts:
+            continue
+        for node in ast.walk(ast.parse(init.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and node.level:
+                bad += [f"{init.relative_to(ROOT)}: {a.name}" for a in node.names if a.name.startswith("_")]
+    assert not bad, bad

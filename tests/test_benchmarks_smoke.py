@@ -12,7 +12,8 @@ import numpy as np
 from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
 from msslib.model import Model
-from msslib.terms import Springs, _spring3d_hessian_loop
+from msslib.terms import Springs
+from msslib.terms.loops import _spring3d_hessian_loop
 
 ROOT = Path(__file__).resolve().parents[1]
 

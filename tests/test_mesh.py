@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from msslib import mesh as M
+from msslib.mesh import core
 
 
 def enclosed_volume(mesh):
@@ -105,7 +106,7 @@ def test_hex_volume_trilinear_exact():
     def tet_approx(n):  # volume of the tets of an n^3 grid mapped through the trilinear map
         fine = M.tet_grid(1.0, 1.0, 1.0, n, n, n)
         u = fine.points
-        shape = np.prod(np.where(M._HEX_REF01[None] == 1, u[:, None, :], 1 - u[:, None, :]), axis=2)
+        shape = np.prod(np.where(core._HEX_REF01[None] == 1, u[:, None, :], 1 - u[:, None, :]), axis=2)
         return M.cell_measures(M.Mesh(shape @ pts, fine.cells, "tetra")).sum()
 
     v4, v8 = tet_approx(4), tet_approx(8)
@@ -121,7 +122,7 @@ def test_tet_grid_volumes_and_conformity(scheme):
     assert np.all(vol > 0)
     assert vol.sum() == pytest.approx(6.0)
     # every triangular face is shared by one (boundary) or two (interior) tetrahedra
-    faces = np.sort(m.cells[:, M._LOCAL_FACETS["tetra"]].reshape(-1, 3), axis=1)
+    faces = np.sort(m.cells[:, core._LOCAL_FACETS["tetra"]].reshape(-1, 3), axis=1)
     _, counts = np.unique(faces, axis=0, return_counts=True)
     assert set(counts) == {1, 2}
     # boundary triangles cover the box surface exactly: no hanging faces

@@ -78,8 +78,8 @@ def test_banded_factorisations_run_on_one_blas_thread(monkeypatch, shift):
             A = _grid_laplacian(nx, ny, shift)
             b = rng.standard_normal(A.shape[0])
             seen.clear()
-            x = S._banded_cholesky_solve(A, b, {})
-            bw = S._band_plan(A, None)["bw"]
+            x = S.direct._banded_cholesky_solve(A, b, {})
+            bw = S.direct._band_plan(A, None)["bw"]
             assert (bw >= BLOCKED_BANDWIDTH) == (nx == 80)
             ref = spla.spsolve(A.tocsc(), b)
             np.testing.assert_allclose(x, ref, rtol=0, atol=1e-9 * np.abs(ref).max())
@@ -91,7 +91,7 @@ def test_banded_factorisations_run_on_one_blas_thread(monkeypatch, shift):
 
 def _spd_update(A, factor=1.5):
     """``A`` with its diagonal blocks scaled by ``factor`` (symmetric, positive definite)."""
-    from msslib.solvers import _block_diag
+    from msslib.solvers.amg_kernels import _block_diag
 
     D = _block_diag(A.indptr, A.indices, A.data)
     return sp.bsr_matrix(A + sp.block_diag(list((factor - 1.0) * D)).tobsr(blocksize=A.blocksize))
@@ -106,7 +106,7 @@ def test_refreshed_diagonal_keeps_the_kept_cycle_symmetric(single):
     from msslib import solvers as S
 
     A, B, _ = _lattice(8)
-    cycle = S._VCycle.build(S._sa_solver(A, B, 3), single=single)
+    cycle = S.amg_cycle._VCycle.build(S.amg._sa_solver(A, B, 3), single=single)
     A2 = _spd_update(A)
     A2.sort_indices()
     assert cycle.update(A2)
@@ -145,15 +145,15 @@ def test_kept_hierarchy_is_given_up_at_the_iteration_limit():
     b = np.random.default_rng(2).standard_normal(A.shape[0])
     rtol = 1e-8
     identity = spla.LinearOperator(A.shape, matvec=lambda v: np.array(v, dtype=float).ravel())
-    _, info, plain = S._pcg(A, b, identity, rtol, 5000)
+    _, info, plain = S.linear._pcg(A, b, identity, rtol, 5000)
     limit = 2.0 * 1.0 * 8 + 10  # per decade 1, 8 decades
     assert info == 0 and plain > 3 * limit  # unpreconditioned CG is far slower
     ctx = dict(ctx, cache={"M": identity, "shape": A.shape, "per_decade": 1.0})
     messages = []
-    x = S._linear_solve(A, b, "cg", True, messages, ctx, rtol)
+    x = S.linear._linear_solve(A, b, "cg", True, messages, ctx, rtol)
     rebuilt = ctx["cache"]["M"]
     assert rebuilt is not identity
-    _, info, fresh = S._pcg(A, b, rebuilt, rtol, 5000)
+    _, info, fresh = S.linear._pcg(A, b, rebuilt, rtol, 5000)
     assert info == 0
     assert ctx["cg_iterations"] == (int(limit) + 1) + fresh  # capped, then solved with the new one
     assert np.linalg.norm(b - A @ x) <= rtol * np.linalg.norm(b)
@@ -179,7 +179,7 @@ def test_cylinder_load_steps_keep_the_hierarchy_and_match_the_direct_solve(monke
     model = prepare(scene).model
     assert int(model.free.sum()) > S.ITERATIVE_THRESHOLD
     built = []
-    real = S._preconditioner
+    real = S.amg._preconditioner
 
     def counting(*a, **k):
         built.append(1)

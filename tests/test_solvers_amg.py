@@ -24,7 +24,8 @@ _lattice_system = lattice_system
 def test_block_jacobi_radius_is_the_largest_eigenvalue():
     from scipy.linalg import eigh
 
-    from msslib.solvers import _block_diag_inverse, _block_jacobi_radius
+    from msslib.solvers.amg_kernels import _block_diag_inverse
+    from msslib.solvers.amg import _block_jacobi_radius
 
     A, _, _ = _lattice_system(5)
     dinv = _block_diag_inverse(A.indptr, A.indices, A.data)
@@ -38,12 +39,8 @@ def test_finest_level_prolongator_is_the_jacobi_smoothed_tentative_one():
     from pyamg.aggregation import fit_candidates, standard_aggregation
     from pyamg.strength import symmetric_strength_of_connection
 
-    from msslib.solvers import (
-        _SA_OPTIONS,
-        _block_diag_inverse,
-        _block_jacobi_radius,
-        _sa_solver,
-    )
+    from msslib.solvers.amg import _SA_OPTIONS, _block_jacobi_radius, _sa_solver
+    from msslib.solvers.amg_kernels import _block_diag_inverse
 
     A, B, _ = _lattice_system(8)
     ml = _sa_solver(A, B, 3)
@@ -61,7 +58,8 @@ def test_finest_level_prolongator_is_the_jacobi_smoothed_tentative_one():
 def test_own_finest_level_preconditions_as_well_as_pyamg():
     import pyamg
 
-    from msslib.solvers import _SA_OPTIONS, _pcg, _sa_solver
+    from msslib.solvers.amg import _SA_OPTIONS, _sa_solver
+    from msslib.solvers.linear import _pcg
 
     A, B, _ = _lattice_system(9)
     b = np.random.default_rng(8).standard_normal(A.shape[0])
@@ -77,7 +75,8 @@ def test_own_finest_level_preconditions_as_well_as_pyamg():
 def test_compiled_block_gauss_seidel_sweeps_equal_pyamg(d):
     from pyamg.relaxation.relaxation import block_gauss_seidel
 
-    from msslib.solvers import _block_diag_inverse, _BlockGaussSeidel
+    from msslib.solvers.amg_kernels import _block_diag_inverse
+    from msslib.solvers.amg_cycle import _BlockGaussSeidel
 
     rng = np.random.default_rng(d)
     nb = 40
@@ -143,9 +142,9 @@ def test_galerkin_product_equals_the_dense_one():
     import msslib.solvers as S
 
     A, B, _ = _lattice_system(8)
-    ml = S._sa_solver(A, B, 3)
+    ml = S.amg._sa_solver(A, B, 3)
     P = ml.levels[0].P
-    A_c = S._galerkin(A, P)
+    A_c = S.amg._galerkin(A, P)
     assert A_c.format == "bsr" and A_c.blocksize == (B.shape[1], B.shape[1])
     ref = (P.T @ A @ P).toarray()
     np.testing.assert_allclose(A_c.toarray(), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
@@ -159,7 +158,7 @@ def test_galerkin_product_equals_the_dense_one():
         M = M + M.T
         Pd = sp.kron(sp.random(nb, nc, 0.3, random_state=m, format="csr"), np.ones((d, m))).toarray()
         Pd *= rng.standard_normal(Pd.shape)
-        C = S._galerkin(sp.bsr_matrix(M, blocksize=(d, d)), sp.bsr_matrix(Pd, blocksize=(d, m)))
+        C = S.amg._galerkin(sp.bsr_matrix(M, blocksize=(d, d)), sp.bsr_matrix(Pd, blocksize=(d, m)))
         ref = Pd.T @ M @ Pd
         np.testing.assert_allclose(C.toarray(), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
 
@@ -174,10 +173,10 @@ def test_compiled_v_cycle_equals_pyamg_cycle():
 
     A, B, _ = _lattice_system(8)
     b = np.random.default_rng(3).standard_normal(A.shape[0])
-    deep = S._compiled_smoothers(pyamg.smoothed_aggregation_solver(A, B=B, **dict(S._SA_OPTIONS, max_coarse=8)))
+    deep = S.amg_cycle._compiled_smoothers(pyamg.smoothed_aggregation_solver(A, B=B, **dict(S.amg._SA_OPTIONS, max_coarse=8)))
     assert len(deep.levels) >= 3 and deep.levels[1].A.blocksize == (6, 6)
-    for ml in (deep, S._sa_solver(A, B, 3)):
-        cycle = S._VCycle.build(ml, single=False)
+    for ml in (deep, S.amg._sa_solver(A, B, 3)):
+        cycle = S.amg_cycle._VCycle.build(ml, single=False)
         assert cycle is not None
         ref = ml.aspreconditioner(cycle="V") @ b
         for _ in range(2):  # work vectors are reused: a second application gives the same
@@ -188,8 +187,8 @@ def test_compiled_v_cycle_equals_pyamg_cycle():
         assert abs(c @ (cycle @ b) - b @ (cycle @ c)) <= 1e-10 * abs(c @ (cycle @ b))
     # single precision on the finest level: the exact V-cycle of the rounded matrix and
     # prolongator; after update(), of the rounded new matrix
-    ml = S._sa_solver(A, B, 3)
-    cycle = S._VCycle.build(ml, single=True)
+    ml = S.amg._sa_solver(A, B, 3)
+    cycle = S.amg_cycle._VCycle.build(ml, single=True)
     assert cycle.levels[0]["a_data"].dtype == np.float32 and cycle.levels[0]["p_data"].dtype == np.float32
     v = np.random.default_rng(6).standard_normal(A.shape[0])
     np.testing.assert_allclose(ml.levels[0].R @ v, ml.levels[0].P.T @ v, rtol=1e-14, atol=0)  # lazy R
@@ -210,13 +209,13 @@ def test_compiled_v_cycle_equals_pyamg_cycle():
         ref = ml.aspreconditioner(cycle="V") @ b
         lvl.A, lvl.P, lvl.R = keep
         np.testing.assert_allclose(z, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
-    assert np.abs(approx - S._VCycle.build(ml, single=False) @ b).max() <= 1e-5 * np.abs(approx).max()
+    assert np.abs(approx - S.amg_cycle._VCycle.build(ml, single=False) @ b).max() <= 1e-5 * np.abs(approx).max()
     # the preconditioner that CG gets is the compiled cycle
     ctx = {"dim": 3, "coords": _lattice_system(8)[2]["coords"]}
-    assert isinstance(S._amg_preconditioner(A, ctx), S._VCycle)
+    assert isinstance(S.amg._amg_preconditioner(A, ctx), S.amg_cycle._VCycle)
     # a level without the compiled smoother: no compiled cycle (pyamg's is used)
-    plain = pyamg.smoothed_aggregation_solver(A, B=B, **S._SA_OPTIONS)
-    assert S._VCycle.build(plain) is None
+    plain = pyamg.smoothed_aggregation_solver(A, B=B, **S.amg._SA_OPTIONS)
+    assert S.amg_cycle._VCycle.build(plain) is None
 
 
 def _random_spd_bsr(nb, d, rng):
@@ -242,14 +241,14 @@ def test_compiled_bsr_kernels_equal_dense_products(d, m):
     Pd *= rng.standard_normal(Pd.shape)
     P = sp.bsr_matrix(Pd, blocksize=(d, m))
     v = rng.standard_normal(nb * d)
-    np.testing.assert_allclose(S._matvec_of(A)(v), M @ v, rtol=0, atol=1e-12 * np.abs(M @ v).max())
+    np.testing.assert_allclose(S.amg_cycle._matvec_of(A)(v), M @ v, rtol=0, atol=1e-12 * np.abs(M @ v).max())
     vc = rng.standard_normal(nc * m)
-    np.testing.assert_allclose(S._matvec_of(P)(vc), Pd @ vc, rtol=0, atol=1e-12 * np.abs(Pd @ vc).max())
-    dinv = S._block_diag_inverse(A.indptr, A.indices, A.data)
+    np.testing.assert_allclose(S.amg_cycle._matvec_of(P)(vc), Pd @ vc, rtol=0, atol=1e-12 * np.abs(Pd @ vc).max())
+    dinv = S.amg_kernels._block_diag_inverse(A.indptr, A.indices, A.data)
     L = np.tril(M, -1) * (np.abs(np.subtract.outer(np.arange(nb * d) // d, np.arange(nb * d) // d)) > 0)
     D = M - L - (np.triu(M, 1) * (np.subtract.outer(np.arange(nb * d) // d, np.arange(nb * d) // d) < 0))
-    kernels = ((S._gs3_forward_from_zero, S._residual3_restrict),) if d == 3 else ()
-    for fwd, res in kernels + ((S._gs_forward_from_zero, S._residual_restrict),):
+    kernels = ((S.amg_kernels._gs3_forward_from_zero, S.amg_kernels._residual3_restrict),) if d == 3 else ()
+    for fwd, res in kernels + ((S.amg_kernels._gs_forward_from_zero, S.amg_kernels._residual_restrict),):
         x, s, bc = np.empty(nb * d), np.empty(nb * d), np.zeros(nc * m)
         fwd(A.indptr, A.indices, A.data, dinv, v, x, s)
         x_ref = np.linalg.solve(D + L, v)  # block forward substitution
@@ -259,13 +258,13 @@ def test_compiled_bsr_kernels_equal_dense_products(d, m):
         np.testing.assert_allclose(bc, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
     x0 = rng.standard_normal(nb * d)
     x_ref = x0.copy()
-    S._block_gauss_seidel_sweep(A.indptr, A.indices, A.data, dinv, x_ref, v, False)
+    S.amg_kernels._block_gauss_seidel_sweep(A.indptr, A.indices, A.data, dinv, x_ref, v, False)
     if d == 3:
         x = x0.copy()
-        S._gs3_backward(A.indptr, A.indices, A.data, dinv, x, v)
+        S.amg_kernels._gs3_backward(A.indptr, A.indices, A.data, dinv, x, v)
         np.testing.assert_allclose(x, x_ref, rtol=0, atol=1e-12 * np.abs(x_ref).max())
     x = x0.copy()
-    S._prolong_add(P.indptr, P.indices, P.data, vc, x)
+    S.amg_kernels._prolong_add(P.indptr, P.indices, P.data, vc, x)
     np.testing.assert_allclose(x, x0 + Pd @ vc, rtol=0, atol=1e-12 * np.abs(Pd @ vc).max())
 
 
@@ -292,7 +291,7 @@ def test_repeated_solves_of_a_problem_keep_the_amg_hierarchy(monkeypatch):
     import msslib.solvers as S
 
     builds = []
-    original = S._preconditioner
+    original = S.amg._preconditioner
 
     def counting(A, context=None):
         builds.append(A.shape)
@@ -303,11 +302,11 @@ def test_repeated_solves_of_a_problem_keep_the_amg_hierarchy(monkeypatch):
     direct = static_solve(model, model.x0, linear_solver="direct", tol=1e-10)  # the reference
     first = static_solve(model, model.x0, linear_solver="cg", tol=1e-10)
     assert len(builds) == 1 and first.cg_iterations > 0
-    ctx = S._kept_context(model)
+    ctx = S.context._kept_context(model)
     K = ctx["K"]
     second = static_solve(model, model.x0, linear_solver="cg", tol=1e-10)
     assert len(builds) == 1  # kept: CG converged as fast with it
-    assert S._kept_context(model) is ctx and ctx["K"] is K  # the matrix refilled in place
+    assert S.context._kept_context(model) is ctx and ctx["K"] is K  # the matrix refilled in place
     assert second.cg_iterations == first.cg_iterations
     scale = np.abs(first.x - model.x0).max()
     np.testing.assert_allclose(second.x, first.x, rtol=0, atol=1e-9 * scale)
@@ -320,12 +319,12 @@ def test_repeated_solves_of_a_problem_keep_the_amg_hierarchy(monkeypatch):
     # a state left by a stiffer model's solve: still converges to the right answer
     soft, stiff = _gravity_cube(6, E=1e4), _gravity_cube(6, E=1e6)
     static_solve(stiff, stiff.x0, linear_solver="cg", tol=1e-10)
-    setattr(soft, S.context.ATTRIBUTE, S._kept_context(stiff))  # as if the values had changed
+    setattr(soft, S.context.ATTRIBUTE, S.context._kept_context(stiff))  # as if the values had changed
     r = static_solve(soft, soft.x0, linear_solver="cg", tol=1e-10)
     np.testing.assert_allclose(r.x, direct.x, rtol=0, atol=1e-7 * scale)
     assert r.residuals[-1][-1] <= 1e-10 * r.force_scale
     # the state goes with the model
-    kept = [weakref.ref(S._kept_context(m)) for m in (model, stiff)]
+    kept = [weakref.ref(S.context._kept_context(m)) for m in (model, stiff)]
     del model, soft, stiff, ctx
     gc.collect()
     assert all(k() is None for k in kept)
@@ -336,16 +335,16 @@ def test_static_context_in_use_is_not_shared():
 
     model = _gravity_cube(3)
     free = np.asarray(model.free, dtype=bool)
-    a = S._static_context(model, model.x0, free, "cg")
-    b = S._static_context(model, model.x0, free, "cg")  # `a` is in use (another thread)
-    assert b is not a and S._kept_context(model) is a
-    S._release_context(a)
-    S._release_context(b)
-    c = S._static_context(model, model.x0, free, "cg")
+    a = S.context._static_context(model, model.x0, free, "cg")
+    b = S.context._static_context(model, model.x0, free, "cg")  # `a` is in use (another thread)
+    assert b is not a and S.context._kept_context(model) is a
+    S.context._release_context(a)
+    S.context._release_context(b)
+    c = S.context._static_context(model, model.x0, free, "cg")
     assert c is a
-    S._release_context(c)
-    assert S._static_context(model, model.x0, free, "direct") is not a
-    assert S._static_context(model, model.x0, free, lambda K, b: b) is not a  # user solver: never kept
+    S.context._release_context(c)
+    assert S.context._static_context(model, model.x0, free, "direct") is not a
+    assert S.context._static_context(model, model.x0, free, lambda K, b: b) is not a  # user solver: never kept
 
 
 @pytest.mark.parametrize("d,m", [(3, 6), (2, 3)])
@@ -363,12 +362,12 @@ def test_smoothed_prolongator_equals_the_dense_formula(d, m):
         if a >= 0:
             Td[i * d:(i + 1) * d, a * m:(a + 1) * m] = rng.standard_normal((d, m))
     T = sp.bsr_matrix(Td, blocksize=(d, m))
-    dinv = S._block_diag_inverse(A.indptr, A.indices, A.data)
+    dinv = S.amg_kernels._block_diag_inverse(A.indptr, A.indices, A.data)
     p_ptr = np.empty(nb + 1, dtype=np.int64)
     args = (A.indptr, A.indices, A.data, dinv, T.indptr, T.indices, T.data, -0.3, nc, p_ptr)
-    assert S._smoothed_prolongator(*args, np.empty(0, dtype=np.int64), np.empty((0, d, m)))
+    assert S.amg_kernels._smoothed_prolongator(*args, np.empty(0, dtype=np.int64), np.empty((0, d, m)))
     p_ind, p_data = np.empty(p_ptr[-1], dtype=np.int64), np.empty((p_ptr[-1], d, m))
-    assert S._smoothed_prolongator(*args, p_ind, p_data)
+    assert S.amg_kernels._smoothed_prolongator(*args, p_ind, p_data)
     P = sp.bsr_matrix((p_data, p_ind, p_ptr), shape=Td.shape)
     ref = Td - 0.3 * sp.block_diag(list(dinv)).toarray() @ M @ Td
     np.testing.assert_allclose(P.toarray(), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
@@ -406,18 +405,18 @@ def test_block_diagonal_and_its_inverse(d):
     M[0, d * 3] = 1.0  # an off-diagonal block
     A = sp.bsr_matrix(M.tocsr(), blocksize=(d, d))
     A.sort_indices()
-    dinv = S._block_diag_inverse(A.indptr, A.indices, A.data)
+    dinv = S.amg_kernels._block_diag_inverse(A.indptr, A.indices, A.data)
     ref = np.linalg.inv(blocks)
     for i in range(nb):
         np.testing.assert_allclose(dinv[i], ref[i], rtol=1e-9 * np.linalg.cond(blocks[i]) * 1e-3,
                                    atol=1e-12 * np.abs(ref[i]).max())
-    np.testing.assert_array_equal(S._block_diag(A.indptr, A.indices, A.data), blocks)
+    np.testing.assert_array_equal(S.amg_kernels._block_diag(A.indptr, A.indices, A.data), blocks)
     singular = blocks.copy()
     singular[2] = np.outer(np.arange(1.0, d + 1), np.arange(1.0, d + 1))  # rank one
     B = sp.bsr_matrix(sp.block_diag(list(singular)).tocsr(), blocksize=(d, d))
     with pytest.raises(np.linalg.LinAlgError):
-        S._block_diag_inverse(B.indptr, B.indices, B.data)
+        S.amg_kernels._block_diag_inverse(B.indptr, B.indices, B.data)
     # a missing diagonal block: NaN inverse, zero block
     C = sp.bsr_matrix((blocks[:2], np.array([1, 0]), np.array([0, 1, 2])), shape=(2 * d, 2 * d))
-    assert np.isnan(S._block_diag_inverse(C.indptr, C.indices, C.data)).all()
-    assert not S._block_diag(C.indptr, C.indices, C.data).any()
+    assert np.isnan(S.amg_kernels._block_diag_inverse(C.indptr, C.indices, C.data)).all()
+    assert not S.amg_kernels._block_diag(C.indptr, C.indices, C.data).any()

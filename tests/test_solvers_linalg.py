@@ -41,7 +41,8 @@ def lattice_block(nx, ny, nz, *, k3=2.0, g=0.05):
 
 
 def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
-    from msslib.solvers import PlanCache, _submatrix
+    from msslib.solvers import PlanCache
+    from msslib.solvers.submatrices import _submatrix
 
     rng = np.random.default_rng(4)
     plans = PlanCache()
@@ -74,7 +75,8 @@ def clamped_golec_block(nx, ny, nz, nu=0.3):
 
 
 def test_submatrix_refill_in_place_equals_fresh_extraction():
-    from msslib.solvers import PlanCache, _submatrix
+    from msslib.solvers import PlanCache
+    from msslib.solvers.submatrices import _submatrix
 
     model = clamped_golec_block(3, 2, 2)
     free = model.free
@@ -99,12 +101,13 @@ def test_submatrix_refill_in_place_equals_fresh_extraction():
 
 @pytest.mark.parametrize("shift", [0.0, -0.5])  # SPD (banded Cholesky) and indefinite (banded LU)
 def test_banded_direct_solve_matches_dense(shift):
-    from msslib.solvers import _direct_solve, _solver_context
+    from msslib.solvers.direct import _direct_solve
+    from msslib.solvers.context import _solver_context
 
     prob = lattice_block(3, 3, 6)
     x = prob.x0()
     free = prob.free
-    from msslib.solvers import _submatrix
+    from msslib.solvers.submatrices import _submatrix
 
     A = _submatrix(prob.stiffness(x) + shift * sp.eye(prob.n_dof, format="csr"), free)
     A = sp.csr_matrix(A)
@@ -126,7 +129,7 @@ def test_banded_direct_solve_matches_dense(shift):
 
 
 def test_pcg_converges_and_detects_negative_curvature():
-    from msslib.solvers import _pcg
+    from msslib.solvers.linear import _pcg
 
     n = 100
     K = sp.diags([-np.ones(n - 1), 2.05 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")
@@ -142,7 +145,7 @@ def test_pcg_converges_and_detects_negative_curvature():
 
 
 def test_forcing_term_loose_far_tight_near():
-    from msslib.solvers import _ETA_MAX, _forcing_term
+    from msslib.solvers.statics import _ETA_MAX, _forcing_term
 
     threshold = 1e-8
     assert _forcing_term(1.0, None, None, threshold) == _ETA_MAX
@@ -170,7 +173,8 @@ def test_static_solve_cg_and_direct_agree_on_a_nonlinear_lattice():
 
 
 def test_free_node_blocks_as_bsr_equal_the_csr_block_and_refill_in_place():
-    from msslib.solvers import _is_node_blocked, _solver_context, _submatrix_bsr
+    from msslib.solvers.submatrices import _is_node_blocked, _submatrix_bsr
+    from msslib.solvers.context import _solver_context
 
     model = clamped_golec_block(3, 2, 2)
     free = model.free
@@ -202,7 +206,7 @@ def test_cg_newton_systems_go_through_node_blocks(monkeypatch):
     prob = lattice_block(4, 4, 7)
     x0 = prob.x0()
     calls = []
-    real = S._submatrix_bsr
+    real = S.submatrices._submatrix_bsr
 
     def spy(*a, **kw):
         out = real(*a, **kw)
@@ -222,15 +226,11 @@ def test_cg_newton_systems_go_through_node_blocks(monkeypatch):
 def test_band_width_bound_never_exceeds_the_bandwidth_found(shape, monkeypatch):
     """The breadth-first bound that skips the band orderings is a lower bound of the bandwidth
     of every ordering, so it never rejects a body the banded Cholesky would take."""
-    from msslib.solvers import (
-        BAND_AUTO_COST,
-        _band_plan,
-        _band_surely_wide,
-        _bsr_entry,
-        _eccentricity,
-        _solver_context,
-        _submatrix,
-    )
+    from msslib.solvers import BAND_AUTO_COST
+    from msslib.solvers.direct import _band_plan
+    from msslib.solvers.policy import _band_surely_wide
+    from msslib.solvers.submatrices import _bsr_entry, _eccentricity, _submatrix
+    from msslib.solvers.context import _solver_context
 
     nx, ny, nz = shape
     model = clamped_golec_block(nx, ny, nz)

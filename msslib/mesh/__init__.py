@@ -54,10 +54,6 @@ Its volume is ``3 s^3 / 4``.
 
 from __future__ import annotations
 
-from .core import _HEX_REF as _HEX_REF
-from .core import _HEX_REF01 as _HEX_REF01
-from .core import _LOCAL_EDGES as _LOCAL_EDGES
-from .core import _LOCAL_FACETS as _LOCAL_FACETS
 from .core import (
     CELL_TYPES,
     COINCIDENT_POLICIES,
@@ -85,7 +81,6 @@ from .structured import (
     triangle_grid_equilateral,
     triangle_grid_right,
 )
-from .topology import _INNER_DIAGONALS as _INNER_DIAGONALS
 from .topology import (
     NodePairs,
     boundary_facets,
@@ -94,8 +89,6 @@ from .topology import (
     inner_diagonals,
     unique_edges,
 )
-from .unstructured import _gmsh_extract as _gmsh_extract
-from .unstructured import _gmsh_session as _gmsh_session
 from .unstructured import (
     cone_mesh,
     cylinder_mesh,

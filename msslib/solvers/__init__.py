@@ -145,82 +145,22 @@ from . import (  # noqa: F401 - the modules, for monkeypatching where a name is 
     statics,
     submatrices,
 )
-from .amg import (  # noqa: F401
-    _SA_OPTIONS,
-    _amg_preconditioner,
-    _block_jacobi_radius,
-    _galerkin,
-    _preconditioner,
-    _rigid_body_modes,
-    _sa_solver,
-)
-from .amg_cycle import (  # noqa: F401
-    VCYCLE_SINGLE,
-    _BlockGaussSeidel,
-    _compiled_smoothers,
-    _matvec_of,
-    _VCycle,
-)
-from .amg_kernels import (  # noqa: F401
-    _block_diag,
-    _block_diag_inverse,
-    _block_gauss_seidel_sweep,
-    _gs3_backward,
-    _gs3_forward_from_zero,
-    _gs_forward_from_zero,
-    _prolong_add,
-    _residual3_restrict,
-    _residual_restrict,
-    _smoothed_prolongator,
-)
-from .context import (  # noqa: F401
-    SolverContext,
-    _kept_context,
-    _release_context,
-    _solver_context,
-    _static_context,
-)
-from .direct import (  # noqa: F401
-    BAND_COST_MAX,
-    BAND_PLAN_MAX_DOFS,
-    _band_plan,
-    _banded_cholesky_solve,
-    _direct_solve,
-)
+from .amg_cycle import VCYCLE_SINGLE  # noqa: F401
+from .context import SolverContext  # noqa: F401
+from .direct import BAND_COST_MAX, BAND_PLAN_MAX_DOFS  # noqa: F401
 from .dynamics import integrate
-from .linear import _linear_solve, _pcg  # noqa: F401
-from .submatrices import (  # noqa: F401
-    PlanCache,
-    _bsr_entry,
-    _eccentricity,
-    _is_node_blocked,
-    _submatrix,
-    _submatrix_bsr,
-)
-from .policy import (  # noqa: F401
-    BAND_AUTO_COST,
-    ITERATIVE_THRESHOLD,
-    _band_surely_wide,
-    choose_linear_solver,
-)
+from .submatrices import PlanCache  # noqa: F401
+from .policy import BAND_AUTO_COST, ITERATIVE_THRESHOLD, choose_linear_solver  # noqa: F401
 from .protocol import DynamicResult, StaticResult
-from .roundoff import (  # noqa: F401
-    EPS,
-    ROUNDOFF_FACTOR,
-    _abs_times,
-    convergence_threshold,
-    roundoff_floor,
-    roundoff_note,
-)
+from .roundoff import EPS, ROUNDOFF_FACTOR, convergence_threshold, roundoff_floor, roundoff_note  # noqa: F401
 from .stability import (  # noqa: F401
     EXPLICIT_METHODS,
-    _omega_max_squared,
     check_time_step,
     critical_time_step,
     explicit_stability_limit,
     omega_max_bound,
 )
-from .statics import _ETA_MAX, _forcing_term, static_solve  # noqa: F401
+from .statics import static_solve
 
 __all__ = [
     "ConvergenceError",

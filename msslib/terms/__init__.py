@@ -52,45 +52,10 @@ The modules import one another in one direction: ``jit`` <- ``loops``, ``assembl
 
 from __future__ import annotations
 
-from .assembly import _block_pattern as _block_pattern
-from .assembly import _block_scatter_bsr as _block_scatter_bsr
-from .assembly import _block_scatter_csr as _block_scatter_csr
-from .assembly import _expand_block_pattern as _expand_block_pattern
-from .assembly import _scatter_add as _scatter_add
-from .assembly import _spring3d_hessian_bsr as _spring3d_hessian_bsr
-from .assembly import _spring3d_hessian_csr as _spring3d_hessian_csr
 from .base import Term
-from .base import _as_flat as _as_flat
-from .base import _connectivity as _connectivity
-from .base import _ElementTerm as _ElementTerm
-from .base import _format_bad as _format_bad
-from .base import _per_element as _per_element
-from .baudet import _FACE_PAIRS as _FACE_PAIRS
-from .baudet import _HEX_FACES as _HEX_FACES
 from .baudet import BaudetCorrection, ElementBaudetCorrection
 from .external import ExternalForce, Gravity, NodalForces, Traction, sum_external_forces
-from .external import _traction_nodal as _traction_nodal
 from .internal import HexVolume, Springs, TetVolume
-from .internal import _check_rest_volumes as _check_rest_volumes
-from .jit import _FAST as _FAST
-from .jit import _U as _U
-from .jit import _drop_stale_numba_cache as _drop_stale_numba_cache
-from .jit import _jit as _jit
-from .jit import _jit_fast as _jit_fast
-from .loops import _hex_energy_loop as _hex_energy_loop
-from .loops import _hex_gradient_loop as _hex_gradient_loop
-from .loops import _hex_hessian_loop as _hex_hessian_loop
-from .loops import _spring2d_energy_loop as _spring2d_energy_loop
-from .loops import _spring2d_gradient_loop as _spring2d_gradient_loop
-from .loops import _spring2d_hessian_loop as _spring2d_hessian_loop
-from .loops import _spring3d_energy_fast as _spring3d_energy_fast
-from .loops import _spring3d_energy_loop as _spring3d_energy_loop
-from .loops import _spring3d_gradient_fast as _spring3d_gradient_fast
-from .loops import _spring3d_gradient_loop as _spring3d_gradient_loop
-from .loops import _spring3d_hessian_loop as _spring3d_hessian_loop
-from .loops import _tet_energy_loop as _tet_energy_loop
-from .loops import _tet_gradient_loop as _tet_gradient_loop
-from .loops import _tet_hessian_loop as _tet_hessian_loop
 
 __all__ = [
     "Term",

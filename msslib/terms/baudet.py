@@ -63,7 +63,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from msslib import mesh as _mesh
+from msslib.mesh.core import _LOCAL_EDGES
+from msslib.mesh.topology import _INNER_DIAGONALS
 from msslib.terms.assembly import _block_pattern
 from msslib.terms.base import Table, Term, _cell_columns, _col, _per_element
 from msslib.terms.external import sum_external_forces
@@ -243,7 +244,7 @@ class BaudetCorrection(Term):
 READINGS = ("boundary", "element")
 """Readings of Baudet's correction force (model option ``correction``)."""
 
-_PAIRS = np.vstack([_mesh._LOCAL_EDGES["hexahedron"], _mesh._INNER_DIAGONALS])  # 12 edges, 4 inner diagonals
+_PAIRS = np.vstack([_LOCAL_EDGES["hexahedron"], _INNER_DIAGONALS])  # 12 edges, 4 inner diagonals
 _INCIDENCE = np.zeros((16, 8))
 _INCIDENCE[np.arange(16), _PAIRS[:, 0]] = 1.0  # force t u on the first node
 _INCIDENCE[np.arange(16), _PAIRS[:, 1]] = -1.0
@@ -362,7 +363,7 @@ class ElementBaudetCorrection(Term):
 
     def pair_forces(self, x) -> np.ndarray:
         """Elongation force ``F_i`` (N) of every cube's three face pairs ``(m, 3)`` (z, y, x order
-        of :data:`msslib.terms._FACE_PAIRS`: bottom/top, y faces, x faces), equilibrium form."""
+        of :data:`msslib.terms.baudet._FACE_PAIRS`: bottom/top, y faces, x faces), equilibrium form."""
         s = self.element_spring_forces(x).reshape(len(self.cells), 24)
         return np.einsum("mij,mj->mi", self.A_inv, np.einsum("mij,mj->mi", self.P, s))
 

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from msslib import mesh as M
+from msslib.mesh import unstructured
 
 R = 0.01  # m, radius of the ball
 C = 0.005  # m, height of its centre above the wall
@@ -32,7 +33,7 @@ def myoma_mesh(radius: float, centre_height: float, cap: float, h: float, seed: 
     meshed with tetrahedra of size about ``h`` (gmsh, deterministic)."""
     if not 0 <= centre_height < radius or not 0 < cap < 1:
         raise ValueError("need 0 <= centre_height < radius and 0 < cap < 1")
-    with M._gmsh_session(h, seed, "myoma") as gmsh:
+    with unstructured._gmsh_session(h, seed, "myoma") as gmsh:
         occ = gmsh.model.occ
         ball = occ.addSphere(0, 0, centre_height, radius)
         big = 4 * radius
@@ -47,7 +48,7 @@ def myoma_mesh(radius: float, centre_height: float, cap: float, h: float, seed: 
             z1 = gmsh.model.getBoundingBox(dim, tag)[5]
             if z1 > centre_height + 2 * radius:  # the box reaches 4 radii above the cap
                 gmsh.model.removeEntities([(dim, tag)], recursive=False)
-        return M._gmsh_extract(gmsh, 3)
+        return unstructured._gmsh_extract(gmsh, 3)
 
 
 def main():
