@@ -294,7 +294,7 @@ rule paper_markdown:
     """The paper's Markdown: the sources with figures, tables and numbers from results filled in."""
     input:
         source=PAPER_SOURCES,
-        derived=["paper/errata.md", "paper/derivations.md"],
+        derived=["paper/errata.md", "paper/derivations.md", "paper/derivations.json"],
         figures=FIGURES,
         tables=TABLES,
         results=COMPARISONS + STUDIES,

@@ -36,6 +36,7 @@ class Derivation:
     errata: list = field(default_factory=list)
     findings: list = field(default_factory=list)  # (label, LaTeX or text) for the paper
     data: dict = field(default_factory=dict)  # anything tests want to look at
+    checks: dict = field(default_factory=dict)  # name -> number (1/0 for a property that holds or not) the paper reads
 
 
 def latex(e) -> str:

@@ -83,5 +83,6 @@ def write(derivations) -> None:
     data = {m: {"title": d.title,
                 "formulas": {f.name: {k: sp.srepr(v) for k, v in f.outputs.items()} for f in d.formulas if registry.kind(m) == "elements"},
                 "findings": dict(d.findings),
+                "checks": {k: float(v) for k, v in d.checks.items()},
                 "errata": [e.__dict__ for e in d.errata]} for m, d in derivations.items()}
     (paper / "derivations.json").write_text(json.dumps(data, indent=1, sort_keys=True))

@@ -122,6 +122,8 @@ def _value(root: Path, spec: str) -> str:
     if not path.is_file():
         raise FileNotFoundError(f"{{{{value {spec}}}}}: no result file {parts[0]!r}")
     scale, fmt, sel = 1.0, ".3g", {}
+    if path.suffix == ".json":  # a key path into a JSON document (paper/derivations.json: MODULE.checks.NAME)
+        return format(_json_value(path, var, spec) * _json_scale(rest, spec), _json_fmt(rest))
     for p in rest:
         k, _, v = p.partition("=")
         if k == "scale":
@@ -148,11 +150,40 @@ def _value(root: Path, spec: str) -> str:
     return format(val * scale, fmt)
 
 
+def _json_value(path: Path, key: str, spec: str) -> float:
+    import json
+
+    node = json.loads(path.read_text(encoding="utf-8"))
+    for part in key.split("."):
+        if not isinstance(node, dict) or part not in node:
+            raise KeyError(f"{{{{value {spec}}}}}: no key {part!r} on the path {key!r} in {path.name}")
+        node = node[part]
+    if isinstance(node, bool) or not isinstance(node, (int, float)):
+        raise ValueError(f"{{{{value {spec}}}}}: {key!r} in {path.name} is not a number")
+    return float(node)
+
+
+def _json_scale(rest, spec) -> float:
+    for p in rest:
+        k, _, v = p.partition("=")
+        if k == "scale":
+            return float(v)
+        if k != "fmt":
+            raise ValueError(f"{{{{value {spec}}}}}: a JSON value takes scale= and fmt= only")
+    return 1.0
+
+
+def _json_fmt(rest) -> str:
+    return next((p.partition("=")[2] for p in rest if p.startswith("fmt=")), ".3g")
+
+
 def _is_quick(path: Path) -> bool:
     """Whether ``path`` holds quick-build results: its attribute ``quick``, or that of the run
     files beside it (a comparison file is made from the runs in its directory)."""
     import xarray as xr
 
+    if path.suffix != ".nc":  # derived facts (paper/derivations.json) have no quick version
+        return False
     for f in [path, *sorted(path.parent.glob("*.nc"))]:
         with xr.open_dataset(f) as ds:
             if "quick" in ds.attrs:

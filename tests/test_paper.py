@@ -305,3 +305,28 @@ def test_false_claim_on_quick_results_is_marked(tmp_path):
     ds.to_netcdf(path)
     text = paper.fill(source, tmp_path / "paper" / "build" / "paper.md").read_text(encoding="utf-8")
     assert "Negative." + paper.QUICK_MARK in text
+
+
+def test_values_and_claims_read_derived_facts_from_json(tmp_path):
+    """``[paper/derivations.json MODULE.checks.NAME]``: a number the derivation computed; a missing
+    key, a non-number and a false claim on it fail with one line."""
+    import json
+
+    (tmp_path / "paper").mkdir()
+    (tmp_path / "paper" / "derivations.json").write_text(json.dumps(
+        {"cube": {"checks": {"isotropic": 1.0, "E_axis": 1.0476190476190477}, "title": "a cube"}}))
+    expand = paper.expand
+    assert expand("{{value paper/derivations.json cube.checks.E_axis fmt=.4f}}", tmp_path / "paper", tmp_path) == "1.0476"
+    assert expand("{{claim [paper/derivations.json cube.checks.isotropic] == 1 | Isotropic.}}", tmp_path / "paper",
+                  tmp_path) == "Isotropic."
+    with pytest.raises(ValueError, match="false claim"):
+        expand("{{claim [paper/derivations.json cube.checks.E_axis] < 1 | Softer.}}", tmp_path / "paper", tmp_path)
+    with pytest.raises(KeyError, match="no key 'shear'"):
+        expand("{{value paper/derivations.json cube.checks.shear}}", tmp_path / "paper", tmp_path)
+    with pytest.raises(ValueError, match="not a number"):
+        expand("{{value paper/derivations.json cube.title}}", tmp_path / "paper", tmp_path)
+    # the project's own derivation: the element-reading lattice is isotropic, the boundary reading's is not
+    root = Path(__file__).resolve().parents[1]
+    checks = json.loads((root / "paper" / "derivations.json").read_text())["cube_baudet"]["checks"]
+    assert checks["element_reading_isotropic"] == 1 and checks["boundary_reading_isotropic"] == 0
+    assert checks["boundary_reading_E_axis_at_nu_0_3"] == pytest.approx(2 * (4 * 0.3 + 1) / (4 * 0.3 + 3))

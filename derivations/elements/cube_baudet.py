@@ -173,6 +173,76 @@ if __name__ == "__main__":
 
 
 # %% [markdown]
+# ## The lattice under the element reading: its continuum limit
+#
+# Read at element level, every cube is corrected from the forces acting on it from outside
+# (`msslib.terms.ElementBaudetCorrection`): at rest the outside holds each cube against its own
+# springs, s_e = -H_e u, so the pair forces solve F_i + c sum_{j != i} F_j = g_i with
+# g_i = -mean_{f in i} sum_{a in f} n_f . s_e(a), and the correction puts c F_j n_g / 4 on each node of
+# every face g outside pair j. The cube's internal forces are -(I + M) H u; the outside applies
+# t = (I + M) H u. Under an affine displacement u = eps X every node of the simple cubic lattice is
+# a centre of inversion symmetry (the cubes around a node cancel both their springs' and their
+# corrections' forces there), so the affine state is the lattice's equilibrium and the lattice's
+# stress is each cube's virial, sigma = (1/V) sum_a t_a X_a^T. Its Voigt matrix is the continuum
+# limit of the element-reading lattice.
+
+# %%
+def _faces():
+    """(pair i, outward unit normal, node indices) of the reference cube's six faces."""
+    out = []
+    for i in range(3):
+        for side in (-1, 1):
+            n = sp.zeros(3, 1)
+            n[i] = side
+            out.append((i, n, [a for a, q in enumerate(_REF["hexahedron"]) if q[i] == side]))
+    return out
+
+
+@lru_cache(maxsize=None)
+def element_reading_tensor():
+    """(C, sigma antisymmetric part): the Voigt matrix of the lattice of identical cubes under the
+    element reading, with the derived constants, and the antisymmetric part of its stress
+    (zero when the virial stress is a true stress)."""
+    (sol,), _ = tension()
+    kx, kd, c = sol[k_x], shear()[1], sol[alpha]
+    X = coords((a, a, a))
+    H = mss.stiffness_at_rest(terms((kx,) * 3, kd), X)
+    faces = _faces()
+    # P: g = P s (3 x 24), Q: correction on the nodes = Q F (24 x 3)
+    P = sp.zeros(3, 24)
+    Q = sp.zeros(24, 3)
+    for i, n, nodes in faces:
+        for node in nodes:
+            for d in range(3):
+                P[i, 3 * node + d] -= sp.Rational(1, 2) * n[d]
+                for j in range(3):
+                    if j != i:
+                        Q[3 * node + d, j] += c * n[d] / 4
+    A = (1 - c) * sp.eye(3) + c * sp.ones(3, 3)
+    M = Q * A.inv() * P
+    eps_symbols = lattice.strain_symbols(3)
+    eps = lattice.strain_matrix(eps_symbols, 3)
+    u = sp.Matrix([v for x in X for v in (eps * sp.Matrix(x))])
+    t = ((sp.eye(24) + M) * H * u).applyfunc(sp.expand)
+    sigma = sp.zeros(3, 3)
+    for node, x in enumerate(X):
+        sigma += t[3 * node:3 * node + 3, 0] * sp.Matrix(x).T
+    sigma = (sigma / a**3).applyfunc(sp.simplify)
+    voigt = sp.Matrix([sigma[i, j] for i, j in el.VOIGT[3]])
+    C = voigt.jacobian(sp.Matrix(eps_symbols)).applyfunc(sp.simplify)
+    return C, (sigma - sigma.T).applyfunc(sp.simplify)
+
+
+# %%
+if __name__ == "__main__":
+    C_el, skew = element_reading_tensor()
+    show.math(r"C_{\text{element reading}}", C_el)
+    show.check(r"C_{\text{element reading}} = D\ \text{(isotropic: } E, \nu, G \text{ exact)}",
+               (C_el - el.elasticity_matrix("3d")).applyfunc(sp.simplify) == sp.zeros(6, 6))
+    show.check(r"\sigma = \sigma^T", skew == sp.zeros(3, 3))
+
+
+# %% [markdown]
 # For orientation, the element matrices themselves (24 x 24, dofs x0, y0, z0, x1, ... in VTK order):
 # the trilinear hexahedron and the springs with the derived constants (the correction force is a load,
 # not a stiffness). Shown: the rows of node 0 against nodes 0 and 1.
@@ -272,6 +342,18 @@ def derive() -> Derivation:
     ]
     d.data.update(solution=s, k_d=kd, per_plane=per_plane, per_node=sols_node, B_with=B_with,
                   B_without=B_without, lattice=C, lattice_moduli=lat)
+    C_el, skew = element_reading_tensor()
+    defect = (C_el - el.elasticity_matrix("3d")).applyfunc(sp.simplify)
+    E_el, nu_el, _, _ = el.isotropic_moduli_3d(C_el)
+    G_el = C_el[3, 3]
+    d.findings.append(("assembled lattice, element reading (continuum limit)",
+                       f"C - D = {'0' if defect == sp.zeros(6, 6) else sp.latex(defect)},\\ "
+                       f"E = {sp.latex(sp.factor(sp.simplify(E_el)))},\\ \\nu = {sp.latex(sp.factor(sp.simplify(nu_el)))},\\ "
+                       f"G = {sp.latex(sp.factor(sp.simplify(G_el)))}"))
+    d.data.update(element_reading_lattice=C_el, element_reading_defect=defect, element_reading_skew=skew)
+    d.checks.update(element_reading_isotropic=int(defect == sp.zeros(6, 6) and skew == sp.zeros(3, 3)),
+                    boundary_reading_isotropic=int(sp.simplify(lat["isotropy defect"]) == 0),
+                    boundary_reading_E_axis_at_nu_0_3=float(lat["uniaxial E along an axis"].subs({E: 1, nu: sp.Rational(3, 10)})))
     rd = eq8_readings()
     d.findings += [(f"eq. 8 read '{n}': derived factor; printed 1/16 applied gives",
                     f"{sp.latex(v['derived'])},\\ E_{{\\text{{eff}}}} = {sp.latex(v['E_eff'])},\\ "

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 188668b2ef2cad0ca95b6a9abcd840af56b34969c13b06085b466969b4c38451
+# source-sha256: bd4e68eff36fd360ffc711f45114ccccec90c4032c80a81170b805bda61765d6
 # body-sha256: ead1efdd2788a93d1bcf1adc1fdb9209f754b2834f6888e42bd556b419504f40
 """Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: a64290e50dcb8f8dce749b641be48b0a0d73bcb725505243c7d00adfd72c2898
+# source-sha256: 028520f94fc92e42e05c334efdcd809c5384eb8f2dfe2aa7b1121bbb6c3b06c7
 # body-sha256: ead38ff0979f342e371691d41eaa2c1fcc80bd8a3ec45ce6848072726eb1950e
 """Cube with edge, face and inner springs and volume correction (Golec et al.).
 

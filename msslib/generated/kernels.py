@@ -1,5 +1,5 @@
 # Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 4ac5afbb74e3e73f6029e669688f452703b06f152465cbfefa727cc75c56119b
+# source-sha256: e267dad093539dd37d2c3e6c4bf847aa22084438716d3e0797244590e62a0aed
 # body-sha256: 3d373773da99006a61be809dfa382060e5f3e52fab7de0235f0cb4b483a8f761
 """Energy, gradient and Hessian kernels.
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: fb7fc9401a92ec6d8f3d57de3537276e4098de6958b5951adc4d07fe6fe7ffe8
+# source-sha256: af254cb39faeaede1ba7465b2cfabedb01b50224711b9d609da81d06b73d6606
 # body-sha256: 1dd982c2337e75087dee499cd350e6dc2d1ddc93b1216533dccefec5767742ed
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 

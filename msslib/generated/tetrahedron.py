@@ -1,5 +1,5 @@
 # Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: de740ea435d2eb81e5f431fa2f8fa625ae0a7f33dd69f94ceee649554b424bee
+# source-sha256: 2de3d99f3a887521f56b603810b4bf22008aa3d8e512a0d68d3d3df50879b044
 # body-sha256: 0b2dbb0b56041ab2d1c0d5c290b0fcfc5ecc68a47555a831b2b6251b8cfd020f
 """Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14).
 

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/square.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: fb7fc9401a92ec6d8f3d57de3537276e4098de6958b5951adc4d07fe6fe7ffe8
+// source-sha256: af254cb39faeaede1ba7465b2cfabedb01b50224711b9d609da81d06b73d6606
 // body-sha256: 1cf15a42ad791d67268aa990ddd04a24b07e3e4ce60a7621e6acedc466da7f91
 /* Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/square.py (derivations/elements/square.py). */
