@@ -26,6 +26,8 @@ PAPERS = ["lloyd", "baudet", "golec", "performance", "summary"]
 # them the same way), name -> source file, and the engine: every file directly in derivations/
 DERIVATIONS = {p.stem: str(p) for kind in ("elements", "terms")
                for p in sorted(Path("derivations", kind).glob("*.py")) if not p.stem.startswith("_")}
+# analyses generate no code; codegen writes their results into paper/derivations.* too
+ANALYSES = sorted(str(p) for p in Path("derivations", "analyses").glob("*.py") if not p.stem.startswith("_"))
 ENGINE = sorted(str(p) for p in Path("derivations").glob("*.py"))
 # the derivation modules as notebooks: one HTML page each, beside the paper (linked as derivations/<name>.html).
 # Each page re-runs its derivation (seconds to a minute of SymPy), so the quick build renders one of
@@ -106,7 +108,7 @@ rule all:
 rule codegen:
     """Re-derive every element family; regenerate msslib/generated/, the errata and the derivation results."""
     input:
-        list(DERIVATIONS.values()) + ENGINE,
+        list(DERIVATIONS.values()) + ANALYSES + ENGINE,
     output:
         "paper/errata.md",
         "paper/derivations.md",

@@ -355,6 +355,12 @@ def derive() -> Derivation:
                            f"{r['unknowns_total']},\\ \\operatorname{{rank}} A = {r['rank_A_box']},\\ "
                            f"\\operatorname{{rank}} [A|b] = {r['rank_Ab_box']}"))
     d.data.update(table=table(), experiments=experiment_counts())
+    for conf, r in table().items():
+        d.checks.update({f"{conf}_unknowns_total": r["unknowns_total"], f"{conf}_rank_A": r["rank_A_box"],
+                         f"{conf}_rank_Ab": r["rank_Ab_box"],
+                         f"{conf}_consistent": int(r["rank_A_box"] == r["rank_Ab_box"]),
+                         f"{conf}_equations_counted": r["equations_total"],
+                         f"{conf}_equations_independent": r["equations_total_independent"]})
     return d
 
 

@@ -351,6 +351,13 @@ def derive() -> Derivation:
                        f"E = {sp.latex(sp.factor(sp.simplify(E_el)))},\\ \\nu = {sp.latex(sp.factor(sp.simplify(nu_el)))},\\ "
                        f"G = {sp.latex(sp.factor(sp.simplify(G_el)))}"))
     d.data.update(element_reading_lattice=C_el, element_reading_defect=defect, element_reading_skew=skew)
+    rd8 = eq8_readings()
+    d.checks.update(k_d_matches_eq7=int(sp.simplify(kd - PUBLISHED["k_d"]) == 0),
+                    k_x_matches_eq8=int(sp.simplify(s[k_x] - PUBLISHED["k_x"]) == 0),
+                    eq8_readings=len(rd8),
+                    eq8_readings_matching_printed=sum(int(sp.simplify(v["derived"] - PUBLISHED["alpha"]) == 0) for v in rd8.values()),
+                    bulk_exact_with_correction=int(sp.simplify(B_with - E / (3 * (1 - 2 * nu))) == 0),
+                    bulk_exact_without_correction=int(sp.simplify(B_without - E / (3 * (1 - 2 * nu))) == 0))
     d.checks.update(element_reading_isotropic=int(defect == sp.zeros(6, 6) and skew == sp.zeros(3, 3)),
                     boundary_reading_isotropic=int(sp.simplify(lat["isotropy defect"]) == 0),
                     boundary_reading_E_axis_at_nu_0_3=float(lat["uniaxial E along an axis"].subs({E: 1, nu: sp.Rational(3, 10)})))

@@ -217,6 +217,14 @@ def derive() -> Derivation:
                     f"{defect} = {sp.latex(v['defect'])},\\ E_{{\\text{{axis}}}} = {sp.latex(v['E'])},\\ "
                     f"\\nu_{{\\text{{axis}}}} = {sp.latex(v['nu'])}") for n, v in rd.items()]
     d.data.update(spring_readings=rd, spring_shares=shares, correction_units=units)
+    C_derived = C.subs({k_e: s[k_e], k_f: s[k_f], k_c: s[k_c], kappa: s[kappa]}).applyfunc(sp.simplify)
+    d.checks.update(
+        isotropic_exact=int((C_derived - el.elasticity_matrix("3d")).applyfunc(sp.simplify) == sp.zeros(6, 6)),
+        springs_alone_isotropic=int(sp.simplify(springs_only["isotropy defect C11-C12-2C44"]) == 0),
+        springs_alone_nu=float(springs_only["E,nu,G,K"][1]),
+        kappa_matches_printed=int(sp.simplify(s[kappa] - KAPPA_PUBLISHED) == 0),
+        kappa_negative_below_quarter=int(all(s[kappa].subs({E: 1, nu: v}) < 0 for v in (sp.Rational(1, 10), sp.Rational(1, 5)))),
+        printed_shear_modulus_exact=int(sp.simplify(mu_pub - mu) == 0))
     d.errata += [
         Erratum("Golec et al. (2017)", "spring constants k_e, k_f (Sec. 2; ambiguous: per cube or per interior spring)",
                 r"k_e = \left(\tfrac{8}{3}A + 1\right)\frac{E l}{\tfrac{10}{3}A + 2.5},\ k_f = \frac{E l}{\tfrac{10}{3}A + 2.5}",

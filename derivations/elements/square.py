@@ -123,6 +123,12 @@ def derive() -> Derivation:
     ]
     d.data.update(solution=s, forces_at_rest=f_rest, tensions=tensions, lattice=C, sigma0=sigma0,
                   no_prestrain=without_prestrain())
+    printed = {k_e: sp.Rational(5, 16) * t * E, k_d: sp.Rational(7, 16) * t * E, c_e: sp.Rational(6, 5),
+               c_d: sp.Rational(6, 7)}  # Lloyd eqs. 10-11 as printed
+    d.checks.update(exact_with_prestrain=len(sols), exact_nu=float(s[nu_c]),
+                    exact_without_prestrain=int(bool(without_prestrain().exists)),
+                    eqs10_11_match_printed=int(all(sp.simplify(s[q] - v) == 0 for q, v in printed.items())),
+                    equilibrium_at_rest=int(f_rest == sp.zeros(*f_rest.shape)))
     return d
 
 

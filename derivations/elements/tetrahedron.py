@@ -160,6 +160,13 @@ def derive() -> Derivation:
     eq14_k = 2 * sp.sqrt(2) / 21 * l * E * sp.Rational(4, 5)
     eq14_kV = sp.sqrt(2) / 84 * l**3 * E * sp.Rational(2, 5)
     d.data.update(eq14=(eq14_k, eq14_kV))
+    d.checks.update(
+        exact_match=int(bool(exact_springs_only().exists)),
+        eq12_matches_printed=int(sp.simplify(k_12 - 2 * sp.sqrt(2) / 25 * l * E) == 0),
+        eq14_matches_optimum_at_quarter=int(sp.simplify(k_vol.subs(nu, QUARTER) - eq14_k) == 0
+                                            and sp.simplify(kV_vol.subs(nu, QUARTER) - eq14_kV) == 0),
+        residual_at_quarter=float(ls.relative_residual.subs(nu, QUARTER)),
+        residual_with_volume_at_quarter=float(lv.relative_residual.subs(nu, QUARTER)))
     d.published.append(Formula("lloyd_tetrahedron_volume_published", (E, l), {"k": eq14_k, "k_volume": eq14_kV},
                                "Lloyd et al.'s eq. 14 as printed (the optimum at nu = 1/4)."))
     d.errata.append(Erratum(

@@ -133,6 +133,12 @@ def derive() -> Derivation:
         ("lattice", sp.latex(C)),
     ]
     d.data.update(solution=s, lattice=C, van_gelder=VAN_GELDER, lloyd_eq9=LLOYD_EQ9)
+    d.checks.update(
+        eq8_matches_printed=int(sp.simplify(k_tri - sp.sqrt(3) / 4 * E * t) == 0),  # Lloyd eq. 8 as printed
+        exact_solutions=len(sol), exact_nu=float(s[nu_c]),
+        exact_at_nu_0=int(any(so[nu_c] == 0 for so in sol)),  # van Gelder's validity claim
+        lattice_is_plane_stress_at_one_third=int((C - elasticity_matrix("plane_stress", E, sp.Rational(1, 3)))
+                                                 .applyfunc(sp.simplify) == sp.zeros(3, 3)))
     d.errata.append(Erratum(
         "van Gelder (1998), as discussed by Lloyd et al. Sec. 3.5", "validity of k = E t A_e / l^2",
         r"\nu = 0", r"\nu = 1/3",

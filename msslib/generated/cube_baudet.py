@@ -1,5 +1,5 @@
 # Generated from derivations/elements/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: bd4e68eff36fd360ffc711f45114ccccec90c4032c80a81170b805bda61765d6
+# source-sha256: 1569ec18616278ef6c494492628d18d6f839f0f40e29b01d43073f3136b47042
 # body-sha256: ead1efdd2788a93d1bcf1adc1fdb9209f754b2834f6888e42bd556b419504f40
 """Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.).
 

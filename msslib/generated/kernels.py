@@ -1,5 +1,5 @@
 # Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: e267dad093539dd37d2c3e6c4bf847aa22084438716d3e0797244590e62a0aed
+# source-sha256: 125d77c3cfda21c60819007651975aaa0e8d553df7a234dc0719c0b597866d48
 # body-sha256: 3d373773da99006a61be809dfa382060e5f3e52fab7de0235f0cb4b483a8f761
 """Energy, gradient and Hessian kernels.
 

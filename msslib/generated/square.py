@@ -1,5 +1,5 @@
 # Generated from derivations/elements/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: af254cb39faeaede1ba7465b2cfabedb01b50224711b9d609da81d06b73d6606
+# source-sha256: 4391d66bca66ad1ed64f4db415fdd3579e07eda530fe2570cc7c17cd83ca699d
 # body-sha256: 1dd982c2337e75087dee499cd350e6dc2d1ddc93b1216533dccefec5767742ed
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 

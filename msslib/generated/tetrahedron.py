@@ -1,5 +1,5 @@
 # Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 2de3d99f3a887521f56b603810b4bf22008aa3d8e512a0d68d3d3df50879b044
+# source-sha256: 06699953ee268c8d79e179822b543f60b488c8df78ce5a129cc6f86bb64f4977
 # body-sha256: 0b2dbb0b56041ab2d1c0d5c290b0fcfc5ecc68a47555a831b2b6251b8cfd020f
 """Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 75b7958914ebb78bb351e3adc839de7b876c3a600027890eb1dd6c270090abc8
+# source-sha256: c7e12af9600c5699881a09c51941a91590563f38b6cbbab4049daa7551f5a3c3
 # body-sha256: 4015acd45b86546c6a6abfcd250b2d8757c57c8cce0e75c00be6d90ffeb475b9
 """Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9).
 

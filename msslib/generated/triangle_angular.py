@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle_angular.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: f08746a555a6c7db67057376ef3e8a5dc3e5bfe606e453c9b6f236cd6b272ee7
+# source-sha256: 3c7dea99bc72081b9128298180bd251df8900275894ea13906912e4d45262d10
 # body-sha256: 78f610b395f66b3386e90107428ca7773530e33fcbcc276aa35a1fc1c4b897a8
 """Triangle of any shape with tensile and angular springs (Delingette 2008).
 

@@ -1,5 +1,5 @@
 // Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: e267dad093539dd37d2c3e6c4bf847aa22084438716d3e0797244590e62a0aed
+// source-sha256: 125d77c3cfda21c60819007651975aaa0e8d553df7a234dc0719c0b597866d48
 // body-sha256: 3c7517ccff04b573e5e29ce2c6a9f72affae7f2595d7f1ac55c6c9ba0e7af367
 /* Energy, gradient and Hessian kernels, in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/kernels.py (derivations/terms/kernels.py). */

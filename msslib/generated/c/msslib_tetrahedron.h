@@ -1,5 +1,5 @@
 // Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 2de3d99f3a887521f56b603810b4bf22008aa3d8e512a0d68d3d3df50879b044
+// source-sha256: 06699953ee268c8d79e179822b543f60b488c8df78ce5a129cc6f86bb64f4977
 // body-sha256: 738438200b0fb2aa500fae7fafe7d5ed17024c3591a585f1464bc59692366c65
 /* Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/tetrahedron.py (derivations/elements/tetrahedron.py). */

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/triangle_angular.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: f08746a555a6c7db67057376ef3e8a5dc3e5bfe606e453c9b6f236cd6b272ee7
+// source-sha256: 3c7dea99bc72081b9128298180bd251df8900275894ea13906912e4d45262d10
 // body-sha256: 666ed28d996e4b629e2d25822fc536937149ffc24f310907ef001194ef6b2a72
 /* Triangle of any shape with tensile and angular springs (Delingette 2008), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/triangle_angular.py (derivations/elements/triangle_angular.py). */
