@@ -85,4 +85,5 @@ def write(derivations) -> None:
                 "findings": dict(d.findings),
                 "checks": {k: float(v) for k, v in d.checks.items()},
                 "errata": [e.__dict__ for e in d.errata]} for m, d in derivations.items()}
+    data["summary"] = {"errata": float(sum(len(d.errata) for d in derivations.values()))}
     (paper / "derivations.json").write_text(json.dumps(data, indent=1, sort_keys=True))

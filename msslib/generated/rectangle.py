@@ -1,5 +1,5 @@
 # Generated from derivations/elements/rectangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: b08e1b1f5624d5bcd54e3af078c61917531da872b29d4270e3872c15e94b0a4c
+# source-sha256: f2fa9509b9899d44faac7ad9b113886e9a86fbe83715d6507b254c83a07b6c0a
 # body-sha256: db29faa74ff7404feba006e6ace82b27c52bd21abe4f6887e99cdde9589f8694
 """Rectangle of aspect ratio r, plane stress, six prestrained springs (generalising Lloyd et al. Sec. 4.1).
 

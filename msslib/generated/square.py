@@ -1,5 +1,5 @@
 # Generated from derivations/elements/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 4391d66bca66ad1ed64f4db415fdd3579e07eda530fe2570cc7c17cd83ca699d
+# source-sha256: 30395605218384c5dd98cbb50ee35ba18f4369cd9d6ce95294e5ffe3e14c6191
 # body-sha256: 1dd982c2337e75087dee499cd350e6dc2d1ddc93b1216533dccefec5767742ed
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: c7e12af9600c5699881a09c51941a91590563f38b6cbbab4049daa7551f5a3c3
+# source-sha256: a24ac01f2ed5d00270a555d32fe839c3916049cee250e7ecf83128c27beb7590
 # body-sha256: 4015acd45b86546c6a6abfcd250b2d8757c57c8cce0e75c00be6d90ffeb475b9
 """Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9).
 

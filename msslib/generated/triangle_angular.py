@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle_angular.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 3c7dea99bc72081b9128298180bd251df8900275894ea13906912e4d45262d10
+# source-sha256: 06851004311d7f18a6d5b1598cfc6a0141b8d2c32ba34a5104d339ba96ff68c2
 # body-sha256: 78f610b395f66b3386e90107428ca7773530e33fcbcc276aa35a1fc1c4b897a8
 """Triangle of any shape with tensile and angular springs (Delingette 2008).
 
