@@ -114,7 +114,7 @@ def energy(terms, coords, positions=None):
 def stiffness_at_rest(terms, coords) -> sp.Matrix:
     """Sum of the terms' Hessians with respect to the node positions, at the rest positions.
 
-    Degrees of freedom are interleaved by node, as in :func:`derivations.fem.element_stiffness`.
+    Degrees of freedom are interleaved by node, as in :func:`derivations.element_stiffness.element_stiffness`.
     """
     R = _to_vectors(coords)
     dim = len(R[0])

@@ -48,7 +48,7 @@ class Element:
     """What an element module (``derivations/elements/<name>.py``) declares at module level as
     ``ELEMENT``: the registry finds the module, codegen writes ``msslib/generated/<name>.py``.
 
-    ``cell`` is the :mod:`derivations.fem` cell type it derives (``triangle``, ``quad``, ``tetra``,
+    ``cell`` is the :mod:`derivations.element_stiffness` cell type it derives (``triangle``, ``quad``, ``tetra``,
     ``hexahedron``); ``models`` the simulator models (scene model names) whose parameters come from
     the generated code; ``source`` the paper and section it derives; ``extends`` the element it
     generalises, if any (its derivation is listed after that one)."""

@@ -96,7 +96,7 @@ def element(name: str):
 
 
 def _element_order(decls: dict) -> list[str]:
-    from derivations.fem import _REF
+    from derivations.element_stiffness import _REF
 
     def key(name):
         d = decls[name]

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from derivations import codegen, fem, lattice, match, mss, registry
+from derivations import codegen, element_stiffness as fem, lattice, match, mss, registry
 from derivations.elements import cube_baudet, cube_golec, square, tetrahedron, triangle
 from derivations.elasticity import E, elasticity_matrix, lame, nu, t
 

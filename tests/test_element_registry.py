@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from derivations import codegen, fem, notebook, registry
+from derivations import codegen, element_stiffness as fem, notebook, registry
 
 GENERATED = registry.generated()
 ELEMENTS = registry.elements()
@@ -66,7 +66,7 @@ def test_adding_a_module_changes_no_other_hash(tmp_path, monkeypatch):
     own.write_text(own.read_text() + "\n")
     after = {m: codegen.source_hash(m) for m in GENERATED}
     assert [m for m in GENERATED if after[m] != before[m]] == [ELEMENTS[0]]
-    (copy / "fem.py").write_text((copy / "fem.py").read_text() + "\n")  # the engine: every file is stale
+    (copy / "element_stiffness.py").write_text((copy / "element_stiffness.py").read_text() + "\n")  # the engine: every file is stale
     assert all(codegen.source_hash(m) != after[m] for m in GENERATED)
 
 

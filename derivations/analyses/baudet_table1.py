@@ -33,9 +33,9 @@ from functools import lru_cache
 import sympy as sp
 
 from derivations import elasticity as el
-from derivations import fem, lattice, match, mss, show
+from derivations import element_stiffness as fem, lattice, match, mss, show
 from derivations.elasticity import E, nu
-from derivations.fem import _REF
+from derivations.element_stiffness import _REF
 from derivations.records import Derivation
 
 x0, y0, z0 = sp.symbols("x_0 y_0 z_0", positive=True)

@@ -22,9 +22,9 @@ from functools import lru_cache
 import sympy as sp
 
 from derivations import elasticity as el
-from derivations import fem, lattice, mss, show
+from derivations import element_stiffness as fem, lattice, mss, show
 from derivations.elasticity import E, nu
-from derivations.fem import _REF
+from derivations.element_stiffness import _REF
 from derivations.records import Derivation, Element, Erratum, Formula
 
 # what this module derives and which simulator models the generated code feeds (derivations.registry)

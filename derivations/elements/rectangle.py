@@ -26,7 +26,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from derivations import fem, lattice, match, mss, show
+from derivations import element_stiffness as fem, lattice, match, mss, show
 from derivations.elasticity import E, elasticity_matrix, nu, t
 from derivations.records import Derivation, Element, Formula
 

@@ -27,7 +27,7 @@ from functools import lru_cache
 
 import sympy as sp
 
-from derivations import fem, match, mss, show
+from derivations import element_stiffness as fem, match, mss, show
 from derivations.elasticity import E, nu, t
 from derivations.records import Derivation, Element, Formula
 

@@ -1,5 +1,5 @@
 # Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 0e7fdcaff0bfb4684e8af742d9b7e8e319d3be70d2d7c707d94ce671eac38912
+# source-sha256: 01dc417d21a14cb956538de96c96f5c034ca8dd711829894e5cd137841ecb392
 # body-sha256: 3d373773da99006a61be809dfa382060e5f3e52fab7de0235f0cb4b483a8f761
 """Energy, gradient and Hessian kernels.
 

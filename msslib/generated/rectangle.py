@@ -1,5 +1,5 @@
 # Generated from derivations/elements/rectangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: f2fa9509b9899d44faac7ad9b113886e9a86fbe83715d6507b254c83a07b6c0a
+# source-sha256: e92947b5ec9d5de17ea0a6e1b85c5c02f45582c90490a75e958fed379a5743ba
 # body-sha256: db29faa74ff7404feba006e6ace82b27c52bd21abe4f6887e99cdde9589f8694
 """Rectangle of aspect ratio r, plane stress, six prestrained springs (generalising Lloyd et al. Sec. 4.1).
 

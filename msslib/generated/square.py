@@ -1,5 +1,5 @@
 # Generated from derivations/elements/square.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 30395605218384c5dd98cbb50ee35ba18f4369cd9d6ce95294e5ffe3e14c6191
+# source-sha256: 9804f2206eea30d6e805ab4abac0719d5f3426bc3efb00253187c092359974e1
 # body-sha256: 1dd982c2337e75087dee499cd350e6dc2d1ddc93b1216533dccefec5767742ed
 """Square with prestrained springs, plane stress (Lloyd et al. eqs. 10-11).
 

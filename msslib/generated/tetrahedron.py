@@ -1,5 +1,5 @@
 # Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 16cb92dc38571c68f2a927530e796077e64b5e3deac2f52da6ffc033a566ba5d
+# source-sha256: 5bb62d6e7e2cb1f7e003dcfe035a9bb825e60f4b36a4cf6de13003e8a19891dd
 # body-sha256: 0b2dbb0b56041ab2d1c0d5c290b0fcfc5ecc68a47555a831b2b6251b8cfd020f
 """Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14).
 

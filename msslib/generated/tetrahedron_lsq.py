@@ -1,5 +1,5 @@
 # Generated from derivations/elements/tetrahedron_lsq.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 7a68192aca4e42a62ee5e0823fb3df55439338f97b1fbffa3d73405e26df59c9
+# source-sha256: 3cd6b1a2973f61017b23473b09935e1fb9ab75164cbff052670e0a5c394210ce
 # body-sha256: 89b8e0e5c48bc84d2b7e4594b8c4d97310a136cbd5701cbff09017ff4d8c8eb8
 """Tetrahedron of any shape, six springs fitted to its own linear element by least squares (Natsupakpong and Cavusoglu 2010, normal equations).
 

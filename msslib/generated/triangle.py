@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: a24ac01f2ed5d00270a555d32fe839c3916049cee250e7ecf83128c27beb7590
+# source-sha256: 0d9f220e94ad8c1b2208895a0c09a40ffc8c3fa8c40bfea289537f12f5c48f4e
 # body-sha256: 4015acd45b86546c6a6abfcd250b2d8757c57c8cce0e75c00be6d90ffeb475b9
 """Equilateral triangle, plane stress (Lloyd et al. eq. 8; van Gelder, eq. 9).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle_angular.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 06851004311d7f18a6d5b1598cfc6a0141b8d2c32ba34a5104d339ba96ff68c2
+# source-sha256: 3f3e6594a47f17c23760017ea2dfd73e990a9e5823b3b48bb95a1ec61cefbda3
 # body-sha256: 78f610b395f66b3386e90107428ca7773530e33fcbcc276aa35a1fc1c4b897a8
 """Triangle of any shape with tensile and angular springs (Delingette 2008).
 

@@ -1,5 +1,5 @@
 # Generated from derivations/elements/triangle_lsq.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 05364e0f283eb88fa04e9ad44909f08717860c7ca088d0c2987378e324bba23a
+# source-sha256: ff8a051dcdda6c6edcadb1b42336594c8aa81007b02247f1f63582cd22d3de6a
 # body-sha256: 57450fa1afc4ade7ef6a3d860ad9bb3d9c204b40b131686eafec79f025b5913c
 """Triangle of any shape, three springs fitted to its own CST by least squares (Natsupakpong and Cavusoglu 2010, closed form).
 

@@ -5,7 +5,7 @@ import sympy as sp
 
 from experiments import script
 
-INPUTS = ["derivations/analyses/baudet_table1.py", "derivations/lattice.py", "derivations/mss.py", "derivations/fem.py",
+INPUTS = ["derivations/analyses/baudet_table1.py", "derivations/lattice.py", "derivations/mss.py", "derivations/element_stiffness.py",
           "derivations/match.py", "derivations/elasticity.py"]
 
 # Baudet et al. (2007), Sec. 4 "Our 3D Model", Table 1 "Number of equations and unknowns according to the

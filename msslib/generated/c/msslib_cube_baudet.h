@@ -1,5 +1,5 @@
 // Generated from derivations/elements/cube_baudet.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: c60a6e0e6bcd81696d98dbadb6964b265b1163ef6a7f000261e975029bc9b2e6
+// source-sha256: 805c5add68aa437da1e97b29747d7bdd7abf33d152a3c10f7f10b91873681ac4
 // body-sha256: ed3871ac34bc05ede2d93d77dc6bfa5d5cf9d38e7fe0c566cea46cd9da016706
 /* Cube with edge and inner-diagonal springs and orthogonal correction (Baudet et al.), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/cube_baudet.py (derivations/elements/cube_baudet.py). */

@@ -1,5 +1,5 @@
 // Generated from derivations/terms/kernels.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 0e7fdcaff0bfb4684e8af742d9b7e8e319d3be70d2d7c707d94ce671eac38912
+// source-sha256: 01dc417d21a14cb956538de96c96f5c034ca8dd711829894e5cd137841ecb392
 // body-sha256: 3c7517ccff04b573e5e29ce2c6a9f72affae7f2595d7f1ac55c6c9ba0e7af367
 /* Energy, gradient and Hessian kernels, in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/kernels.py (derivations/terms/kernels.py). */

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/rectangle.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: f2fa9509b9899d44faac7ad9b113886e9a86fbe83715d6507b254c83a07b6c0a
+// source-sha256: e92947b5ec9d5de17ea0a6e1b85c5c02f45582c90490a75e958fed379a5743ba
 // body-sha256: 7164229a583f900ca146aca36a9edbb85c829bd260ee9c182fd4b8ef478eb2c2
 /* Rectangle of aspect ratio r, plane stress, six prestrained springs (generalising Lloyd et al. Sec. 4.1), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/rectangle.py (derivations/elements/rectangle.py). */

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 16cb92dc38571c68f2a927530e796077e64b5e3deac2f52da6ffc033a566ba5d
+// source-sha256: 5bb62d6e7e2cb1f7e003dcfe035a9bb825e60f4b36a4cf6de13003e8a19891dd
 // body-sha256: 738438200b0fb2aa500fae7fafe7d5ed17024c3591a585f1464bc59692366c65
 /* Regular tetrahedron, least squares (Lloyd et al. eqs. 12-14), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/tetrahedron.py (derivations/elements/tetrahedron.py). */

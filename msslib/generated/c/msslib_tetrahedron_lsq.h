@@ -1,5 +1,5 @@
 // Generated from derivations/elements/tetrahedron_lsq.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 7a68192aca4e42a62ee5e0823fb3df55439338f97b1fbffa3d73405e26df59c9
+// source-sha256: 3cd6b1a2973f61017b23473b09935e1fb9ab75164cbff052670e0a5c394210ce
 // body-sha256: d3424e9148ad293e12c80e2b2d4b32e79d8c09b389dab6212e6df4cdcbe315f0
 /* Tetrahedron of any shape, six springs fitted to its own linear element by least squares (Natsupakpong and Cavusoglu 2010, normal equations), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/tetrahedron_lsq.py (derivations/elements/tetrahedron_lsq.py). */

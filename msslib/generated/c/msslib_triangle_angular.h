@@ -1,5 +1,5 @@
 // Generated from derivations/elements/triangle_angular.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 06851004311d7f18a6d5b1598cfc6a0141b8d2c32ba34a5104d339ba96ff68c2
+// source-sha256: 3f3e6594a47f17c23760017ea2dfd73e990a9e5823b3b48bb95a1ec61cefbda3
 // body-sha256: 666ed28d996e4b629e2d25822fc536937149ffc24f310907ef001194ef6b2a72
 /* Triangle of any shape with tensile and angular springs (Delingette 2008), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/triangle_angular.py (derivations/elements/triangle_angular.py). */

@@ -1,5 +1,5 @@
 // Generated from derivations/elements/triangle_lsq.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 05364e0f283eb88fa04e9ad44909f08717860c7ca088d0c2987378e324bba23a
+// source-sha256: ff8a051dcdda6c6edcadb1b42336594c8aa81007b02247f1f63582cd22d3de6a
 // body-sha256: c170b5b8e3023be5ac195a0759f71c4844255dea36ed3e84d56a659f5840c7b2
 /* Triangle of any shape, three springs fitted to its own CST by least squares (Natsupakpong and Cavusoglu 2010, closed form), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/triangle_lsq.py (derivations/elements/triangle_lsq.py). */
