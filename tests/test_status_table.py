@@ -47,3 +47,35 @@ def test_one_row_per_item_with_six_columns():
 def test_every_status_is_computed_by_the_build():
     typed = [r[0] for r in _rows() if not r[4].startswith("{{claim ") or not r[4].endswith("}}")]
     assert not typed, typed
+
+
+STATUSES = ("reproduced", "partly", "not", "missing")
+
+
+def _claim_text(cell: str) -> str:
+    """The sentence a ``{{claim CONDITION | TEXT}}`` prints: what follows the first bar at depth one."""
+    depth = 0
+    for i in range(len(cell)):
+        if cell.startswith("{{", i):
+            depth += 1
+        elif cell.startswith("}}", i):
+            depth -= 1
+        elif cell[i] == "|" and depth == 1:
+            return cell[i + 1:-2].strip()
+    raise AssertionError(f"no text in {cell[:60]}")
+
+
+def test_one_status_per_row():
+    """Each status opens with one of the four statuses and names no second one (a row that gave one
+    status per reading would be two items in one row)."""
+    for name, *_, status, _ in _rows():
+        text = _claim_text(status)
+        first = re.match(r"[a-z]+", text)
+        assert first and first.group(0) in STATUSES, (name, text[:40])
+        for word in STATUSES:
+            assert not re.search(rf"reading: {word}\b", text), (name, text[:80])
+
+
+def test_claim_text_is_found():
+    assert _claim_text("{{claim [a] < 1 | partly: {{value a fmt=.1f}} x}}") == "partly: {{value a fmt=.1f}} x"
+    assert _claim_text("{{claim max([a], [b]) < 1 | not}}") == "not"
