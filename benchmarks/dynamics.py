@@ -32,7 +32,7 @@ from numba import njit
 
 from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import solvers as S
 from msslib import terms as T
 from msslib.terms import loops

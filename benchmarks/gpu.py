@@ -76,9 +76,9 @@ def _support(mesh):
 
 
 def golec_lattice(n, nu, volume):
-    """The :class:`msslib.model.Model` of :func:`golec_arrays`, bottom clamped, gravity, with or
+    """The :class:`msslib.system.Model` of :func:`golec_arrays`, bottom clamped, gravity, with or
     without the volume term."""
-    from msslib.model import Model
+    from msslib.system import Model
     from msslib.terms import Gravity, HexVolume, Springs
 
     mesh, conn, k, L0, c = golec_arrays(n, nu)
@@ -92,7 +92,7 @@ def golec_lattice(n, nu, volume):
 def check_construction():
     """The vectorised lattice against golec_cube_springs on 3^3 cubes: forces at a perturbed state."""
     from msslib import mesh as M
-    from msslib.model import Model
+    from msslib.system import Model
     from msslib.models.golec import golec_cube_springs
 
     ours = golec_lattice(3, 0.3, True)

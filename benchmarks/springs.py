@@ -9,7 +9,7 @@ import scipy.sparse as sp
 
 from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib.terms import loops
 
 from .common import median_time

@@ -13,7 +13,7 @@ import scipy.sparse.linalg as spla
 from msslib.models.baudet import baudet_cube_springs
 from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import solvers as S
 from msslib import terms as T
 

@@ -48,7 +48,7 @@ def lloyd_network(h, reorder=False):
 
 def golec_network(n, reorder=False):
     """n^3 Golec cubes of 1 cm (E = 1 MPa) at nu = 1/4, where his volume term vanishes: the springs alone."""
-    from msslib.model import Model
+    from msslib.system import Model
     from msslib.models.golec import golec_cube_springs
     from msslib.terms import Gravity
 

@@ -27,7 +27,7 @@ from experiments.stability_common import (
 from msslib.models.common import assemble_springs
 from msslib import fem
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import parameters as P
 from msslib import solvers as S
 from msslib.terms import Gravity, Traction

@@ -12,7 +12,7 @@ from msslib.models.golec import golec_cube_springs
 from msslib.models.lloyd import lloyd_tet_springs
 from msslib import fem
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import solvers as S
 from msslib.terms import NodalForces
 

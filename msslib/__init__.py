@@ -22,7 +22,7 @@ The API (names are imported on first use: ``import msslib`` loads neither numba 
     A model by the names scenes use (:data:`msslib.scene.MSS_MODELS`, or a FEM reference
     ``fem_linear``, ``fem_svk``, ``fem_neohookean``); ``fixed``, ``loads`` and the options in the
     syntax of the scene keys ``boundary``, ``loads`` and ``model`` (:mod:`msslib.scene`).
-    ``.model`` is the :class:`msslib.model.Model` (see :mod:`msslib.api`).
+    ``.model`` is the :class:`msslib.system.Model` (see :mod:`msslib.api`).
 ``spring_constants(model) -> xarray.Dataset``
     The springs (``node_a``, ``node_b``, ``spring_constant``, ``rest_length``, ``rest_distance``)
     and the per-cell constants of the other terms (volume terms, Baudet's correction).

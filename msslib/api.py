@@ -38,7 +38,7 @@ __all__ = ["ModelSetup", "read_mesh", "build_model", "spring_constants", "solve_
 @dataclass(repr=False)
 class ModelSetup(_scene.Setup):
     """What :func:`build_model` returns: a :class:`msslib.scene.Setup` (``model`` the
-    :class:`msslib.model.Model` of an MSS model, None for a FEM reference; ``mesh``, ``fixed``,
+    :class:`msslib.system.Model` of an MSS model, None for a FEM reference; ``mesh``, ``fixed``,
     ``prescribed``, ``surface_forces``, ``gravity``, ``masses``, ``scene``) that remembers the
     scene mapping it was built from (``source``) and its geometry (``geometry``: the Mesh, the
     file or the generator mapping), so that :func:`solve_static` and :func:`solve_dynamic` can
@@ -161,14 +161,14 @@ def build_model(name: str, mesh, materials, *, fixed=None, loads=None, thickness
     **options : the model options ``published`` and ``terms`` (every model) and each model's own:
         {model_options} (:mod:`msslib.scene`, key ``model``, says what each does).
 
-    Returns a :class:`ModelSetup`: ``.model`` is the :class:`msslib.model.Model`.  Bad arguments
+    Returns a :class:`ModelSetup`: ``.model`` is the :class:`msslib.system.Model`.  Bad arguments
     raise a one-line ValueError naming the scene key (``scene.materials[0].nu: must be < 0.5``).
     """
     # the model's own copy of the arguments: editing them afterwards changes nothing
     raw = copy.deepcopy(_source(name, materials, fixed, loads, thickness, solver, checks, options))
     base_dir = Path.cwd()
     if isinstance(mesh, _mesh.Mesh):  # the model's own copy: editing the caller's mesh changes nothing
-        from msslib.model import frozen_mesh
+        from msslib.system import frozen_mesh
 
         mesh = frozen_mesh(mesh)
     with _loaded(raw, mesh, base_dir) as scene:
@@ -202,7 +202,7 @@ def _var(dims, data, units, long_name):
 def spring_constants(model):
     """The constants of a model's terms as an :class:`xarray.Dataset` (a table per dimension).
 
-    ``model``: a :class:`ModelSetup` or a :class:`msslib.model.Model`.  Along ``spring`` (every
+    ``model``: a :class:`ModelSetup` or a :class:`msslib.system.Model`.  Along ``spring`` (every
     spring of every :class:`~msslib.terms.Springs` term): ``node_a``, ``node_b``,
     ``spring_constant`` (N/m), ``rest_length`` (m) and ``rest_distance`` (m, the distance of the
     nodes in the mesh; it differs from ``rest_length`` for prestrained springs); along ``cell``:
@@ -214,7 +214,7 @@ def spring_constants(model):
     """
     import xarray as xr
 
-    from msslib.model import Model
+    from msslib.system import Model
 
     name = None
     if isinstance(model, ModelSetup):
@@ -223,7 +223,7 @@ def spring_constants(model):
             raise ValueError(f"spring_constants: {name} is a FEM reference; it has no spring constants")
         model = model.model
     if not isinstance(model, Model):
-        raise ValueError(f"spring_constants: expected what msslib.build_model returns (or a msslib.model.Model), "
+        raise ValueError(f"spring_constants: expected what msslib.build_model returns (or a msslib.system.Model), "
                          f"got {type(model).__name__}")
     mesh = model.mesh
     springs = [t for t in model.terms if t.kind == "springs"]
@@ -263,7 +263,7 @@ def spring_constants(model):
 def _run(model, kind: str, given: dict, output: dict | None, progress):
     if not isinstance(model, ModelSetup):
         raise ValueError(f"solve_{kind}: expected what msslib.build_model returns, got {type(model).__name__} "
-                         f"(a msslib.model.Model of your own: msslib.solvers.static_solve / integrate)")
+                         f"(a msslib.system.Model of your own: msslib.solvers.static_solve / integrate)")
     base = model.source.get("solver") or {}
     base = dict(base) if isinstance(base, Mapping) and base.get("type", "static") == kind else {}
     solver = {**base, "type": kind, **{k: v for k, v in given.items() if v is not None}}

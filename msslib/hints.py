@@ -118,7 +118,7 @@ def check_load_scale(mesh, loads, moduli, cell_density=None, thickness: float = 
 def failure_hint(problem, x, residual=None, free=None) -> str:
     """A clause for the message of a failed Newton solve, or ``""``.
 
-    ``problem`` is the solver's problem (a :class:`msslib.model.Model`: its ``mesh``), ``x`` the
+    ``problem`` is the solver's problem (a :class:`msslib.system.Model`: its ``mesh``), ``x`` the
     failing iterate (positions, ``n_dof``), ``residual`` the free-dof residual there (computed
     from ``problem.force`` at load 1 when None).  When the node with the largest residual is a
     corner of a sliver (aspect ratio at least :data:`SLIVER_ASPECT`), the worst such cell is named.

@@ -143,7 +143,7 @@ def lattice_system(n=8):
     """The free-dof block matrix of a clamped Golec lattice of n^3 cubes at a perturbed state, its
     rigid-body modes and the solver context (the AMG and speed-path tests' system)."""
     from msslib import mesh as M
-    from msslib.model import Model
+    from msslib.system import Model
     from msslib.models.golec import golec_cube_springs
     from msslib.solvers.amg import _rigid_body_modes
     from msslib.solvers.context import _solver_context

@@ -53,7 +53,7 @@ def test_docstring_example_runs_as_written(tmp_path, monkeypatch):
 
 
 def test_import_is_lazy():
-    code = ("import sys, msslib; heavy = [m for m in ('numba', 'scipy', 'xarray', 'msslib.scene', 'msslib.model') "
+    code = ("import sys, msslib; heavy = [m for m in ('numba', 'scipy', 'xarray', 'msslib.scene', 'msslib.system') "
             "if m in sys.modules]; print(heavy); msslib.build_model; print('msslib.api' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split("\n")[:2] == ["[]", "True"]

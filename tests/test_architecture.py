@@ -120,3 +120,19 @@ def test_package_faces_export_public_names_only():
             if isinstance(node, ast.ImportFrom) and node.level:
                 bad += [f"{init.relative_to(ROOT)}: {a.name}" for a in node.names if a.name.startswith("_")]
     assert not bad, bad
+
+
+def test_no_module_is_named_like_a_sibling_package():
+    """A module beside a package of (nearly) the same name (``model`` beside ``models``, ``plan``
+    beside ``plans``) gives one concept two paths; every name says what it holds."""
+    clashes = []
+    for package in (ROOT / "msslib").rglob("__init__.py"):
+        folder = package.parent
+        if "generated" in folder.parts:
+            continue
+        modules = {p.stem for p in folder.glob("*.py") if p.stem != "__init__"}
+        packages = {p.name for p in folder.iterdir() if (p / "__init__.py").is_file()}
+        clashes += [f"{folder.relative_to(ROOT)}/{m}.py beside {m}s/" for m in modules if f"{m}s" in packages]
+        clashes += [f"{folder.relative_to(ROOT)}/{m}.py beside {m[:-1]}/" for m in modules
+                    if m.endswith("s") and m[:-1] in packages]
+    assert not clashes, clashes

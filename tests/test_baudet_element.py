@@ -8,7 +8,7 @@ import pytest
 
 from msslib.models.baudet import baudet_correction, baudet_cube_springs
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import terms as T
 from msslib.terms.baudet import (
     ElementBaudetCorrection,

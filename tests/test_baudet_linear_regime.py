@@ -23,7 +23,7 @@ import scipy.sparse.linalg as spla
 
 from msslib.models.baudet import baudet_correction, baudet_cube_springs
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import terms as T
 from msslib.errors import ConvergenceError
 from msslib.fem import solve_linear

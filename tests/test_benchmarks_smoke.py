@@ -11,7 +11,7 @@ import numpy as np
 
 from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
-from msslib.model import Model
+from msslib.system import Model
 from msslib.terms import Springs
 from msslib.terms.loops import _spring3d_hessian_loop
 

@@ -36,7 +36,7 @@ def _voigt(eps):
 
 @pytest.mark.parametrize("nu_value", [0.3, 0.45])
 def test_a_block_under_an_affine_boundary_displacement_has_the_isotropic_stress(nu_value):
-    from msslib.model import Model
+    from msslib.system import Model
     from msslib.scene import load_scene, prepare
     from msslib.solvers import static_solve
 

@@ -12,7 +12,7 @@ from derivations.elasticity import E, nu, t
 from derivations.elements import triangle_angular as D
 from msslib import fem
 from msslib import mesh as M
-from msslib.model import Model
+from msslib.system import Model
 from msslib.models.delingette import (
     delingette_springs,
     delingette_triangle,

@@ -9,7 +9,7 @@ from msslib.models.common import _pairs_of
 from msslib.models.golec import golec_cube_springs
 from msslib.models.lloyd import lloyd_tet_springs
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import solvers as S
 from msslib import terms as T
 from msslib.explicit.lattice import LatticeExplicit, lattice_index

@@ -8,7 +8,7 @@ import pytest
 
 from msslib.models.golec import golec_cube_springs
 import msslib
-from msslib.model import Model, frozen_mesh
+from msslib.system import Model, frozen_mesh
 
 STEEL = msslib.Material(2.0e11, 0.3)
 LOAD = 1.0e6  # Pa on the top face z = 0.1

@@ -14,7 +14,7 @@ from msslib.models.baudet import baudet_correction, baudet_cube_springs
 from msslib.models.golec import golec_cube_springs
 from msslib import cli, fem
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import solvers as S
 from msslib import terms as T
 from msslib.errors import StabilityError

@@ -18,7 +18,7 @@ from experiments import stability_cases, stability_common
 from msslib.models.common import assemble_springs
 from msslib import cli
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import solvers as S
 from msslib.errors import StabilityError
 from msslib.scene import load_scene, prepare

@@ -15,7 +15,7 @@ from msslib import solvers as S
 from msslib.errors import DivergenceError, MsslibWarning, StabilityError
 from msslib.explicit import LatticeExplicit
 from msslib.explicit.network import N_MONITOR, network_forces, network_layout, network_steps, records
-from msslib.model import Model
+from msslib.system import Model
 from msslib.models.golec import golec_cube_springs
 from msslib.terms import Gravity
 

@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from derivations import fem as sfem
+from derivations import element_stiffness as sfem
 from derivations import match, mss
 from derivations.elasticity import E, nu, t
 from derivations.elements import tetrahedron_lsq as DT
 from derivations.elements import triangle_lsq as D
 from fem_helpers import fem_stiffness, jittered
 from msslib import mesh as M
-from msslib.model import Model
+from msslib.system import Model
 from msslib.models.checks import FormulaValidityWarning
 from msslib.models.lloyd import (
     lloyd_tet_springs,

@@ -12,7 +12,7 @@ import pytest
 
 from fem_helpers import jittered
 from msslib import mesh as M
-from msslib.model import Model
+from msslib.system import Model
 from msslib.models.checks import FormulaValidityWarning
 from msslib.models.lsq import (
     _not_positive_definite,

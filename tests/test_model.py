@@ -1,4 +1,4 @@
-"""Tests of msslib.terms and msslib.model: derivatives, assembly, builders, loads, corrections."""
+"""Tests of msslib.terms and msslib.system: derivatives, assembly, builders, loads, corrections."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from msslib.models.common import assemble_springs
 from msslib.models.golec import golec_cube_springs
 from msslib.models.lloyd import lloyd_square_springs, lloyd_tet_springs, lloyd_triangle_springs, van_gelder_springs
 from msslib import mesh as M
-from msslib.model import Model
+from msslib.system import Model
 from msslib.terms import (
     BaudetCorrection,
     Gravity,

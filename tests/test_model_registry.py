@@ -14,7 +14,7 @@ import yaml
 from fem_helpers import fem_stiffness
 from msslib import mesh as M
 from msslib import models
-from msslib.model import Model
+from msslib.system import Model
 
 MSS = models.names("mss")
 SPECS = models.registry()

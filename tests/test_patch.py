@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from derivations import fem as sfem
+from derivations import element_stiffness as sfem
 from derivations.elasticity import E as sE
 from derivations.elasticity import nu as snu
 from derivations.elasticity import t as st
 from msslib.models.golec import golec_cube_springs
 from msslib.models.lloyd import lloyd_square_springs, lloyd_triangle_springs
 from msslib import fem, mesh as M
-from msslib.model import Model
+from msslib.system import Model
 
 E0, T0 = 1234.0, 0.01
 

@@ -11,7 +11,7 @@ from scipy.sparse import csgraph
 from msslib.models.golec import golec_cube_springs
 from msslib import mesh as M
 from msslib import solvers as S
-from msslib.model import Model
+from msslib.system import Model
 from msslib.solvers import direct, memo, submatrices as plans
 from msslib.solvers.context import ATTRIBUTE
 from msslib.terms import Gravity

@@ -120,7 +120,7 @@ def test_model_newton_systems_filled_as_free_node_blocks(monkeypatch):
     formed); the solution equals the direct solve's."""
     from msslib import mesh as M
     from msslib import terms as T
-    from msslib.model import Model
+    from msslib.system import Model
 
     mesh = M.hex_grid(0.05, 0.02, 0.02, 5, 2, 2)
     masses = M.lumped_masses(mesh, 1000.0)
@@ -271,7 +271,7 @@ def test_compiled_bsr_kernels_equal_dense_products(d, m):
 def _gravity_cube(n, E=1e4):
     from msslib import mesh as M
     from msslib import terms as T
-    from msslib.model import Model
+    from msslib.system import Model
 
     mesh = M.hex_grid(0.1, 0.1, 0.1, n, n, n)
     masses = M.lumped_masses(mesh, 1000.0)

@@ -66,7 +66,7 @@ def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
 def clamped_golec_block(nx, ny, nz, nu=0.3):
     """Golec cube lattice of nx x ny x nz 1 cm cells, clamped at x = 0."""
     from msslib import mesh as M
-    from msslib.model import Model
+    from msslib.system import Model
 
     mesh = M.hex_grid(0.01 * nx, 0.01 * ny, 0.01 * nz, nx, ny, nz)
     fixed = np.zeros((mesh.n_nodes, 3), dtype=bool)

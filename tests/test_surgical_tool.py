@@ -7,7 +7,7 @@ import pytest
 
 from experiments.examples import surgical_tool as ex
 from msslib import solvers as S
-from msslib.model import Model
+from msslib.system import Model
 
 
 def test_example_writes_the_force_history(tmp_path, capsys):

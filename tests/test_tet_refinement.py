@@ -8,7 +8,7 @@ from experiments.lloyd.studies import tet_refinement as T
 from msslib.models.lloyd import lloyd_tet_springs
 from msslib import fem
 from msslib import mesh as M
-from msslib.model import Model
+from msslib.system import Model
 from msslib.mesh.quality import relative_jacobians
 
 E, NU = 14630.0, 0.25

@@ -24,7 +24,7 @@ import numpy as np
 from experiments.script import LoadSegment
 from msslib.models.baudet import baudet_correction, baudet_cube_springs
 from msslib import mesh as M
-from msslib import model as MD
+from msslib import system as MD
 from msslib import terms as T
 from msslib.solvers import static_solve
 

@@ -1,6 +1,6 @@
 """Fast explicit dynamics of mass-spring models on structured hexahedral lattices.
 
-:class:`LatticeExplicit` takes a :class:`msslib.model.Model` whose nodes form a full structured
+:class:`LatticeExplicit` takes a :class:`msslib.system.Model` whose nodes form a full structured
 lattice (``nx + 1`` by ``ny + 1`` by ``nz + 1`` points on a tensor-product grid; the spacing may
 vary along each axis, the node numbering is free) and whose terms are
 
@@ -122,7 +122,7 @@ class LatticeExplicit:
 
     Parameters
     ----------
-    model : :class:`msslib.model.Model` (3D) whose nodes form a full tensor-product lattice and
+    model : :class:`msslib.system.Model` (3D) whose nodes form a full tensor-product lattice and
         whose terms are Springs between lattice neighbours, HexVolume terms on lattice cells and
         constant external loads (anything else raises ValueError naming the term).  The lattice
         is detected from the rest positions ``model.mesh.points``.

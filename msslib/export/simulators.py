@@ -89,7 +89,7 @@ def _vec(v) -> str:
 
 
 def _springs_only_model(exp: MssExport):
-    from msslib.model import Model
+    from msslib.system import Model
     from msslib.terms import Springs
 
     # a non-positive constant here comes from a model that accepted it after checking its

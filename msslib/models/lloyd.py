@@ -200,7 +200,7 @@ def lloyd_tetrahedron_volume(E, *, l, nu=0.25, published=False) -> TetrahedronVo
 
 
 # --------------------------------------------------------------------------------------------
-# the rectangle's builder (the other builders are those of msslib.model)
+# the rectangle's builder (the other builders are those of msslib.system)
 # --------------------------------------------------------------------------------------------
 
 

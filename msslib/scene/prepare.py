@@ -1,5 +1,5 @@
 """From a scene to what a solver needs: :func:`prepare` builds the mesh, boundary conditions, loads
-and, for a mass-spring model, the :class:`msslib.model.Model` (its force terms built by the model's
+and, for a mass-spring model, the :class:`msslib.system.Model` (its force terms built by the model's
 spec in :mod:`msslib.models`)."""
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ class Setup:
     ``fixed`` (n, dim) bool and ``prescribed`` (n, dim) m; ``surface_forces`` (n, dim) N, the
     traction and nodal-force loads; ``gravity`` (dim,) m/s^2 or None; ``cell_density`` (n_cells,)
     (NaN where not given); ``masses`` (n,) kg lumped node masses (None without densities);
-    ``model`` the :class:`msslib.model.Model` of an MSS scene (None for FEM).
+    ``model`` the :class:`msslib.system.Model` of an MSS scene (None for FEM).
     """
 
     scene: Scene
@@ -160,7 +160,7 @@ def prepare(scene: Scene) -> Setup:
 
 
 def _build_model(setup: Setup):
-    from msslib.model import Model
+    from msslib.system import Model
     from msslib.terms import Gravity, NodalForces
 
     scene, mesh = setup.scene, setup.mesh

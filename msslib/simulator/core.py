@@ -19,7 +19,7 @@ ENGINES = ("auto", "network", "generic", "jax")
 class Simulator:
     """Step a model in time, with loads that the caller changes between steps.
 
-    ``Simulator(model, dt=...)`` takes a :class:`msslib.model.Model` (or what
+    ``Simulator(model, dt=...)`` takes a :class:`msslib.system.Model` (or what
     :func:`msslib.build_model` returns) at rest, with its own loads and supports, and integrates
     ``M dv/dt = f(x, load(t)) + f_user(t) - C v`` from ``x0`` (its prescribed displacements
     applied) at rest, with the schemes of :func:`msslib.solvers.integrate`: ``method`` is

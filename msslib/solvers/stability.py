@@ -167,7 +167,7 @@ def critical_time_step(omega_max: float, method: str = "symplectic_euler", alpha
 
 def _abs_row_sums(problem, x, load, isq):
     """Row sums of ``|D K D|`` (``D = diag(isq)``): the problem's own bound when it has one
-    (:meth:`msslib.model.Model.stiffness_row_bound`), else from its assembled stiffness."""
+    (:meth:`msslib.system.Model.stiffness_row_bound`), else from its assembled stiffness."""
     own = getattr(problem, "stiffness_row_bound", None)
     if own is not None:
         return np.asarray(own(x, load, isq), dtype=float)

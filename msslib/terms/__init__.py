@@ -17,7 +17,7 @@ node, see :mod:`msslib.solvers`) and shares one interface:
 ``hessian_coo(x) -> (rows, cols, vals)``
     Convenience: the pattern and the values together (duplicates are to be summed).
 
-Class attributes describe how a :class:`msslib.model.Model` combines the terms:
+Class attributes describe how a :class:`msslib.system.Model` combines the terms:
 ``conservative`` (False: the model's energy is ``None``), ``scales_with_load`` (True: external
 terms whose contribution is multiplied by the load factor) and ``symmetric`` (Hessian symmetry).
 
@@ -36,7 +36,7 @@ Contents of this package, one concern per module; every name below is importable
 * :mod:`msslib.terms.loops`: numba loops of the internal terms (energy, gradient and Hessian
   blocks of springs, tetrahedron and hexahedron volumes; the fast 3D spring force);
 * :mod:`msslib.terms.assembly`: element block patterns and the loops that add Hessian values into
-  CSR and BSR matrices with a node-blocked pattern (used by :class:`msslib.model.Model`);
+  CSR and BSR matrices with a node-blocked pattern (used by :class:`msslib.system.Model`);
 * :mod:`msslib.terms.base`: :class:`Term` and the element-term base class;
 * :mod:`msslib.terms.internal`: :class:`Springs`, :class:`TetVolume`, :class:`HexVolume`;
 * :mod:`msslib.terms.external`: :class:`ExternalForce`, :class:`NodalForces`, :class:`Gravity`,

@@ -1,5 +1,5 @@
 """Hessian assembly: element block patterns and the numba loops that add Hessian values into
-the data of CSR and BSR matrices with a node-blocked pattern (see :class:`msslib.model.Model`).
+the data of CSR and BSR matrices with a node-blocked pattern (see :class:`msslib.system.Model`).
 
 Node-blocked pattern: node row ``a`` has ``deg = nptr[a + 1] - nptr[a]`` neighbour nodes
 (itself included), each standing for a ``dim x dim`` block; dof row ``dim a + i`` lists

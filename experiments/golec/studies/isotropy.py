@@ -30,7 +30,7 @@ from msslib.models.golec import golec_cube_springs
 from msslib.results import write_result
 from msslib.mesh import hex_grid
 from msslib.metrics import mesh_volume, shear_modulus, youngs_modulus_poisson
-from msslib.model import Model
+from msslib.system import Model
 from msslib.parameters import golec_cube
 from msslib.solvers import static_solve
 from msslib.terms import HexVolume, Springs

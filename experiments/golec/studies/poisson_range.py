@@ -37,7 +37,7 @@ from msslib import fem
 from msslib.experiment import load_experiment, scene_of
 from msslib.mesh import hex_grid
 from msslib.metrics import displacement_error, mesh_volume, youngs_modulus_poisson
-from msslib.model import Model
+from msslib.system import Model
 from msslib.models.golec import golec_cube, golec_cube_springs
 from msslib.results import mesh_from_result, write_result
 from msslib.scene import load_scene, prepare, run_scene

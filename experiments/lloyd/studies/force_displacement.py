@@ -25,7 +25,7 @@ from msslib.models.lloyd import lloyd_square_springs, lloyd_triangle_springs
 from msslib import fem
 from msslib import mesh as M
 from msslib.results import write_result
-from msslib.model import Model
+from msslib.system import Model
 from msslib.solvers import static_solve
 from msslib.terms import NodalForces
 

@@ -51,7 +51,7 @@ from msslib import fem
 from msslib import mesh as M
 from msslib.results import write_result
 from msslib.metrics import displacement_error
-from msslib.model import Model
+from msslib.system import Model
 from msslib.solvers import static_solve
 from msslib.terms import NodalForces, Traction
 

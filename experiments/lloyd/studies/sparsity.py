@@ -14,7 +14,7 @@ node 2 in the xy plane) and its matrices are counted twice:
   when it is identically zero for every Poisson's ratio (FEM) or for independent constants (and
   rest-length factors) of every spring and of the volume term (MSS);
 * numerically, from the simulator (``msslib.fem.element_stiffness``; the tangent of an
-  ``msslib.model.Model`` holding the builder's terms on a one-element mesh) with the paper's
+  ``msslib.system.Model`` holding the builder's terms on a one-element mesh) with the paper's
   values: nu = 1/3 and eqs. 10-11 for the square, nu = 1/4 and eqs. 12 and 14 for the tetrahedron;
   an entry is zero when ``|K_ij| <= 1e-12 max |K|``.
 
@@ -34,14 +34,14 @@ import numpy as np
 import sympy as sp
 import xarray as xr
 
-from derivations import fem as sfem
+from derivations import element_stiffness as sfem
 from derivations import mss as smss
 from derivations.elasticity import E as E_sym
 from derivations.elasticity import nu as nu_sym
 from derivations.elasticity import t as t_sym
 from msslib import fem
 from msslib import mesh as M
-from msslib.model import Model
+from msslib.system import Model
 from msslib.models.common import assemble_springs
 from msslib.models.lloyd import lloyd_square, lloyd_square_springs, lloyd_tet_springs
 from msslib.results import write_result

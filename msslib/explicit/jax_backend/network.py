@@ -122,7 +122,7 @@ class _NetworkBase:
 
     @classmethod
     def from_model(cls, model, h, alpha=None, *, load: float = 1.0, x0=None, v0=None, **options):
-        """From a :class:`msslib.model.Model` whose internal terms are 3D Springs (and dead
+        """From a :class:`msslib.system.Model` whose internal terms are 3D Springs (and dead
         external loads at the factor ``load``); ``alpha`` None takes ``model.damping`` (a scalar:
         Rayleigh ``beta`` is refused).  The stability check runs on the model itself."""
         arrays = network_arrays(model, load)

@@ -1,4 +1,5 @@
-"""Mass-spring models: a mesh, force terms and boundary conditions behind the solver protocol.
+"""The assembled mass-spring system: a mesh, force terms and boundary conditions behind the solver
+protocol (the model families that build the terms are :mod:`msslib.models`).
 
 :class:`Model` sums the terms of :mod:`msslib.terms` and implements the problem protocol of
 :mod:`msslib.solvers` (``n_dof``, ``force``, ``stiffness``, ``energy``, ``free``, ``mass``,
