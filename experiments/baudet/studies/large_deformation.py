@@ -10,6 +10,11 @@ FEM (Q1, scales with the load) and the non-linear reference, neo-Hookean FEM (Q1
 dead load), both on 24x6x6 hexahedra. Errors per node (error_stats: relative to the largest reference
 displacement, and to each node's own) of every model against the non-linear and against the linear
 FEM, and the tip deflection (mean -u_z of the end section).
+
+The resolution limit of Fig. 11 (left) at the largest density: the MSS under the element reading of the
+correction (each cube's correction from the forces on it) at 8x2x2, 16x4x4 and 32x8x8 cubes, with the
+level's load steps, and the 32x8x8 once more with twice as many load steps (the correction is not
+conservative: a static equilibrium need not be unique, and the load path can pick another one).
 """
 
 import time
@@ -23,6 +28,7 @@ from experiments.baudet import cantilever_common as K
 FEM_N = (24, 6, 6)
 MSS = ((4, 1, 1), (8, 2, 2), (16, 4, 4))
 SHAPE_MSS = (16, 4, 4)  # the MSS drawn in the figure
+LIMIT_MSS = ((8, 2, 2), (16, 4, 4), (32, 8, 8))  # element reading, largest density only
 
 
 def label(n):
@@ -37,6 +43,29 @@ def at_points(ds, u, X):
     if X.shape == Xr.shape and np.allclose(X, Xr):
         return u
     return interpolate(mesh_from_result(ds), u, X)
+
+
+def limit_runs(rho, steps, size, nl, refs, stat_names):
+    """The element-reading MSS at the resolutions of LIMIT_MSS at density ``rho`` (``steps`` load steps;
+    the finest also with twice as many): errors against ``refs`` (the neo-Hookean and the linear FEM
+    displacements on the mesh of ``nl``), tip deflections, load steps, wall time."""
+    from msslib.scene import load_scene, run_scene
+
+    t = time.perf_counter()
+    err, tip, nsteps = {}, {}, {}
+    runs = [(n, steps, f"mss_{label(n)}_element") for n in LIMIT_MSS]
+    runs.append((LIMIT_MSS[-1], 2 * steps, f"mss_{label(LIMIT_MSS[-1])}_element_steps_x2"))
+    for n, st, name in runs:
+        solver = {"type": "static", "load_steps": st, "tol": 1e-9}
+        sc, base_dir = K.scene("baudet_cube", size(n), density=rho, solver=solver)
+        sc["model"] = {"type": "baudet_cube", "correction": "element"}
+        X, u = K.fields(run_scene(load_scene(sc, base_dir=base_dir), progress=False))
+        err[name] = [[K.error_stats(u, at_points(nl, ref, X))[k] for k in stat_names] for ref in refs]
+        tip[name] = K.tip(X, u)
+        nsteps[name] = st
+        print(f"  {name} ({st} load steps): tip/L {tip[name] / K.base()[0]:.4f}, max error vs non-linear FEM "
+              f"{err[name][0][stat_names.index('max_max')]:.4f}", flush=True)
+    return err, tip, nsteps, time.perf_counter() - t
 
 
 def main():
@@ -91,6 +120,7 @@ def main():
         tip[i, -1] = K.tip(X_f, u_nl)
         tip_x[i, -1] = float(u_nl[np.isclose(X_f[:, 0], L), 0].mean())
         if i == len(levels) - 1:
+            limit = limit_runs(rho, steps, size, nl, (u_nl, u_l), stat_names)
             shapes = {"mss": fields[f"mss_{label(shape_n)}"], "fem_linear": (X_f, u_l), "fem_nonlinear": (X_f, u_nl)}
         k_mean = stat_names.index("max_mean")
         print(f"density {rho:.4g} kg/m^3 ({steps} steps): tip/L nonlinear FEM {tip[i, -1] / L:.4f}, linear {tip[i, -2] / L:.4f}; "
@@ -121,6 +151,17 @@ def main():
         ds[f"rest_{name}"] = ((f"node_{name}", "axis"), X, {"units": "m", "long_name": f"rest positions, {name}"})
         ds[f"displacement_{name}"] = ((f"node_{name}", "axis"), u, {"units": "m",
                                        "long_name": f"displacement at the largest density, {name}"})
+    lim_err, lim_tip, lim_steps, lim_time = limit
+    lim_models = list(lim_tip)
+    ds["limit_error"] = (("limit_model", "reference", "stat"), np.array([lim_err[m] for m in lim_models]),
+                         {"units": "1", "long_name": "error statistics at the largest density, element reading "
+                                                     "(reference: nonlinear = neo-Hookean FEM, linear = linear FEM)"})
+    ds["limit_tip_ratio"] = ("limit_model", np.array([lim_tip[m] for m in lim_models]) / L,
+                             {"units": "1", "long_name": "tip deflection / length at the largest density, element reading"})
+    ds["limit_load_steps"] = ("limit_model", np.array([lim_steps[m] for m in lim_models]),
+                              {"units": "1", "long_name": "load steps of the static solve"})
+    ds["limit_wall_time"] = ((), lim_time, {"units": "s", "long_name": "wall time of the element-reading runs"})
+    ds = ds.assign_coords(limit_model=lim_models)
     ds.attrs.update(title="Baudet cantilever under growing weight (Fig. 11)", quick=int(args.quick),
                     fem_mesh=label(fem_n), shape_mss=label(shape_n), length=L)
     C.write(ds, args.out, t0)
