@@ -5,8 +5,9 @@ from matplotlib.patches import Polygon, Rectangle
 
 from experiments.baudet import baudet_common as C
 from experiments import plotting
+from experiments import script
 
-INPUTS = ["results/baudet/studies/large_deformation.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 COLORS = {"mss_4x1x1": "tab:red", "mss_8x2x2": "tab:orange", "mss_16x4x4": "tab:blue", "mss_32x8x8": "tab:purple",
           "fem_linear": "0.4", "fem_nonlinear": "k"}
 
@@ -41,7 +42,7 @@ def outline(X, u, y0, L, H):
 
 
 def main():
-    args = C.figure_args(__doc__)
+    args = script.args(__doc__)
     ds = C.open_result(INPUTS[0])
     L = float(ds.attrs["length"])
     rho = ds["density"].values
@@ -55,6 +56,13 @@ def main():
         ax2.plot(rho, 100 * ds["error"].sel(model=m, reference="nonlinear", stat="max_mean"), marker="o", ms=3,
                  color=COLORS.get(str(m)), ls="--" if m == "fem_linear" else "-", label=label(str(m)) + ", M")
         ax2.plot(rho, 100 * ds["error"].sel(model=m, reference="nonlinear", stat="max_max"), ":", color=COLORS.get(str(m)))
+    if "limit_error" in ds:  # the element reading at the largest density only (resolution limit)
+        for m, mk in (("mss_8x2x2_element", "s"), ("mss_16x4x4_element", "D"), ("mss_32x8x8_element", "^"),
+                      ("mss_32x8x8_element_steps_x2", "v")):
+            if m in ds.limit_model.values:
+                ax2.plot([rho[-1]], [100 * float(ds["limit_error"].sel(limit_model=m, reference="nonlinear", stat="max_max"))],
+                         mk, ms=6, mfc="none", color=COLORS.get("_".join(m.split("_")[:2]), "k"),
+                         label=f"MSS {m.split('_')[1]}, element reading, MAX" + (" (2x load steps)" if "steps" in m else ""))
     for ax in (ax1, ax2):
         for k, txt in (("reading_density", "kg/m³"), ("reading_linear_density", "kg/m"), ("reading_total_mass", "kg")):
             v = float(ds[k])
