@@ -8,16 +8,20 @@
 #   snakemake --report report.html   a report of the figures, tables and paper (after a build)
 #
 # Layout the rules discover (add a file, the DAG grows):
-#   experiments/<paper>/<name>.yaml              an experiment: cases x model variants (msslib.experiment)
-#   experiments/<paper>/studies/<study>.py       a sweep script writing one NetCDF (--out, --quick)
-#   experiments/<paper>/figures/<fig>.py         one figure (--out STEM writes STEM.png and STEM.pdf)
-#   experiments/<paper>/tables/<table>.py        one table (--out FILE.md)
-# Figure and table scripts name the results they read in a module-level INPUTS list.
+#   experiments/<paper>/<name>.yaml              an experiment: cases x model variants (msslib.experiment),
+#                                                and the figures drawn from its runs (its figures block)
+#   experiments/<paper>/studies/<study>.py       a sweep script writing one NetCDF
+#   experiments/<paper>/figures/<fig>.py         a figure that computes or draws something of its own
+#   experiments/<paper>/tables/<table>.py        one table
+#   experiments/<paper>/{figures,tables}/inputs.yaml   the results each of those scripts reads
+# Every study, figure and table takes one command line: --out PATH (a study's NetCDF file, a figure's
+# stem: STEM.png and STEM.pdf, a table's Markdown file) and --quick (figures and tables accept it).
 
-import ast
 from pathlib import Path
 
 import yaml
+
+from msslib.experiment import figure_runs, load_experiment
 
 QUICK = bool(int(config.get("quick", 0)))
 QFLAG = "--quick" if QUICK else ""
@@ -61,29 +65,29 @@ def scripts(kind):
     return {(p.parent.parent.name, p.stem): p for paper in PAPERS for p in sorted(Path("experiments", paper, kind).glob("*.py"))}
 
 
-def _constants(path):
-    """The top-level constants of an experiment module: its assignments (constants and
-    comprehensions; functions are not run) and the names it imports from other experiment
-    modules (``from experiments.<...> import NAME [as X]``), computed the same way."""
-    tree = ast.parse(Path(path).read_text())
-    namespace = {"__builtins__": {"range": range, "str": str, "int": int, "len": len, "sorted": sorted,
-                                  "zip": zip, "enumerate": enumerate, "list": list, "dict": dict, "tuple": tuple}}
-    for node in tree.body:
-        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("experiments."):
-            source = Path(*node.module.split(".")).with_suffix(".py")
-            values = _constants(source) if source.is_file() else {}
-            namespace.update({a.asname or a.name: values[a.name] for a in node.names if a.name in values})
-        elif isinstance(node, ast.Assign):
-            try:
-                exec(compile(ast.Module(body=[node], type_ignores=[]), str(path), "exec"), namespace)
-            except Exception:
-                pass
-    return namespace
+def declared_inputs(paper, kind, name):
+    """The results a figure or table script reads, from the inputs.yaml beside it (data: no script runs)."""
+    path = Path("experiments", paper, kind, "inputs.yaml")
+    declared = (yaml.safe_load(path.read_text()) or {}) if path.is_file() else {}
+    if name not in declared:
+        raise ValueError(f"{path}: {name} is not declared (list the results {kind}/{name}.py reads)")
+    return list(declared[name])
 
 
-def declared_inputs(path):
-    """The INPUTS list a figure or table script declares (:func:`_constants`)."""
-    return list(_constants(path).get("INPUTS", []))
+def declared_figures():
+    """The figures declared in the experiment files (their figures block): (paper, name) -> (experiment
+    name, the experiment loaded and checked)."""
+    out = {}
+    for (paper, exp), path in experiments().items():
+        loaded = load_experiment(path)
+        for name in loaded.figures:
+            if (paper, name) in out or (paper, name) in scripts("figures"):
+                raise ValueError(f"{path}: figure {name!r} of {paper} is declared twice")
+            out[(paper, name)] = (exp, loaded)
+    return out
+
+
+EXPERIMENT_FIGURES = declared_figures()
 
 
 # `snakemake --report`: figures, tables and the paper, one category per paper (captions in paper/report/)
@@ -91,7 +95,7 @@ report: "paper/report/workflow.rst"
 
 COMPARISONS = [f"results/{p}/{n}/comparison.nc" for p, n in experiments()]
 STUDIES = [f"results/{p}/studies/{n}.nc" for p, n in scripts("studies")]
-FIGURES = [f"paper/figures/{p}_{n}.png" for p, n in scripts("figures")]
+FIGURES = sorted(f"paper/figures/{p}_{n}.png" for p, n in list(scripts("figures")) + list(EXPERIMENT_FIGURES))
 TABLES = ([f"paper/tables/experiments/{p}_{n}.md" for p, n in experiments()]
           + [f"paper/tables/{p}_{n}.md" for p, n in scripts("tables")])
 
@@ -215,33 +219,62 @@ if not QUICK:
 
 
 rule figure:
+    """A figure script of experiments/<paper>/figures/ (one that computes or draws something of its own)."""
     input:
         script="experiments/{paper}/figures/{name}.py",
         shared=shared,
         plotting="experiments/plotting.py",
-        data=lambda wc: declared_inputs(f"experiments/{wc.paper}/figures/{wc.name}.py"),
+        data=lambda wc: declared_inputs(wc.paper, "figures", wc.name),
     output:
         png=report("paper/figures/{paper}_{name}.png", caption="paper/report/figure.rst",
                    category="{paper}", subcategory="figures", labels={"figure": "{name}"}),
         pdf="paper/figures/{paper}_{name}.pdf",
+    wildcard_constraints:
+        name="|".join(sorted({n for _, n in scripts("figures")})),
+    params:
+        quick=QFLAG,
     log:
         "logs/{paper}/figures/{name}.log",
     shell:
-        "python -m experiments.{wildcards.paper}.figures.{wildcards.name} --out paper/figures/{wildcards.paper}_{wildcards.name} > {log} 2>&1"
+        "python -m experiments.{wildcards.paper}.figures.{wildcards.name} --out paper/figures/{wildcards.paper}_{wildcards.name} {params.quick} > {log} 2>&1"
+
+
+rule experiment_figure:
+    """A figure declared in an experiment file (its figures block), drawn from the experiment's runs."""
+    input:
+        exp=lambda wc: f"experiments/{wc.paper}/{EXPERIMENT_FIGURES[(wc.paper, wc.name)][0]}.yaml",
+        runs=lambda wc: [f"results/{wc.paper}/{EXPERIMENT_FIGURES[(wc.paper, wc.name)][0]}/{c}__{m}.nc"
+                         for c, m in figure_runs(EXPERIMENT_FIGURES[(wc.paper, wc.name)][1], wc.name)],
+        code=["experiments/figures.py", "experiments/plotting.py", "experiments/script.py"],
+    output:
+        png=report("paper/figures/{paper}_{name}.png", caption="paper/report/experiment_figure.rst",
+                   category="{paper}", subcategory="figures", labels={"figure": "{name}"}),
+        pdf="paper/figures/{paper}_{name}.pdf",
+    wildcard_constraints:
+        name="|".join(sorted({n for _, n in EXPERIMENT_FIGURES})),
+    params:
+        quick=QFLAG,
+    log:
+        "logs/{paper}/figures/{name}.log",
+    shell:
+        "python -m experiments.figures {input.exp} {wildcards.name} --out paper/figures/{wildcards.paper}_{wildcards.name} "
+        "{params.quick} > {log} 2>&1"
 
 
 rule table:
     input:
         script="experiments/{paper}/tables/{name}.py",
         shared=shared,
-        data=lambda wc: declared_inputs(f"experiments/{wc.paper}/tables/{wc.name}.py"),
+        data=lambda wc: declared_inputs(wc.paper, "tables", wc.name),
     output:
         report("paper/tables/{paper}_{name}.md", caption="paper/report/table.rst",
                category="{paper}", subcategory="tables", labels={"table": "{name}"}),
+    params:
+        quick=QFLAG,
     log:
         "logs/{paper}/tables/{name}.log",
     shell:
-        "python -m experiments.{wildcards.paper}.tables.{wildcards.name} --out {output} > {log} 2>&1"
+        "python -m experiments.{wildcards.paper}.tables.{wildcards.name} --out {output} {params.quick} > {log} 2>&1"
 
 
 rule stability:

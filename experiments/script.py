@@ -1,6 +1,7 @@
-"""The command line and the table output shared by the figure and table scripts of
-experiments/<paper>/{figures,tables}/ (run as ``python -m experiments.<paper>.<kind>.<name> --out ...``),
-and the load-continuation step shared by studies."""
+"""The command line shared by every study, figure and table of experiments/<paper>/{studies,figures,tables}/
+(``python -m experiments.<paper>.<kind>.<name> --out PATH [--quick]``), the inputs a figure or table
+script declares (``inputs.yaml`` beside it), the table output, and the load-continuation step shared by
+studies."""
 
 import argparse
 from pathlib import Path
@@ -10,12 +11,38 @@ import numpy as np
 from msslib.results import write_text
 
 
-def args(doc, argv=None):
-    """The script's arguments: ``--out``, the output stem of a figure (STEM.png and STEM.pdf) or the
-    Markdown file of a table; ``doc`` is the script's docstring (its first line describes it)."""
+def parse(doc, argv=None, *, extra=None):
+    """The one command line of every study, figure and table of experiments/: ``--out`` (a study's
+    NetCDF file, a figure's output stem: STEM.png and STEM.pdf, a table's Markdown file) and
+    ``--quick`` (the reduced version of the CI build; figures and tables accept it and draw what they
+    find). ``doc`` is the script's docstring (its first line describes it); ``extra(parser)`` may add
+    arguments of its own. Returns the parser (for ``parser.error``) and the arguments."""
     ap = argparse.ArgumentParser(description=doc.strip().splitlines()[0] if doc else None)
-    ap.add_argument("--out", required=True, help="figure: output stem (writes STEM.png and STEM.pdf); table: FILE.md")
-    return ap.parse_args(argv)
+    if extra is not None:
+        extra(ap)
+    ap.add_argument("--out", required=True,
+                    help="study: FILE.nc; figure: output stem (writes STEM.png and STEM.pdf); table: FILE.md")
+    ap.add_argument("--quick", action="store_true", help="reduced version (CI); figures and tables draw what they find")
+    return ap, ap.parse_args(argv)
+
+
+def args(doc, argv=None):
+    """The arguments of :func:`parse` (``--out``, ``--quick``)."""
+    return parse(doc, argv)[1]
+
+
+def inputs(path):
+    """The result files the figure or table script at ``path`` (its ``__file__``) reads, as declared in
+    ``inputs.yaml`` beside it (``name: [file, ...]``; the workflow reads the same file, without running
+    the script)."""
+    import yaml
+
+    path = Path(path)
+    listing = path.with_name("inputs.yaml")
+    declared = yaml.safe_load(listing.read_text(encoding="utf-8")) or {}
+    if path.stem not in declared:
+        raise KeyError(f"{listing}: {path.stem} is not declared (list the results {path.name} reads)")
+    return list(declared[path.stem])
 
 
 def number(v, spec, scale=1, missing="-"):

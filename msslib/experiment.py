@@ -20,6 +20,14 @@ An experiment file (YAML, one per experiment of the papers, under ``experiments/
     quick: {geometry: {args: {n: 4}}}      # overrides for the reduced (CI) build
     published:                             # numbers printed in the paper, with their unit
       stretch: {mss: {max: [0.033, cm], mean: [0.008, cm]}}
+    figures:                               # figures drawn from the runs (python -m experiments.figures)
+      membrane_equilateral:                # the figure's name: paper/figures/<paper>_<name>.png and .pdf
+        caption: "Lloyd et al. Fig. 9: MSS (red) over linear FEM"
+        kind: comparison                   # the only kind: one column per (case, variant, reference)
+        plane: xy                          # options of the kind (:data:`FIGURE_OPTIONS`)
+        columns:
+          - {title: "a) stretch", case: stretch, variant: mss}   # reference: the experiment's
+          - {title: "b) shear", case: shear, variant: mss, reference: fem}
 
 Overrides merge mappings key by key; any other value (lists included) replaces the base value. A
 run is one (case, model) pair: :func:`scene_of` gives its scene, :func:`run` solves it. The
@@ -28,6 +36,9 @@ same case (per-node Euclidean distance: mean, standard deviation and maximum, ab
 to the largest reference displacement) and puts the published values beside them. When the meshes
 differ (a reference computed at another resolution), the reference displacement is interpolated at
 the variant's nodes with the reference's own shape functions.
+
+A figure (``figures``) is data: its kind, its columns and the kind's drawing options, checked here
+(:func:`figure_runs` names the runs it reads); ``experiments.figures`` draws it.
 """
 
 from __future__ import annotations
@@ -39,10 +50,19 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-KEYS = {"name", "paper", "title", "section", "description", "scene", "cases", "models", "reference", "quick", "published"}
+KEYS = {"name", "paper", "title", "section", "description", "scene", "cases", "models", "reference", "quick", "published",
+        "figures"}
 PAPERS = ("lloyd", "baudet", "golec", "performance")  # performance: experiments of this project beyond the papers
 UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "%": 1e-2, "1": 1.0, "Pa": 1.0, "kPa": 1e3, "s": 1.0, "m^3": 1.0, "cm^3": 1e-6}
 METRICS = ("mean", "std", "max")
+#: The figure kinds and the options each accepts beside ``kind``, ``caption`` and ``columns``, with
+#: their types (the drawing options of ``experiments.plotting.comparison_figure``).
+FIGURE_OPTIONS = {"comparison": {"plane": str, "length_unit": str, "panel_width": float, "panel_height": float,
+                                 "magnify": float, "node_errors": bool, "show_rest": bool, "variant_label": str,
+                                 "reference_label": str, "title": str}}
+FIGURE_PLANES = ("xy", "xz", "yz", "yx", "zx", "zy")
+FIGURE_LENGTH_UNITS = ("m", "cm", "mm")
+COLUMN_KEYS = ("title", "case", "variant", "reference")
 
 
 @dataclass(frozen=True)
@@ -60,6 +80,7 @@ class Experiment:
     base_dir: Path
     description: str = ""
     path: Path | None = field(default=None)
+    figures: dict = field(default_factory=dict)
 
 
 def _fail(path, msg):
@@ -103,10 +124,86 @@ def load_experiment(path) -> Experiment:
             for metric, v in values.items():
                 if not (isinstance(v, list) and len(v) == 2 and v[1] in UNITS):
                     _fail(f"experiment.published.{case}.{model}.{metric}", f"expected [value, unit] with unit in {sorted(UNITS)}, got {v!r}")
+    figures = _figures(raw.get("figures") or {}, cases, models, ref)
     return Experiment(name=raw.get("name", path.stem), paper=paper, title=raw.get("title", path.stem),
                       section=str(raw.get("section", "")), scene=raw["scene"], cases=cases, models=models,
                       reference=ref, quick=raw.get("quick") or {}, published=published, base_dir=path.parent,
-                      description=raw.get("description", ""), path=path)
+                      description=raw.get("description", ""), path=path, figures=figures)
+
+
+def _figures(raw, cases, models, reference):
+    """The ``figures`` block checked and completed: every column names its case, variant and
+    reference (a column may leave out the case of a one-case experiment and the experiment's
+    reference); options are those of the kind, of the right type."""
+    if not isinstance(raw, dict):
+        _fail("experiment.figures", "must be a mapping of figure name to figure")
+    out = {}
+    for name, fig in raw.items():
+        where = f"experiment.figures.{name}"
+        if not isinstance(name, str) or not name.replace("_", "").replace("-", "").isalnum():
+            _fail(where, "a figure name is letters, digits, '_' and '-' (it names the output file)")
+        if not isinstance(fig, dict):
+            _fail(where, "must be a mapping with kind, caption and columns")
+        kind = fig.get("kind")
+        if kind not in FIGURE_OPTIONS:
+            _fail(f"{where}.kind", f"{kind!r} is not one of {sorted(FIGURE_OPTIONS)}")
+        allowed = {"kind", "caption", "columns", *FIGURE_OPTIONS[kind]}
+        unknown = sorted(set(fig) - allowed)
+        if unknown:
+            _fail(f"{where}.{unknown[0]}", f"unknown key; expected one of {', '.join(sorted(allowed))}")
+        if not isinstance(fig.get("caption"), str) or not fig["caption"].strip():
+            _fail(f"{where}.caption", "missing: one line saying what the figure shows")
+        options = {}
+        for key, typ in FIGURE_OPTIONS[kind].items():
+            if key not in fig:
+                continue
+            v = fig[key]
+            ok = isinstance(v, bool) if typ is bool else (isinstance(v, (int, float)) and not isinstance(v, bool)
+                                                          if typ is float else isinstance(v, typ))
+            if not ok:
+                _fail(f"{where}.{key}", f"expected a {typ.__name__}, got {v!r}")
+            options[key] = float(v) if typ is float else v
+        if "plane" in options and options["plane"] not in FIGURE_PLANES:
+            _fail(f"{where}.plane", f"{options['plane']!r} is not one of {FIGURE_PLANES}")
+        if options.get("length_unit", "cm") not in FIGURE_LENGTH_UNITS:
+            _fail(f"{where}.length_unit", f"{options['length_unit']!r} is not one of {FIGURE_LENGTH_UNITS}")
+        columns = fig.get("columns")
+        if not isinstance(columns, list) or not columns:
+            _fail(f"{where}.columns", "must be a non-empty list of {title, case, variant, reference}")
+        out[name] = {"kind": kind, "caption": fig["caption"].strip(), "options": options,
+                     "columns": [_column(f"{where}.columns[{k}]", c, cases, models, reference)
+                                 for k, c in enumerate(columns)]}
+    return out
+
+
+def _column(where, col, cases, models, reference):
+    if not isinstance(col, dict):
+        _fail(where, f"must be a mapping with keys {', '.join(COLUMN_KEYS)}")
+    unknown = sorted(set(col) - set(COLUMN_KEYS))
+    if unknown:
+        _fail(f"{where}.{unknown[0]}", f"unknown key; expected one of {', '.join(COLUMN_KEYS)}")
+    col = {"case": next(iter(cases)) if len(cases) == 1 else None, "reference": reference, **col}
+    for key, names in (("case", cases), ("variant", models), ("reference", models)):
+        if col.get(key) is None:
+            _fail(f"{where}.{key}", "missing" + (" (the experiment has no reference)" if key == "reference" else ""))
+        if col[key] not in names:
+            _fail(f"{where}.{key}", f"{col[key]!r} is not one of {sorted(names)}")
+    if not isinstance(col.get("title"), str):
+        _fail(f"{where}.title", "missing: the column's title")
+    return {k: col[k] for k in COLUMN_KEYS}
+
+
+def figure_runs(exp: Experiment, name: str):
+    """The (case, model) runs figure ``name`` of ``exp`` reads, each once, in the order of its
+    columns (variant, then reference)."""
+    if name not in exp.figures:
+        raise ValueError(f"{exp.name}: no figure {name!r}; declared: {sorted(exp.figures) or 'none'}")
+    out = []
+    for col in exp.figures[name]["columns"]:
+        for run in ((col["case"], col["variant"]), (col["case"], col["reference"])):
+            if run not in out:
+                out.append(run)
+    return out
 
 
 def merge(base, override):

@@ -15,12 +15,12 @@ the paper's definitions (eqs. 1-6: forces over the rest areas, changes over rest
 
 from __future__ import annotations
 
-import argparse
 import time
 from pathlib import Path as _P
 
 import numpy as np
 
+from experiments import script
 from experiments.script import LoadSegment
 from msslib.models.baudet import baudet_correction, baudet_cube_springs
 from msslib import mesh as M
@@ -35,17 +35,14 @@ NU_LABELS = tuple(f"{v:g}" for v in NUS)
 FACTORS = ("derived", "printed")
 READINGS = ("boundary", "element")  # readings of the correction force (msslib.terms.baudet)
 STEPS = 40  # load levels per curve (set to 10 by --quick)
-# the cantilever's MSS resolutions and the results its figure and table read
+# the cantilever's MSS resolutions (its figure and table read these runs: figures/inputs.yaml, tables/inputs.yaml)
 CANTILEVER_RES = ("4x1x1", "8x2x2", "16x4x4", "32x8x8")
-CANTILEVER_INPUTS = ([f"results/baudet/cantilever/gravity__mss_{r}.nc" for r in CANTILEVER_RES]
-                     + ["results/baudet/cantilever/gravity__fem.nc", "results/baudet/studies/cantilever_eq10.nc"])
 
 
 def parse(doc):
-    p = argparse.ArgumentParser(description=doc)
-    p.add_argument("--out", required=True, help="output NetCDF file")
-    p.add_argument("--quick", action="store_true", help="reduced version (CI)")
-    args = p.parse_args()
+    """A study's command line (:func:`experiments.script.args`: ``--out``, ``--quick``); ``--quick``
+    sets :data:`STEPS` to 10."""
+    args = script.args(doc)
     global STEPS
     STEPS = 10 if args.quick else 40
     return args
@@ -230,12 +227,6 @@ def tie_matrix(n_nodes, free_nodes, groups):
 
 # ---- figures ----------------------------------------------------------------------------------
 
-def figure_args(doc):
-    p = argparse.ArgumentParser(description=doc)
-    p.add_argument("--out", required=True, help="output stem (writes STEM.png and STEM.pdf)")
-    return p.parse_args()
-
-
 def open_result(path):
     import xarray as xr
 
@@ -248,19 +239,6 @@ def open_result(path):
 CUBE_PANELS = {"boundary reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "boundary"},
                "boundary reading, printed factor": {"geometry": "cube", "factor": "printed", "reading": "boundary"},
                "element reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "element"}}
-
-
-def comparison(doc, labels, inputs, **kw):
-    """A figure of MSS wireframes over the FEM reference and per-node error maps, side view (xz) in mm:
-    one column per label, with the MSS result of the same position in ``inputs`` against the reference,
-    the last of ``inputs``; ``kw`` goes to :func:`experiments.plotting.comparison_figure`."""
-    from experiments import plotting
-
-    args = figure_args(doc)
-    ref = open_result(inputs[-1])
-    pairs = {k: (open_result(p), ref) for k, p in zip(labels, inputs[:-1], strict=True)}
-    fig = plotting.comparison_figure(pairs, plane="xz", length_unit="mm", node_errors=True, **kw)
-    plotting.save(fig, args.out)
 
 
 NU_COLORS = {"0.1": "tab:blue", "0.2": "tab:orange", "0.25": "tab:brown", "0.3": "tab:green", "0.4": "tab:red", "0.499": "tab:purple"}

@@ -3,12 +3,13 @@ the boundary and the element reading of the correction force."""
 
 from experiments.baudet import baudet_common as C
 from experiments import plotting
+from experiments import script
 
-INPUTS = ["results/baudet/studies/bulk.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def main():
-    args = C.figure_args(__doc__)
+    args = script.args(__doc__)
     ds = C.open_result(INPUTS[0])
     panels = C.CUBE_PANELS
     fig = C.curves(ds["B_error_by_reading"], ds["volume_change"].values, xlabel="volume change dV/V0 (%)", ylabel="B error (%)",

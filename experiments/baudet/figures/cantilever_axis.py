@@ -1,13 +1,15 @@
 """Baudet Figs. 9-10: deflection of the cantilever's neutral axis, MSS (and 32x8x8 beyond the paper) and FEM against eq. 10."""
 
 from experiments.baudet import baudet_common as C
-from experiments.baudet.baudet_common import CANTILEVER_INPUTS as INPUTS
+from experiments import script
 from experiments.baudet.baudet_common import CANTILEVER_RES as RES
 from experiments import plotting
 
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
+
 
 def main():
-    args = C.figure_args(__doc__)
+    args = script.args(__doc__)
     eq = C.open_result(INPUTS[-1])
     fig = plotting.figure(figsize=(6.0, 3.6))
     ax = fig.add_subplot()

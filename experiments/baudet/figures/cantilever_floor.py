@@ -5,12 +5,13 @@ from matplotlib.ticker import NullLocator
 
 from experiments.baudet import baudet_common as C
 from experiments import plotting
+from experiments import script
 
-INPUTS = ["results/baudet/studies/cantilever_floor.nc", "results/baudet/cantilever/comparison.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def main():
-    args = C.figure_args(__doc__)
+    args = script.args(__doc__)
     ds = C.open_result(INPUTS[0])
     cmp = C.open_result(INPUTS[1])
     n = ds["cubes_across"].values

@@ -5,13 +5,14 @@ import matplotlib.ticker
 
 from experiments.baudet import baudet_common as C
 from experiments import plotting
+from experiments import script
 
-INPUTS = ["results/baudet/studies/tension.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 BAND = 5.0  # %, the tolerance drawn
 
 
 def main():
-    args = C.figure_args(__doc__)
+    args = script.args(__doc__)
     ds = C.open_result(INPUTS[0])
     panels = C.CUBE_PANELS
     fig = C.curves(ds["nu_error_by_reading"], ds["strain"].values, xlabel="axial strain (%)",

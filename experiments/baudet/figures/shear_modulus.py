@@ -3,12 +3,13 @@ with it under the boundary reading (derived, printed factor) and the element rea
 
 from experiments.baudet import baudet_common as C
 from experiments import plotting
+from experiments import script
 
-INPUTS = ["results/baudet/studies/shear.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def main():
-    args = C.figure_args(__doc__)
+    args = script.args(__doc__)
     ds = C.open_result(INPUTS[0])
     panels = {"no correction (paper's definition)": {"factor": "none", "reading": "boundary"},
               "boundary reading, derived factor": {"factor": "derived", "reading": "boundary"},

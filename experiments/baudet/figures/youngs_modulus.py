@@ -3,13 +3,14 @@ correction read at element level (every cube corrected from the forces on it fro
 
 from experiments.baudet import baudet_common as C
 from experiments import plotting
+from experiments import script
 
-INPUTS = ["results/baudet/studies/tension.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 PUBLISHED = [(10.0, 2.7, "0.3"), (10.0, 2.0, "0.4"), (10.0, 1.5, "0.499")]  # Sec. 5 text, nu = 0.5 as 0.499
 
 
 def main():
-    args = C.figure_args(__doc__)
+    args = script.args(__doc__)
     ds = C.open_result(INPUTS[0])
     panels = C.CUBE_PANELS
     fig = C.curves(ds["E_error_by_reading"], ds["strain"].values, xlabel="axial strain (%)", ylabel="E error (%)",

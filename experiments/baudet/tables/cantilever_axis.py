@@ -2,8 +2,9 @@
 
 from experiments import script
 from experiments.baudet import baudet_common as C
-from experiments.baudet.baudet_common import CANTILEVER_INPUTS as INPUTS
 from experiments.baudet.baudet_common import CANTILEVER_RES as RES
+
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def main():

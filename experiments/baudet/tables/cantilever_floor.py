@@ -6,7 +6,7 @@ import numpy as np
 from experiments import script
 from experiments.baudet import baudet_common as C
 
-INPUTS = ["results/baudet/studies/cantilever_floor.nc", "results/baudet/cantilever/comparison.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def pc(v, fmt=".3g"):

@@ -5,8 +5,7 @@ import numpy as np
 from experiments import script
 from experiments.baudet import baudet_common as C
 
-INPUTS = ["results/baudet/studies/cantilever_floor.nc", "results/baudet/studies/large_deformation.nc",
-          "results/baudet/cantilever/comparison.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 LEVELS = ("4x1x1", "8x2x2", "16x4x4")
 
 

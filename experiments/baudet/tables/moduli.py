@@ -5,7 +5,7 @@ acting on it from outside; for one cube both readings agree)."""
 from experiments import script
 from experiments.baudet import baudet_common as C
 
-INPUTS = ["results/baudet/studies/tension.nc", "results/baudet/studies/shear.nc", "results/baudet/studies/bulk.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def main():

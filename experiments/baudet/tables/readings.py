@@ -7,9 +7,7 @@ import numpy as np
 from experiments import script
 from experiments.baudet import baudet_common as C
 
-INPUTS = ["results/baudet/studies/tension.nc", "results/baudet/studies/shear.nc", "results/baudet/studies/bulk.nc",
-          "results/baudet/shear_beam/comparison.nc", "results/baudet/cantilever/comparison.nc",
-          "results/baudet/l_block/comparison.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 READINGS = ("boundary", "element")
 
 

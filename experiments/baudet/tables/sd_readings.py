@@ -9,8 +9,7 @@ import numpy as np
 from experiments import script
 from experiments.baudet import baudet_common as C
 
-INPUTS = ["results/baudet/shear_beam/comparison.nc", "results/baudet/cantilever/comparison.nc",
-          "results/baudet/l_block/comparison.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 EXPERIMENTS = (("sheared beam (Fig. 7)", "shear", ("mss_2x2x6", "mss_4x4x12", "mss_8x8x24")),
                ("cantilever (Fig. 10)", "gravity", ("mss_4x1x1", "mss_8x2x2", "mss_16x4x4")),
                ("L-block (Fig. 13)", "lateral", ("mss_n2", "mss_n4", "mss_n8")))

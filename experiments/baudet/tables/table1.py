@@ -5,8 +5,7 @@ import sympy as sp
 
 from experiments import script
 
-INPUTS = ["derivations/analyses/baudet_table1.py", "derivations/lattice.py", "derivations/mss.py", "derivations/element_stiffness.py",
-          "derivations/match.py", "derivations/elasticity.py"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 # Baudet et al. (2007), Sec. 4 "Our 3D Model", Table 1 "Number of equations and unknowns according to the
 # geometry chosen" (M1: face diagonals, M2: inner diagonals, M3: both); elongation unknowns are printed

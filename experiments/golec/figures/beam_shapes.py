@@ -10,9 +10,7 @@ from experiments import plotting
 from msslib.results import read_result
 
 R = "results/golec/beam"
-INPUTS = ["results/golec/beam/default__fem.nc", "results/golec/beam/default__golec.nc",
-          "results/golec/beam/default__mss_classical.nc", "results/golec/beam/default__golec_published.nc",
-          "results/golec/studies/wrinkles.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 AMPLIFY = 20.0
 #: how each variant is drawn in every panel: colour, line style, marker, line width
 STYLE = {

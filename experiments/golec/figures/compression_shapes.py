@@ -8,9 +8,7 @@ from experiments import plotting
 from msslib.results import read_result
 
 R = "results/golec/compression"
-INPUTS = ["results/golec/compression/clamped__mss_classical.nc", "results/golec/compression/clamped__golec.nc",
-          "results/golec/compression/clamped__golec_published.nc", "results/golec/compression/clamped__fem.nc",
-          "results/golec/studies/wrinkles.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def main():

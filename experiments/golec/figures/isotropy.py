@@ -7,7 +7,7 @@ from experiments import script
 from experiments import plotting
 from msslib.results import read_result
 
-INPUTS = ["results/golec/studies/isotropy.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 LABELS = {"derived": "derived constants", "published": "printed constants, per element",
           "printed_totals": "printed constants as interior totals"}
 COLORS = {"derived": "tab:red", "published": "tab:blue", "printed_totals": "tab:green"}

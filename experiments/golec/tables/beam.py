@@ -3,7 +3,7 @@
 from experiments import script
 from msslib.results import read_result
 
-INPUTS = ["results/golec/studies/wrinkles.nc", "results/golec/beam/comparison.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 VARIANTS = {
     "mss_no_face": "classical MSS without face diagonals (A = 1e4), no correction",
     "mss_classical": "classical MSS: printed springs, no correction",

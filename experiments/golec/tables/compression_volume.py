@@ -18,10 +18,7 @@ VARIANTS = {
 PUBLISHED = {"mss_classical": "115.196 (Fig. 2 (1), classical MSS with wrinkles)",
              "mss_no_face": "115.196 (Fig. 2 (1), classical MSS with wrinkles)",
              "golec_published": "124.959 (Fig. 2 (2), with correction forces)"}
-INPUTS = ["results/golec/compression/clamped__mss_no_face.nc", "results/golec/compression/clamped__mss_classical.nc",
-          "results/golec/compression/clamped__mss_springs.nc", "results/golec/compression/clamped__golec.nc",
-          "results/golec/compression/clamped__golec_published.nc", "results/golec/compression/clamped__fem.nc",
-          "results/golec/studies/wrinkles.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def volume(path):

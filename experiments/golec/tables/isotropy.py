@@ -3,7 +3,7 @@
 from experiments import script
 from msslib.results import read_result
 
-INPUTS = ["results/golec/studies/isotropy.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 LABELS = {"derived": "derived (per element)", "published": "printed, used per element",
           "printed_totals": "printed, read as interior totals"}
 

@@ -3,7 +3,7 @@
 from experiments import script
 from msslib.results import read_result
 
-INPUTS = ["results/golec/studies/poisson_range.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 LABELS = {"golec": "hybrid MSS (A = 1, correction)", "golec_no_face": "no face diagonals (A = 1e4), correction",
           "springs": "springs only (A = 1)", "springs_no_face": "springs only, no face diagonals (A = 1e4)"}
 

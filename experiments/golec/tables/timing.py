@@ -3,7 +3,7 @@
 from experiments import script
 from msslib.results import read_result
 
-INPUTS = ["results/golec/studies/timing.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def main():

@@ -14,7 +14,7 @@ from experiments import script
 from experiments import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
-INPUTS = ["results/lloyd/studies/force_displacement.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 TITLES = {"triangle": "a) equilateral triangle", "square": "b) square"}
 
 

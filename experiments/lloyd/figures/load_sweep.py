@@ -18,7 +18,7 @@ from experiments import script
 from experiments import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
-INPUTS = ["results/lloyd/studies/load_sweep.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 TITLES = {
     "membrane_equilateral": "Sec. 5.1 equilateral membrane", "membrane_arbitrary": "Sec. 5.2 arbitrary triangles",
     "membrane_square": "Sec. 5.3 square mesh", "resolutions": "Sec. 5.4 resolutions (shear)",

@@ -14,7 +14,7 @@ from experiments import script
 from experiments import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
-INPUTS = ["results/lloyd/studies/poisson_error.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 TITLES = {"stretch": "a) stretch, 10 % of E", "shear": "b) shear, 4 % of E", "small_stretch": "c) stretch, 1 % of E"}
 
 

@@ -20,7 +20,7 @@ from experiments import plotting
 from experiments import script
 
 ROOT = Path(__file__).resolve().parents[3]
-INPUTS = ["results/lloyd/studies/sparsity.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 TITLES = {"square_mss_plain": "a) MSS, no prestrain", "square_mss_prestrain": "b) MSS, prestrain (eqs. 10-11)",
           "square_fem": "c) FEM, bilinear, $\\nu$ = 1/3", "tet_mss": "d) MSS, springs (eq. 12)",
           "tet_mss_volume": "e) MSS + volume term (eq. 14)", "tet_fem": "f) FEM, linear, $\\nu$ = 1/4"}

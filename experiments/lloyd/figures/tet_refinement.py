@@ -21,7 +21,7 @@ from experiments import script
 from experiments import plotting
 
 ROOT = Path(__file__).resolve().parents[3]
-INPUTS = ["results/lloyd/studies/tet_refinement.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 LEVEL_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:purple"]
 
 

@@ -8,7 +8,7 @@ import xarray as xr
 from experiments import script
 
 ROOT = Path(__file__).resolve().parents[3]
-INPUTS = ["results/lloyd/studies/load_sweep.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def main(argv=None):

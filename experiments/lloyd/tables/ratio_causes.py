@@ -7,7 +7,7 @@ import xarray as xr
 from experiments import script
 
 ROOT = Path(__file__).resolve().parents[3]
-INPUTS = ["results/lloyd/studies/ratio_causes.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 SHORT = {"baseline": "nothing (the experiment file)", "equal_forces": "equal nodal forces",
          "mss_strain": "load from the MSS strain", "flipped": "mesh upside down",
          "flipped_equal_forces": "mesh upside down, equal forces", "counts_mesh": "mesh with 39 nodes, 92 springs", "cst_slash": "reference CST, diagonals up",

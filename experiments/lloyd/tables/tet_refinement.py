@@ -6,7 +6,7 @@ import numpy as np
 from experiments import script
 from msslib.results import read_result
 
-INPUTS = ["results/lloyd/studies/tet_refinement.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def _pct(v):

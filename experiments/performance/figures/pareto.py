@@ -3,15 +3,15 @@ Pareto front (the runs no other run beats in both time and error), the reference
 error as a band and the crossover error budget (FEM fastest below it, an MSS above it), drawn only
 where the fronts cross once (not where they interleave)."""
 
-import argparse
 
 import numpy as np
 
 from experiments import plotting
 from msslib.results import read_result
+from experiments import script
 
 SCENES = ["cantilever", "cylinder", "membrane"]
-INPUTS = [f"results/performance/studies/front_{s}.nc" for s in SCENES]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 MARKERS = "osD^v<>p"
 
 
@@ -26,9 +26,7 @@ def _style(name, k):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", required=True, help="output stem: writes STEM.png and STEM.pdf")
-    a = p.parse_args()
+    a = script.args(__doc__)
     fig = plotting.figure(figsize=(14, 6.6))
     axes = fig.subplots(1, 3)
     for ax, scene, path in zip(axes, SCENES, INPUTS):

@@ -1,12 +1,12 @@
 """The benchmark figures with their baselines, threads and load, as a Markdown table."""
 
-import argparse
 import json
 from pathlib import Path
 
 from msslib.results import write_text
+from experiments import script
 
-INPUTS = ["results/benchmarks.json"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def _md(text):
@@ -15,9 +15,7 @@ def _md(text):
 
 
 def main():
-    p = argparse.ArgumentParser()
-    p.add_argument("--out", required=True)
-    a = p.parse_args()
+    a = script.args(__doc__)
     data = json.loads(Path(INPUTS[0]).read_text())
     m = data["meta"]
     lines = [f"`python -m benchmarks{' --quick' if m['quick'] else ''}`: BLAS and numba pinned to "

@@ -3,16 +3,16 @@ its error decreases under refinement, its place on the Pareto front, and the cro
 (the fastest variant within a budget is FEM below it, an MSS above it). No published values exist
 for this comparison: it is ours only."""
 
-import argparse
 import math
 
 import numpy as np
 
 from msslib.results import read_result, write_text
 from msslib.planning import pareto
+from experiments import script
 
 SCENES = ["cantilever", "cylinder", "membrane"]
-INPUTS = [f"results/performance/studies/front_{s}.nc" for s in SCENES]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def _g(v, s=1.0, fmt=".3g"):
@@ -20,9 +20,7 @@ def _g(v, s=1.0, fmt=".3g"):
 
 
 def main():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", required=True)
-    a = p.parse_args()
+    a = script.args(__doc__)
     lines = [("| scene | reference (level, dofs) | its own error (est.) | observed order | linear vs non-linear "
               "reference | crossover budget | fastest just below it | fastest at it | an MSS fastest up to |"),
              "|---|---|---|---|---|---|---|---|---|"]

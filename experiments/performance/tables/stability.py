@@ -1,12 +1,12 @@
 """Stability table: every hard case x model, with the error, volume ratio, inverted elements and how it broke."""
 
-import argparse
 
 import numpy as np
 
 from msslib.results import read_result, write_text
+from experiments import script
 
-INPUTS = ["results/stability.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def _md(text):
@@ -36,9 +36,7 @@ def cell(r):
 
 
 def main():
-    p = argparse.ArgumentParser()
-    p.add_argument("--out", required=True)
-    a = p.parse_args()
+    a = script.args(__doc__)
     d = read_result(INPUTS[0])
     models = [str(m) for m in d.model.values]
     lines = [f"Hard cases (E = {d.attrs['E']:g} Pa). *err*: largest node error relative to the largest displacement of "

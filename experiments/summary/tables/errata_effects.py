@@ -3,9 +3,7 @@
 from experiments import script
 from msslib.results import read_result
 
-INPUTS = ["results/golec/studies/isotropy.nc", "results/baudet/studies/tension.nc",
-          "results/baudet/studies/bulk.nc", "results/lloyd/studies/poisson_error.nc",
-          "results/lloyd/cylinder_volume/comparison.nc"]
+INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
 def pct(v):
