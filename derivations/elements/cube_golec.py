@@ -133,6 +133,13 @@ def correction_force_units():
             "printed_unit": printed_unit}
 
 
+def _is_force(q) -> bool:
+    """Whether a dimension expression (sympy.physics.units) is a force."""
+    from sympy.physics import units as u
+    from sympy.physics.units.systems.si import dimsys_SI
+    return dimsys_SI.get_dimensional_dependencies(q) == dimsys_SI.get_dimensional_dependencies(u.force)
+
+
 def unit_text(q) -> str:
     """'N m^3' for newton*meter**3 (plain text for the erratum)."""
     from sympy.physics import units as u
@@ -224,7 +231,10 @@ def derive() -> Derivation:
         springs_alone_nu=float(springs_only["E,nu,G,K"][1]),
         kappa_matches_printed=int(sp.simplify(s[kappa] - KAPPA_PUBLISHED) == 0),
         kappa_negative_below_quarter=int(all(s[kappa].subs({E: 1, nu: v}) < 0 for v in (sp.Rational(1, 10), sp.Rational(1, 5)))),
-        printed_shear_modulus_exact=int(sp.simplify(mu_pub - mu) == 0))
+        printed_shear_modulus_exact=int(sp.simplify(mu_pub - mu) == 0),
+        printed_force_is_newton=int(_is_force(units["printed"])),
+        printed_force_extra_length_power=units["deg_V"] + units["deg_grad"] - 2,  # Pa m^k = N m^(k-2)
+        corrected_force_is_newton=int(_is_force(units["corrected"])))
     d.errata += [
         Erratum("Golec et al. (2017)", "spring constants k_e, k_f (Sec. 2; ambiguous: per cube or per interior spring)",
                 r"k_e = \left(\tfrac{8}{3}A + 1\right)\frac{E l}{\tfrac{10}{3}A + 2.5},\ k_f = \frac{E l}{\tfrac{10}{3}A + 2.5}",

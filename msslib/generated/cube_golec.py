@@ -1,5 +1,5 @@
 # Generated from derivations/elements/cube_golec.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 7e89820f5cbbeab27ef98890be16880b96db7ec7e84e8c4fc3b35dc8a4648106
+# source-sha256: 2baf740924006b24ab708a6eb9fe0afe8cc5962c5c534f961faf5ee0c0b2c7f1
 # body-sha256: ead38ff0979f342e371691d41eaa2c1fcc80bd8a3ec45ce6848072726eb1950e
 """Cube with edge, face and inner springs and volume correction (Golec et al.).
 
