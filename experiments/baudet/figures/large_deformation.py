@@ -58,11 +58,11 @@ def main():
         ax2.plot(rho, 100 * ds["error"].sel(model=m, reference="nonlinear", stat="max_max"), ":", color=COLORS.get(str(m)))
     if "limit_error" in ds:  # the element reading at the largest density only (resolution limit)
         for m, mk in (("mss_8x2x2_element", "s"), ("mss_16x4x4_element", "D"), ("mss_32x8x8_element", "^"),
-                      ("mss_32x8x8_element_steps_x2", "v")):
+                      ("mss_32x8x8_element_other_path", "v")):
             if m in ds.limit_model.values:
                 ax2.plot([rho[-1]], [100 * float(ds["limit_error"].sel(limit_model=m, reference="nonlinear", stat="max_max"))],
                          mk, ms=6, mfc="none", color=COLORS.get("_".join(m.split("_")[:2]), "k"),
-                         label=f"MSS {m.split('_')[1]}, element reading, MAX" + (" (2x load steps)" if "steps" in m else ""))
+                         label=f"MSS {m.split('_')[1]}, element reading, MAX" + (" (other load path)" if "path" in m else ""))
     for ax in (ax1, ax2):
         for k, txt in (("reading_density", "kg/m³"), ("reading_linear_density", "kg/m"), ("reading_total_mass", "kg")):
             v = float(ds[k])
