@@ -14,6 +14,24 @@ from msslib.scene.schema import Scene, _check_size, _generator_function
 from msslib.scene.validate import AXES, _fail
 
 
+def _oriented(mesh: _mesh.Mesh, what: str) -> _mesh.Mesh:
+    """``mesh`` with every cell positively oriented (:func:`msslib.mesh.orient`).  A mesh numbered
+    the other way throughout (another convention) is re-ordered silently; one whose cells disagree
+    (some negative, some positive: a cell numbered backwards, or a tangled mesh, whose re-ordered
+    cells would overlap) is re-ordered with a :class:`msslib.errors.MsslibWarning` naming them."""
+    measures = _mesh.cell_measures(mesh)
+    negative = np.flatnonzero(measures < 0)
+    if 0 < len(negative) < mesh.n_cells:
+        from msslib.errors import MsslibWarning
+
+        shown = ", ".join(str(c) for c in negative[:3]) + (", ..." if len(negative) > 3 else "")
+        warnings.warn(f"scene.geometry: {what} has {len(negative)} of {mesh.n_cells} {mesh.cell_type} cells numbered "
+                      f"against the others (negative measure; cell {shown}); they were re-ordered. Right if only "
+                      f"their node order is reversed; a tangled mesh (a node moved through a neighbour) stays wrong",
+                      MsslibWarning, stacklevel=4)
+    return _mesh.orient(mesh)
+
+
 def _build_mesh(scene: Scene) -> _mesh.Mesh:
     geo = scene.geometry
     if "file" in geo:
@@ -23,12 +41,12 @@ def _build_mesh(scene: Scene) -> _mesh.Mesh:
             _fail("scene.geometry.file", str(exc))
         _check_size("scene", geo, scene.model, scene.solver, scene.output, scene.checks, n_nodes=mesh.n_nodes,
                     dim=mesh.dim)
-        mesh = _mesh.orient(mesh)
+        mesh = _oriented(mesh, f"the mesh file {geo['file'].name}")
     elif "mesh" in geo:  # an in-memory mesh (the API): used as given, oriented like a file's
         mesh = geo["mesh"]
         _check_size("scene", geo, scene.model, scene.solver, scene.output, scene.checks, n_nodes=mesh.n_nodes,
                     dim=mesh.dim)
-        mesh = _mesh.orient(mesh)
+        mesh = _oriented(mesh, "the in-memory mesh")
     else:
         fn = _generator_function(geo["generator"])
         try:
