@@ -280,7 +280,7 @@ rule table:
 rule stability:
     """Hard cases: where each model breaks, and how."""
     input:
-        script=["experiments/stability.py", "experiments/stability_cases.py", "experiments/stability_common.py"],
+        script=sorted(str(p) for p in Path("experiments", "stability").glob("*.py")) + ["experiments/stability/cases.yaml"],
         derived="paper/derivations.json",
         code=MSSLIB,
     output:

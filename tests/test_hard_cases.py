@@ -1,31 +1,34 @@
 """Hard cases of the mass-spring models: the behaviour measured by ``experiments.stability``.
 
-The cases are built by the helpers of that script (loaded from its file), so the test suite and
-the recorded experiment cannot drift apart.  Meshes are kept small (the whole module runs in
-well under half a minute); every threshold below is the measured value plus a margin, and its
-comment says why the behaviour is what it is.
+The cases are the study's own (``experiments/stability/cases.yaml``, run as scenes by
+:func:`msslib.scene.run_scene` through :mod:`experiments.stability.study`, at the sizes of
+``--quick``), so the test suite and the recorded experiment cannot drift apart.  Every threshold
+below is the measured value plus a margin, and its comment says why the behaviour is what it is.
 """
 
 from __future__ import annotations
-
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 import yaml
 
-from experiments import stability_cases, stability_common
-from msslib.models.common import assemble_springs
+from experiments.stability import scenes, shapes, study
 from msslib import cli
 from msslib import mesh as M
-from msslib import system as MD
 from msslib import solvers as S
 from msslib.errors import StabilityError
-from msslib.scene import load_scene, prepare
+from msslib.models.common import assemble_springs
+from msslib.scene import load_scene, prepare, run_scene
 
-# the hard-case study's cases and their shared pieces, as one namespace
-st = SimpleNamespace(**{k: v for m in (stability_common, stability_cases) for k, v in vars(m).items()
-                        if not k.startswith("__")})
+DATA = scenes.load_cases()
+E0 = float(DATA["E"])
+NU_VALUES = (0.45, 0.49, 0.499, 0.4999)
+MODELS = list(DATA["models"])
+MSS_MODELS = [m for m in MODELS if not study.is_fem(DATA["models"][m])]
+
+
+def case(name):
+    return study.static_case(name, DATA["cases"][name], DATA, quick=True)
 
 
 # --------------------------------------------------------------------------------------------
@@ -35,10 +38,10 @@ st = SimpleNamespace(**{k: v for m in (stability_common, stability_cases) for k,
 
 @pytest.fixture(scope="module")
 def nu_results():
-    return {nu: st.nu_case(nu, n=2) for nu in st.NU_VALUES}
+    return {nu: case(f"nu_{nu}") for nu in NU_VALUES}
 
 
-@pytest.mark.parametrize("nu", st.NU_VALUES)
+@pytest.mark.parametrize("nu", NU_VALUES)
 def test_nu_sweep_golec_derived_follows_neohookean(nu_results, nu):
     r = nu_results[nu]
     ref, golec = r["fem_neohookean"], r["golec_derived"]
@@ -69,9 +72,9 @@ def test_nu_4999_golec_keeps_volume_springs_alone_do_not(nu_results):
 
 
 def test_nu_sweep_springs_only_volume_does_not_depend_on_nu(nu_results):
-    v = [nu_results[nu]["golec_springs_only"]["volume_ratio"] for nu in st.NU_VALUES]
+    v = [nu_results[nu]["golec_springs_only"]["volume_ratio"] for nu in NU_VALUES]
     assert np.ptp(v) < 1e-6
-    loss_ref = [1.0 - nu_results[nu]["fem_neohookean"]["volume_ratio"] for nu in st.NU_VALUES]
+    loss_ref = [1.0 - nu_results[nu]["fem_neohookean"]["volume_ratio"] for nu in NU_VALUES]
     assert loss_ref == sorted(loss_ref, reverse=True)  # the reference loses less and less
 
 
@@ -82,12 +85,12 @@ def test_nu_sweep_springs_only_volume_does_not_depend_on_nu(nu_results):
 
 @pytest.fixture(scope="module")
 def compression():
-    return {c: st.compression_case(c, n=3) for c in (0.3, 0.5)}
+    return {c: case(f"compress_{round(100 * c)}") for c in (0.3, 0.5)}
 
 
 def test_compression_30_percent_converges(compression):
     r = compression[0.3]
-    for name in st.MSS_MODELS + st.FEM_MODELS:
+    for name in MODELS:
         assert r[name]["converged"], (name, r[name]["outcome"])
     for name in ("golec_derived", "golec_published", "golec_springs_only", "baudet_cube",
                  "lloyd_tetrahedron_volume", "fem_neohookean"):
@@ -100,7 +103,7 @@ def test_compression_30_percent_converges(compression):
 
 def test_compression_50_percent(compression):
     r = compression[0.5]
-    for name in st.MSS_MODELS:  # with a sensible force scale every model converges ...
+    for name in MSS_MODELS:  # with a sensible force scale every model converges ...
         assert r[name]["converged"], (name, r[name]["outcome"])
     # ... the neo-Hookean reference and Golec's cube without inverting an element
     assert r["fem_neohookean"]["n_inverted"] == 0
@@ -115,10 +118,13 @@ def test_compression_50_percent(compression):
 def test_default_force_scale_under_displacement_control():
     """Under pure displacement control the convergence scale is ||K(x0) u_prescribed||, finite even
     when the prescribed state is force-free (50 % compression of 4 layers lands on a mirror image)."""
-    hexm, _ = st.cube_meshes(0.1, 4)
-    fixed, presc, _ = st.clamped_bc(hexm, 0.5)
-    model = MD.Model(hexm, st.mss_terms("golec_springs_only", hexm, [(st.E0, 0.3)]), fixed=fixed, prescribed=presc)
-    S.static_solve(model, model.x0, load_steps=10, max_cuts=2)
+    spec = DATA["cases"]["compress_50"]
+    sc = scenes.scene("compress_50", spec, "hexahedron", DATA["models"]["golec_springs_only"]["model"], DATA, False)
+    model = prepare(load_scene(sc)).model
+    res = S.static_solve(model, model.x0, load_steps=10, max_cuts=2)
+    xp = model.apply_prescribed(model.x0, 1.0)
+    assert res.force_scale == pytest.approx(np.linalg.norm(model.stiffness(model.x0) @ (xp - model.x0)), rel=1e-12)
+    assert res.force_scale > 0
 
 
 # --------------------------------------------------------------------------------------------
@@ -126,11 +132,17 @@ def test_default_force_scale_under_displacement_control():
 # --------------------------------------------------------------------------------------------
 
 
-def test_inverted_input_is_refused_by_every_model():
-    r = st.inverted_case()
-    for name in st.MSS_MODELS + st.FEM_MODELS:
-        assert not r[name]["ran"], name
-        assert "inverted" in r[name]["outcome"] and "cell 1 " in r[name]["outcome"], r[name]["outcome"]
+def test_inverted_input_is_said_and_reordered_for_every_model():
+    """A cell numbered backwards: the scene loader warns naming it, re-orders it, and every model
+    then gives the result of the consistently numbered mesh (the independent run)."""
+    r = study.inverted_case("inverted_input", DATA["cases"]["inverted_input"], DATA, quick=True)
+    assert list(r) == MODELS
+    for name in MODELS:
+        assert r[name]["ran"] and r[name]["converged"], (name, r[name]["outcome"])
+        assert r[name]["outcome"].startswith("detected and re-ordered:"), r[name]["outcome"]
+        assert "cell 1)" in r[name]["outcome"] and "numbered against the others" in r[name]["outcome"]
+        assert r[name]["error"] < 1e-12, name  # the same displacement as the consistent mesh's
+        assert r[name]["n_inverted"] == 0
 
 
 # --------------------------------------------------------------------------------------------
@@ -140,26 +152,26 @@ def test_inverted_input_is_refused_by_every_model():
 
 @pytest.mark.parametrize("nu", [0.25, 0.3, 0.45])
 def test_elementwise_least_squares_reproduces_lloyd_on_regular_tetrahedron(nu):
-    X = st.shape_coordinates("regular")
-    k, _ = st.elementwise_lsq(X, st.E0, nu)
-    np.testing.assert_allclose(k, st.lloyd_constant(X, st.E0, nu), rtol=1e-9)
+    X = shapes.shape_coordinates("regular")
+    k, _ = shapes.elementwise_lsq(X, E0, nu)
+    np.testing.assert_allclose(k, shapes.lloyd_constant(X, E0, nu), rtol=1e-9)
 
 
 @pytest.mark.parametrize("shape, n_negative", [("sliver", 2), ("cap", 3), ("wedge", 1), ("spindle", 0)])
 def test_bad_tetrahedra_least_squares_constants(shape, n_negative):
-    X = st.shape_coordinates(shape)
-    assert st.lloyd_constant(X, st.E0, 0.3) > 0  # the equivalent-edge formula stays positive
-    k, _ = st.elementwise_lsq(X, st.E0, 0.3)
+    X = shapes.shape_coordinates(shape)
+    assert shapes.lloyd_constant(X, E0, 0.3) > 0  # the equivalent-edge formula stays positive
+    k, _ = shapes.elementwise_lsq(X, E0, 0.3)
     assert int((k < 0).sum()) == n_negative
 
 
 def test_sliver_negative_constant_rejected_by_springs_with_its_index():
-    X = st.shape_coordinates("sliver")
-    k, _ = st.elementwise_lsq(X, st.E0, 0.3)
+    X = shapes.shape_coordinates("sliver")
+    k, _ = shapes.elementwise_lsq(X, E0, 0.3)
     mesh = M.Mesh(X, np.array([[0, 1, 2, 3]]), "tetra")
     edges = M.unique_edges(mesh)
     pairs = edges.pairs
-    local = {tuple(sorted(e)): i for i, e in enumerate(st.TET_EDGES.tolist())}
+    local = {tuple(sorted(e)): i for i, e in enumerate(shapes.TET_EDGES.tolist())}
     k_pairs = k[[local[tuple(p)] for p in pairs.tolist()]]
     bad = np.flatnonzero(k_pairs <= 0)
     assert len(bad) == 2
@@ -176,9 +188,9 @@ def test_sliver_negative_constant_rejected_by_springs_with_its_index():
 
 
 def test_contrast_1000_bar_golec_matches_fem():
-    homogeneous = st.contrast_case(1.0, n=(4, 1, 1))
-    contrast = st.contrast_case(1000.0, n=(4, 1, 1))
-    for name in st.MSS_MODELS:
+    homogeneous = case("contrast_1")
+    contrast = case("contrast_1000")
+    for name in MSS_MODELS:
         assert contrast[name]["converged"], (name, contrast[name]["outcome"])
     # Golec's derived lattice is exact for homogeneous strain; what remains comes from the clamped
     # end and the material interface: 1.5 % for one material, 2.9 % at 1000x (measured on this
@@ -200,30 +212,35 @@ def test_contrast_1000_bar_golec_matches_fem():
 
 @pytest.mark.parametrize("name", ["golec_derived", "lloyd_tetrahedron"])
 def test_explicit_step_above_limit_diverges_implicit_is_stable(name):
-    model = st.cantilever(name)
-    limit = S.explicit_stability_limit(model, model.x0)
-    dt = 1.5 * limit
-    v0 = np.zeros(model.n_dof)
+    spec, cells, model = DATA["cases"]["explicit_1.5x"], DATA["models"][name]["cells"], DATA["models"][name]["model"]
+
+    def dynamic(**kw):
+        return scenes.scene("explicit_1.5x", spec, cells, model, DATA, True, **kw)
+
+    static = scenes.scene("explicit_1.5x", spec, cells, model, DATA, True, static=True)
+    system = prepare(load_scene(static)).model
+    dt = 1.5 * S.explicit_stability_limit(system, system.x0)
     with pytest.raises(StabilityError, match="1.5 x the explicit stability limit"):  # refused up front
-        S.integrate(model, model.x0, v0, dt=dt, t_end=100 * dt, method="symplectic_euler", damping=0.0)
+        run_scene(dynamic(dt=dt, t_end=100 * dt), progress=False)
     with pytest.raises(S.DivergenceError, match="symplectic_euler diverged") as info:
-        S.integrate(model, model.x0, v0, dt=dt, t_end=100 * dt, method="symplectic_euler", damping=0.0,
-                    allow_unstable=True)
+        run_scene(dynamic(dt=dt, t_end=100 * dt, allow_unstable=True), progress=False)
     assert info.value.step < 30  # the highest mode grows ~6.9x per step at omega dt = 3
     assert np.isfinite(info.value.x_last).all() and np.isfinite(info.value.v_last).all()
-    res = S.integrate(model, model.x0, v0, dt=dt, t_end=40 * dt, method="implicit_euler", damping=0.0)
-    assert np.isfinite(res.x).all() and np.isfinite(res.v).all()
-    u_static = np.abs(S.static_solve(model, model.x0).x - model.x0).max()
+    sc = dynamic(dt=dt, t_end=40 * dt, method="implicit_euler")
+    sc["output"] = {"history": True}
+    u = run_scene(sc, progress=False)["displacement_history"].values
+    assert np.isfinite(u).all()
+    u_static = np.abs(run_scene(static, progress=False)["displacement"].values).max()
     # a suddenly applied load overshoots to at most twice the static deflection (undamped,
     # linear); implicit Euler only removes energy
-    assert np.abs(res.x - model.x0).max() <= 2.0 * u_static
+    assert np.abs(u).max() <= 2.0 * u_static
 
 
 def _cantilever_scene(method, dt, t_end):
     return {
         "name": "cantilever_over_limit",
         "geometry": {"generator": "hex_grid", "args": {"lx": 0.2, "ly": 0.05, "lz": 0.05, "nx": 4, "ny": 1, "nz": 1}},
-        "materials": [{"E": st.E0, "nu": 0.3, "density": st.DENSITY}],
+        "materials": [{"E": E0, "nu": 0.3, "density": float(DATA["density"])}],
         "model": {"type": "golec_cube", "A": 1.0},
         "boundary": [{"select": {"plane": ["x", 0.0]}, "fix": "all"}],
         "loads": [{"type": "gravity", "g": [0.0, 0.0, -9.81]}],
