@@ -170,9 +170,12 @@ def _figures(raw, cases, models, reference):
         columns = fig.get("columns")
         if not isinstance(columns, list) or not columns:
             _fail(f"{where}.columns", "must be a non-empty list of {title, case, variant, reference}")
-        out[name] = {"kind": kind, "caption": fig["caption"].strip(), "options": options,
-                     "columns": [_column(f"{where}.columns[{k}]", c, cases, models, reference)
-                                 for k, c in enumerate(columns)]}
+        checked = [_column(f"{where}.columns[{k}]", c, cases, models, reference) for k, c in enumerate(columns)]
+        titles = [c["title"] for c in checked]
+        for k, title in enumerate(titles):
+            if title in titles[:k]:
+                _fail(f"{where}.columns[{k}].title", f"{title!r} names two columns")
+        out[name] = {"kind": kind, "caption": fig["caption"].strip(), "options": options, "columns": checked}
     return out
 
 

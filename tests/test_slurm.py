@@ -35,8 +35,9 @@ TARGETS = [
     "paper/figures/lloyd_membrane_square.png",
     "paper/tables/lloyd_load_sweep.md",
 ]
-# the rules these targets need, one job each (the figure reads the runs, the table the study)
-JOBS = {"experiment_lloyd_membrane_square", "experiment_compare", "figure", "study", "table"}
+# the rules these targets need, one job each (the figure, declared in the experiment file, reads the runs;
+# the table the study)
+JOBS = {"experiment_lloyd_membrane_square", "experiment_compare", "experiment_figure", "study", "table"}
 # for this machine's small cluster: job states from squeue (no accounting database; the cluster keeps
 # finished jobs for an hour), the first status check after a second, and the jobs' logs kept
 CLUSTER_OPTIONS = ["--slurm-status-command", "squeue", "--slurm-init-seconds-before-status-checks", "1",

@@ -25,12 +25,13 @@ import os
 for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
     os.environ.setdefault(_v, "1")  # single thread, before numpy is imported
 
-import argparse
 import math
 from pathlib import Path
 
 import numpy as np
 import yaml
+
+from experiments import script
 
 HERE = Path(__file__).resolve().parent
 LONG = 2.0  # s: runs longer than this are timed once
@@ -146,10 +147,7 @@ def crossover(front):
 def main(scene: str, levels, quick_levels=(0, 1), below=1):
     from msslib.results import write_result
 
-    p = argparse.ArgumentParser(description=f"speed against error for {scene}")
-    p.add_argument("--out", required=True)
-    p.add_argument("--quick", action="store_true")
-    a = p.parse_args()
+    a = script.args(f"speed against error for {scene}")
     front = measure(HERE / "scenes" / scene, quick_levels if a.quick else levels, repeats=1 if a.quick else 3,
                     progress=lambda s: print(s, flush=True), below=below)
     front.attrs["scene_file"] = f"experiments/performance/scenes/{scene}"

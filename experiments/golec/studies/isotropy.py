@@ -18,13 +18,13 @@ k_f/2 and k_c, errata 4), which gives an isotropic spring lattice with nu = 1/4 
   W = 2 G45 eps^2 V. An isotropic lattice has G = G45 = E/(2(1+nu)).
 """
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from experiments import script
 from msslib.models.common import assemble_springs
 from msslib.models.golec import golec_cube_springs
 from msslib.results import write_result
@@ -104,10 +104,7 @@ def shear45(mesh, E, nu, A, published):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--quick", action="store_true")
-    args = ap.parse_args()
+    args = script.args(__doc__)
     A_values = [0.5, 1.0, 4.0] if args.quick else [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0]
     constants = ["derived", "published", "printed_totals"]
     mesh = hex_grid(L, L, L, N, N, N)

@@ -25,13 +25,13 @@ and measures:
   reference) and triquadratic (Q2, which does not lock in bending: the converged reference).
 """
 
-import argparse
 import time
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from experiments import script
 from experiments.golec.studies.isotropy import L, N, STRAIN
 from msslib import fem
 from msslib.experiment import load_experiment, scene_of
@@ -109,10 +109,7 @@ def beam_q2(nu, quick):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--quick", action="store_true")
-    args = ap.parse_args()
+    args = script.args(__doc__)
     t0 = time.perf_counter()
     nv = (len(NUS), len(VARIANTS))
     out = {k: np.full(nv, np.nan) for k in ("E_eff", "nu_eff", "compression_min_eigenvalue", "compression_volume",

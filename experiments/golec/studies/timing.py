@@ -17,7 +17,6 @@ figure; the full 10 s are simulated (--quick: 0.2 s, the 10 s wall time extrapol
 --quick simulates 0.5 s in the other runs. Wall times are of this single-threaded Python/numba code.
 """
 
-import argparse
 import os
 import time
 from pathlib import Path
@@ -25,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from experiments import script
 from msslib.explicit import LatticeExplicit
 from msslib.results import mesh_from_result, write_result
 from msslib.metrics import mesh_volume
@@ -96,10 +96,7 @@ def comparable(t_end):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--quick", action="store_true")
-    args = ap.parse_args()
+    args = script.args(__doc__)
     t_end = 0.5 if args.quick else 10.0
     ds_run, dt = timed(4.0e5, 0.3, t_end)
     u = ds_run["displacement"].transpose("node", "axis").values

@@ -12,7 +12,6 @@ the wrinkled states (volume and largest downward displacement also for golec_pub
 FEM reference), and the node positions of both states for the figures.
 """
 
-import argparse
 import time
 from pathlib import Path
 
@@ -20,6 +19,7 @@ import numpy as np
 import xarray as xr
 from scipy.optimize import minimize
 
+from experiments import script
 from msslib.experiment import load_experiment, run, scene_of
 from msslib.results import mesh_from_result, write_result
 from msslib.metrics import mesh_volume
@@ -55,10 +55,7 @@ def relax(model, x_start):
 
 
 def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--quick", action="store_true")
-    args = ap.parse_args()
+    args = script.args(__doc__)
     ds = xr.Dataset(coords={"experiment": list(EXPERIMENTS), "variant": VARIANTS})
     shape = (len(EXPERIMENTS), len(VARIANTS))
     out = {k: np.full(shape, np.nan) for k in ("min_eigenvalue", "volume_symmetric", "volume_wrinkled",

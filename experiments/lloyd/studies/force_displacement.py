@@ -14,13 +14,13 @@ about two between them).
 
 from __future__ import annotations
 
-import argparse
 import warnings
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from experiments import script
 from msslib.models.lloyd import lloyd_square_springs, lloyd_triangle_springs
 from msslib import fem
 from msslib import mesh as M
@@ -81,10 +81,7 @@ def slope(forces, disp, side, limit=np.inf):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="NetCDF file to write")
-    ap.add_argument("--quick", action="store_true", help="fewer force levels")
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     n = 9 if args.quick else 41
     forces = np.linspace(-F_MAX, F_MAX, n)
     shapes = ["triangle", "square"]

@@ -21,7 +21,6 @@ other experiments are written as rows of NaN (same labels as the full build).
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
 import sys
 import time
@@ -31,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from experiments import script
 from msslib.experiment import UNITS, compare, load_experiment, scene_of
 from msslib.results import write_result
 from msslib.scene import load_scene, run_scene
@@ -301,11 +301,10 @@ def dataset(rows, n_level, quick):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="NetCDF file to write")
-    ap.add_argument("--quick", action="store_true", help="two small experiments, two loads")
-    ap.add_argument("--only", nargs="*", help="experiments to run (default: all)")
-    args = ap.parse_args(argv)
+    def extra(p):
+        p.add_argument("--only", nargs="*", help="experiments to run (default: all)")
+
+    args = script.parse(__doc__, argv, extra=extra)[1]
     names = args.only or (QUICK if args.quick else list(EXPERIMENTS))
     rows = []
     t0 = time.perf_counter()

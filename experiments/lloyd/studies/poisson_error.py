@@ -13,13 +13,13 @@ nu = 1/3, where eq. 8 is exact.
 
 from __future__ import annotations
 
-import argparse
 import warnings
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from experiments import script
 from msslib.results import write_result
 from msslib.metrics import displacement_error
 from msslib.scene import run_scene
@@ -43,10 +43,7 @@ def scene(model, nu, traction):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="NetCDF file to write")
-    ap.add_argument("--quick", action="store_true", help="fewer values of nu")
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     nus = np.array([0.0, 1 / 3, 0.49]) if args.quick else np.append(np.arange(0.0, 0.46, 0.05), [1 / 3, 0.49])
     nus = np.unique(nus)
     cases = list(LOADS)

@@ -39,13 +39,13 @@ percent").
 
 from __future__ import annotations
 
-import argparse
 import warnings
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
+from experiments import script
 from msslib.models.lloyd import lloyd_square_springs, lloyd_triangle_springs
 from msslib import fem
 from msslib import mesh as M
@@ -204,10 +204,7 @@ def run(section, case, factor):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="NetCDF file to write")
-    ap.add_argument("--quick", action="store_true", help="the same runs (all are small)")
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     rows = []
     for section in ("5.1", "5.3"):
         for case in DIRECTION:

@@ -27,7 +27,6 @@ element turned by a fixed rotation) show which zeros belong to the orientation.
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +38,7 @@ from derivations import mss as smss
 from derivations.elasticity import E as E_sym
 from derivations.elasticity import nu as nu_sym
 from derivations.elasticity import t as t_sym
+from experiments import script
 from msslib import fem
 from msslib import mesh as M
 from msslib.system import Model
@@ -226,10 +226,7 @@ def dataset(rows, quick):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="NetCDF file to write")
-    ap.add_argument("--quick", action="store_true", help="the same computation (it is small)")
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     ds = dataset(study(), args.quick)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)

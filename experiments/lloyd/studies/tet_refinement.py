@@ -23,7 +23,6 @@ Four parts, one NetCDF:
 
 from __future__ import annotations
 
-import argparse
 import time
 import warnings
 from pathlib import Path
@@ -35,6 +34,7 @@ import xarray as xr
 import yaml
 from scipy.stats import spearmanr
 
+from experiments import script
 from experiments.script import LoadSegment
 from msslib.compare import interpolate
 from msslib.results import mesh_from_result, write_result
@@ -331,10 +331,7 @@ def part_path(sc, loads, progress, label):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", required=True, help="NetCDF file to write")
-    ap.add_argument("--quick", action="store_true", help="the coarsest level, coarse references and meshes")
-    args = ap.parse_args(argv)
+    args = script.args(__doc__, argv)
     t0 = time.perf_counter()
 
     def progress(text):
