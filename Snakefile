@@ -17,6 +17,8 @@
 # Every study, figure and table takes one command line: --out PATH (a study's NetCDF file, a figure's
 # stem: STEM.png and STEM.pdf, a table's Markdown file) and --quick (figures and tables accept it).
 
+import hashlib
+import json
 from pathlib import Path
 
 import yaml
@@ -139,12 +141,20 @@ rule scene:
 
 # One job per experiment runs all its (case, model) pairs in one process (the imports cost more
 # than a small run); each pair is still its own NetCDF file.
+def run_spec(path):
+    """A digest of an experiment file without its figures block: what its runs depend on. The run rules
+    take it as a parameter instead of the file as an input, so that editing a figure reruns no run
+    (Snakemake reruns a job whose parameters changed)."""
+    raw = yaml.safe_load(Path(path).read_text())
+    raw.pop("figures", None)
+    return hashlib.sha256(json.dumps(raw, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
 for (_paper, _exp), _path in experiments().items():
     rule:
         name:
             f"experiment_{_paper}_{_exp}"
         input:
-            exp=str(_path),
             # mesh files the experiments of this paper read (experiments/<paper>/meshes/)
             meshes=sorted(str(p) for p in Path("experiments", _paper, "meshes").glob("*") if p.suffix != ".py"),
             derived="paper/derivations.json",
@@ -152,12 +162,14 @@ for (_paper, _exp), _path in experiments().items():
         output:
             [f"results/{_paper}/{_exp}/{r}.nc" for r in runs(_paper, _exp)],
         params:
+            exp=str(_path),
+            spec=run_spec(_path),
             quick=QFLAG,
             outdir=f"results/{_paper}/{_exp}",
         log:
             f"logs/{_paper}/{_exp}/runs.log",
         shell:
-            "python -m msslib experiment run-all {input.exp} --out-dir {params.outdir} {params.quick} --quiet > {log} 2>&1"
+            "python -m msslib experiment run-all {params.exp} --out-dir {params.outdir} {params.quick} --quiet > {log} 2>&1"
 
 
 rule experiment_compare:
