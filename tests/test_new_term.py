@@ -114,7 +114,10 @@ DENSITY, SIZE, N = 1000.0, 0.02, 2
 
 @pytest.fixture()
 def family(tmp_path, monkeypatch):
-    """The term and the family as two new files; the family is found by the registry's own scan."""
+    """The term and the family as two new files; the family is found by the registry's own scan
+    (the scene's module-level tables of the shipped models are built before, and stay as they are)."""
+    import msslib.scene  # noqa: F401
+
     (tmp_path / "tether_term.py").write_text(textwrap.dedent(TERM))
     fam = tmp_path / "families"
     fam.mkdir()

@@ -15,7 +15,7 @@ from msslib.fem.materials import _cell_materials, _check_plane, _law, lame
 from msslib.fem.space import _boundary, _Geometry, _linear_stiffness, _skfem_linear_stiffness
 from msslib.errors import MsslibWarning
 from msslib.mesh import CELL_TYPES, Mesh
-from msslib.models.fem import warn_locking
+from msslib.models.references import warn_locking
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,7 @@
 """The simulator models, one module per family, found by scanning this package.
 
-Each family module (``lloyd``, ``baudet``, ``golec``, ``fem``) holds its parameter dataclasses and
-functions (constants from :mod:`msslib.generated`, with their checks), its builders, and a
+Each family module (``lloyd``, ``baudet``, ``golec``, ``delingette``, ``lsq``; ``references``, the
+FEM references) holds its parameter dataclasses and functions (constants from :mod:`msslib.generated`, with their checks), its builders, and a
 module-level ``SPECS`` tuple of :class:`ModelSpec`.  :func:`registry` imports every module of the
 package and collects the specs: adding a model is adding a module (or a spec to one); scenes,
 :mod:`msslib.parameters`, :mod:`msslib.planning` and the tests read the registry.

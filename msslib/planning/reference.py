@@ -17,7 +17,7 @@ three levels the observed order ``p = log2(c_1 / c_2)`` of the two changes at th
 nodes gives Richardson's ``c / (2^p - 1)`` for what is left after the last refinement, else
 (``p`` not positive, or two levels only) ``c`` itself.  One level only: no estimate (NaN).
 
-Locking: at nu >= :data:`msslib.models.fem.LOCKING_NU` (3D or plane strain), even quadratic
+Locking: at nu >= :data:`msslib.models.references.LOCKING_NU` (3D or plane strain), even quadratic
 displacement elements keep some volumetric locking (a few per cent at nu = 0.4999 on a clamped
 cube, shrinking slowly under refinement); the reference then integrates the volumetric term with
 the reduced rule (``volumetric="reduced"`` of :mod:`msslib.fem`: P2-P0 on simplices, selective
@@ -36,7 +36,7 @@ import numpy as np
 def nearly_incompressible(setup) -> float | None:
     """The largest nu of the scene when its linear or quadratic displacement elements would lock
     (nu >= LOCKING_NU in 3D or plane strain), else None."""
-    from msslib.models.fem import LOCKING_NU
+    from msslib.models.references import LOCKING_NU
 
     nu = max(m.nu for m in setup.scene.materials)
     plane = setup.scene.model_options.get("plane", "stress") if setup.mesh.dim == 2 else None

@@ -89,7 +89,7 @@ class Scene:
 
     @property
     def is_fem(self) -> bool:
-        return self.model in FEM_MODELS
+        return self.model in _models.names("fem")
 
     @property
     def is_dynamic(self) -> bool:
@@ -234,7 +234,7 @@ def _model(path, value):
     if not isinstance(value, Mapping):
         _fail(path, f"expected a model name or a mapping with 'type', got {value!r}")
     _mapping(path, value, ("type", "published", "terms", *_models.option_names()), required=("type",))
-    name = _choice(type_path, value["type"], MODELS, "model")
+    name = _choice(type_path, value["type"], _models.names(), "model")  # live: a family added later counts
     spec = _models.get(name)
     opts = {"published": False, "A": None, "terms": None, "plane": "stress"}
     for key in value:
@@ -342,12 +342,12 @@ def _solver(path, value, model):
             "load_steps": _integer(f"{path}.load_steps", value.get("load_steps", 1), maximum=MAX_LOAD_STEPS,
                                    why=" (each load step is a Newton solve)"),
             "tol": _number(f"{path}.tol", value.get("tol", 1e-8), low=0.0),
-            "max_iter": _integer(f"{path}.max_iter", value.get("max_iter", 50 if model in MSS_MODELS else 30),
+            "max_iter": _integer(f"{path}.max_iter", value.get("max_iter", 50 if model in _models.names("mss") else 30),
                                  maximum=MAX_NEWTON_ITERATIONS, why=" (Newton converges in tens of iterations or not at all)"),
         }
     _mapping(path, value, ("type", "method", "dt", "t_end", "damping", "save_every", "allow_unstable", "load_curve"),
              required=("dt", "t_end"))
-    if model in FEM_MODELS:
+    if model in _models.names("fem"):
         _fail(f"{path}.type", f"dynamic runs need an MSS model; {model} is static only")
     damping = value.get("damping", 0.0)
     if isinstance(damping, (list, tuple)):
@@ -431,7 +431,7 @@ def _check_size(root, geometry, model, solver, output, checks, n_nodes=None, dim
             return
         n_nodes *= (2**dim) ** geometry.get("refine", 0)  # about: a refinement multiplies the nodes by 2^dim
     n_saved = _saved_states(solver, output)
-    estimate = resources.run_memory(n_nodes, dim, fem=model in FEM_MODELS, n_saved=n_saved)
+    estimate = resources.run_memory(n_nodes, dim, fem=model in _models.names("fem"), n_saved=n_saved)
     history = resources.history_memory(n_saved, n_nodes * dim)
     if history > 0.5 * estimate:
         what = (f"{root}.solver: {n_saved:.3g} saved states of {n_nodes:.3g} nodes (dt = {solver['dt']:g} s, "
@@ -499,7 +499,7 @@ def load_scene(source, *, base_dir=None) -> Scene:
         if geometry.get("generator") and GENERATORS[geometry["generator"]] == 3:
             _fail(f"{root}.thickness", f"applies to 2D meshes only; {geometry['generator']} is 3D")
     model, options = _model(f"{root}.model", raw["model"])
-    if "generator" in geometry and model in MSS_MODELS:
+    if "generator" in geometry and model in _models.names("mss"):
         dim, spec = GENERATORS[geometry["generator"]], _models.get(model)
         if spec.dim != dim:
             _fail(f"{root}.model", f"{model} needs {spec.cell_type} cells, "
