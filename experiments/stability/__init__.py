@@ -52,7 +52,6 @@ Cases (dimension ``case``):
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 import warnings
@@ -61,6 +60,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from experiments.script import parse
 from experiments.stability.scenes import load_cases
 from experiments.stability.shapes import SHAPES, TET_EDGES
 from experiments.stability.study import FIELDS, record, run_all
@@ -134,10 +134,7 @@ def summary(ds) -> str:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m experiments.stability", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--out", required=True, help="result file (NetCDF)")
-    parser.add_argument("--quick", action="store_true", help="smaller meshes and fewer steps")
-    args = parser.parse_args(argv)
+    _, args = parse(__doc__, argv)  # the one command line of experiments/: --out, --quick
     out = Path(args.out)
     if not out.parent.is_dir():
         print(f"stability: error: directory {str(out.parent)!r} does not exist", file=sys.stderr)
