@@ -60,7 +60,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from experiments.script import parse
+from experiments import script
 from experiments.stability.scenes import load_cases
 from experiments.stability.shapes import SHAPES, TET_EDGES
 from experiments.stability.study import FIELDS, record, run_all
@@ -134,7 +134,7 @@ def summary(ds) -> str:
 
 
 def main(argv=None) -> int:
-    _, args = parse(__doc__, argv)  # the one command line of experiments/: --out, --quick
+    _, args = script.parse(__doc__, argv)  # the one command line of experiments/: --out, --quick
     out = Path(args.out)
     if not out.parent.is_dir():
         print(f"stability: error: directory {str(out.parent)!r} does not exist", file=sys.stderr)
