@@ -1,6 +1,6 @@
 """The formats and file names of ``msslib export``: which formats a model can be written in, the
 paths of the outputs, the writer of each, and :func:`write_outputs`, which writes them all or none
-with a manifest of what the export owns. ``not_carried`` is re-exported for the command line.
+with a manifest of what the export owns.
 
 The manifest (``STEM.export-manifest.json``, :data:`MANIFEST_SCHEMA`) lists every file the export
 wrote with its SHA-256. A later export to the same stem replaces those files and removes the ones it
@@ -25,7 +25,7 @@ from typing import Callable
 from msslib.export import simulators as export_simulators
 from msslib.export import text as export_text
 from msslib.errors import MsslibWarning
-from msslib.export.model import C_HEADER_PATH, MssExport, _safe_name, c_header_paths, not_carried  # noqa: F401
+from msslib.export.model import C_HEADER_PATH, MssExport, _safe_name, c_header_paths
 from msslib.export.model import _version
 from msslib.results.staging import TEMP_TAG, StagedOutputs, terminate_raises
 
