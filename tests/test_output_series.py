@@ -107,7 +107,7 @@ def _stage_time(n_files: int, directory) -> float:
 
 def test_staging_a_long_series_takes_linear_time(tmp_path):
     small = min(_stage_time(300, tmp_path) for _ in range(3))
-    large = _stage_time(3000, tmp_path)
+    large = min(_stage_time(3000, tmp_path) for _ in range(2))  # the fastest of each: a busy machine only adds
     assert large / small < 30, (small, large)  # linear: about 10; quadratic: about 100
     assert os.listdir(tmp_path) == []  # every temporary file removed
 

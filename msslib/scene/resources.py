@@ -27,8 +27,10 @@ from msslib.errors import ResourceError
 __all__ = ["available_memory", "generated_mesh_size", "run_memory", "check_memory", "history_memory"]
 
 #: resident memory of a process that has imported msslib, numpy, scipy, numba and scikit-fem and
-#: compiled its kernels (B; compiling with a cold numba cache adds about 170 MB to a warm run's 250 MB)
-BASE_BYTES = 450e6
+#: compiled its kernels (B): compiling with a cold numba cache adds about 170 MB to a warm run, and
+#: the first run in a freshly installed environment peaked at 905 MB on a 9 261-node lattice (of
+#: which about 300 MB its nodes), so the fixed part is taken as 700 MB
+BASE_BYTES = 700e6
 #: bytes per node of a whole run, by (kind, dimension); see the module docstring
 PER_NODE_BYTES = {("mss", 3): 32e3, ("mss", 2): 10e3, ("fem", 3): 100e3, ("fem", 2): 30e3}
 #: copies of the history held between the integrator and the result file
