@@ -122,8 +122,6 @@ def _value(root: Path, spec: str) -> str:
     if not path.is_file():
         raise FileNotFoundError(f"{{{{value {spec}}}}}: no result file {parts[0]!r}")
     scale, fmt, sel = 1.0, ".3g", {}
-    if path.suffix == ".json":  # a key path into a JSON document (paper/derivations.json: MODULE.checks.NAME)
-        return format(_json_value(path, var, spec) * _json_scale(rest, spec), _json_fmt(rest))
     for p in rest:
         k, _, v = p.partition("=")
         if k == "scale":
@@ -132,6 +130,10 @@ def _value(root: Path, spec: str) -> str:
             fmt = v
         else:
             sel[k] = v
+    if path.suffix == ".json":  # a key path into a JSON document (paper/derivations.json: MODULE.checks.NAME)
+        if sel:
+            raise ValueError(f"{{{{value {spec}}}}}: a JSON value takes scale= and fmt= only")
+        return format(_json_value(path, var, spec) * scale, fmt)
     with xr.open_dataset(path) as ds:
         for k, v in list(sel.items()):  # labels are text in the template: match the coordinate's type
             if k in ds.coords and ds[k].dtype.kind in "fiu":
@@ -161,20 +163,6 @@ def _json_value(path: Path, key: str, spec: str) -> float:
     if isinstance(node, bool) or not isinstance(node, (int, float)):
         raise ValueError(f"{{{{value {spec}}}}}: {key!r} in {path.name} is not a number")
     return float(node)
-
-
-def _json_scale(rest, spec) -> float:
-    for p in rest:
-        k, _, v = p.partition("=")
-        if k == "scale":
-            return float(v)
-        if k != "fmt":
-            raise ValueError(f"{{{{value {spec}}}}}: a JSON value takes scale= and fmt= only")
-    return 1.0
-
-
-def _json_fmt(rest) -> str:
-    return next((p.partition("=")[2] for p in rest if p.startswith("fmt=")), ".3g")
 
 
 def _is_quick(path: Path) -> bool:

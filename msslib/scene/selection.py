@@ -21,7 +21,9 @@ def _oriented(mesh: _mesh.Mesh, what: str) -> _mesh.Mesh:
     cells would overlap) is re-ordered with a :class:`msslib.errors.MsslibWarning` naming them."""
     measures = _mesh.cell_measures(mesh)
     negative = np.flatnonzero(measures < 0)
-    if 0 < len(negative) < mesh.n_cells:
+    if not len(negative):
+        return mesh
+    if len(negative) < mesh.n_cells:
         from msslib.errors import MsslibWarning
 
         shown = ", ".join(str(c) for c in negative[:3]) + (", ..." if len(negative) > 3 else "")
