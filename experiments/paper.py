@@ -139,12 +139,18 @@ def _value(root: Path, spec: str) -> str:
             if k in ds.coords and ds[k].dtype.kind in "fiu":
                 sel[k] = ds[k].dtype.type(float(v))
         if var in ds.variables:
-            val = ds[var].sel(sel) if sel else ds[var]
-            val = float(val.values)
+            try:
+                val = float((ds[var].sel(sel) if sel else ds[var]).values)
+            except KeyError:  # a label the reduced quick build does not run (e.g. fewer ratios)
+                val = None
         elif var in ds.attrs:
             val = float(ds.attrs[var])
         else:
             raise KeyError(f"{{{{value {spec}}}}}: {var!r} is neither a variable nor an attribute of {parts[0]}")
+    if val is None:
+        if _is_quick(path):
+            return QUICK_NA
+        raise KeyError(f"{{{{value {spec}}}}}: no such label in {parts[0]}")
     if math.isnan(val):  # (infinity is a value: e.g. a budget with no upper end)
         if _is_quick(path):  # a quantity the reduced quick build does not compute
             return QUICK_NA
