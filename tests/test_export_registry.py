@@ -76,8 +76,8 @@ def _build(name, opts):
 def test_model_exports_to_every_format_and_json_round_trips(tmp_path, name, opts):
     exp = _build(name, opts)
     stem = tmp_path / "m"
-    planned = export_files.output_paths(exp, stem, export.FORMATS)
-    assert {fmt for fmt, *_ in planned} == set(export.FORMATS)
+    planned = export_files.output_paths(exp, stem, export.formats.names())
+    assert {fmt for fmt, *_ in planned} == set(export.formats.names())
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         written = export_files.write_outputs(exp, stem, planned)
@@ -176,7 +176,7 @@ def test_format_help_lists_every_format():
     from msslib.cli import build_parser
 
     help_text = " ".join(build_parser()._subparsers._group_actions[0].choices["export"].format_help().split())
-    for f in export.FORMAT_TABLE:
+    for f in export.formats.table():
         assert f"{f.name}: {' '.join(f.help.split())}" in help_text
-    assert export.FORMATS == ("csv", "json", "vtu", "mjcf", "sofa", "c")
-    assert export.SPRINGS_ONLY_FORMATS == ("mjcf", "sofa")
+    assert export.formats.names() == ("csv", "json", "vtu", "mjcf", "sofa", "c")
+    assert export.formats.whole_only() == ("mjcf", "sofa")

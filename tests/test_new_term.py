@@ -173,7 +173,7 @@ def test_every_format_exports_the_new_model_or_names_the_term_it_leaves_out(fami
         warnings.simplefilter("ignore")
         exp = export.build(_scene({"type": "static"}))
     stem = tmp_path / "m"
-    planned = export_files.output_paths(exp, stem, export.FORMATS)
+    planned = export_files.output_paths(exp, stem, export.formats.names())
     export_files.write_outputs(exp, stem, planned)
     doc, tables = read_json(stem.with_suffix(".json"))
     tethers = tables["tethers"]
@@ -183,6 +183,6 @@ def test_every_format_exports_the_new_model_or_names_the_term_it_leaves_out(fami
     np.testing.assert_allclose(np.asarray(tethers["k_t"], dtype=float), RATE * exp.masses, rtol=1e-15)
     csv = read_csv(tmp_path / "m_tethers.csv")
     np.testing.assert_array_equal(np.asarray(csv["k_t"], dtype=float), np.asarray(tethers["k_t"], dtype=float))
-    for fmt in export.FORMATS:  # the formats the term does not list say that they leave it out
+    for fmt in export.formats.names():  # the formats the term does not list say that they leave it out
         notes = export.not_carried(exp, fmt)
         assert any("tethers" in n for n in notes) == (fmt not in ("csv", "json")), (fmt, notes)

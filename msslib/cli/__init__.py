@@ -449,6 +449,7 @@ def _cmd_export(args) -> int:
     import warnings
 
     from msslib.export import files as export_files
+    from msslib.export import formats as export_formats
     from msslib import export
     from msslib.errors import MsslibWarning
 
@@ -478,13 +479,16 @@ def _cmd_export(args) -> int:
     else:
         for _, what, path, _ in planned:
             _check_writable(path, what)
-    skipped = [f for f in export.SPRINGS_ONLY_FORMATS if formats is None and f not in chosen]
+    skipped = [f for f in export_formats.whole_only() if formats is None and f not in chosen]
     if skipped:
-        warnings.warn(f"{scene.name}: {' and '.join(skipped)} not written: the model {scene.model} has "
-                      f"{'; '.join(exp.volume_terms)}, which MuJoCo and SOFA cannot express; --format "
-                      f"{','.join(skipped)} writes the rest of the model with a note", MsslibWarning, stacklevel=2)
+        left_out = list(dict.fromkeys(n for f in skipped for n in export.not_carried(exp, f)))
+        listed = " and ".join(skipped) if len(skipped) < 3 else f"{', '.join(skipped[:-1])} and {skipped[-1]}"
+        warnings.warn(f"{scene.name}: {listed} not written: the model {scene.model} has "
+                      f"{'; '.join(left_out)}, which {'they cannot' if len(skipped) > 1 else 'it cannot'} express; "
+                      f"--format {','.join(skipped)} writes the rest of the model with a note", MsslibWarning,
+                      stacklevel=2)
     for fmt in chosen:
-        missing = export.not_carried(exp, fmt) if fmt in export.SPRINGS_ONLY_FORMATS else []
+        missing = export.not_carried(exp, fmt) if fmt in export_formats.whole_only() else []
         if missing:
             warnings.warn(f"{scene.name}: the {fmt} output of model {scene.model} does not carry {'; '.join(missing)} "
                           f"(said in the file; "

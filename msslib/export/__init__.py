@@ -46,10 +46,12 @@ displacements, the loads and gravity. The writers turn it into
     header per derivation module (``msslib_<module>.h``: its spring-constant formulas, or the energy,
     gradient and Hessian kernels), all copied beside the outputs (:func:`c_header_paths`).
 
-One entry per format (name, files, writer, what it carries, help) is
-:data:`msslib.export.files.FORMAT_TABLE`; which terms a format carries each term says itself
-(:attr:`msslib.terms.Term.export_formats`), and a format that leaves one out says so in the file and
-on the command line, naming the model and the term.
+One entry per format (name, files, writer, what it carries, help) is declared in a module of
+:mod:`msslib.export.formats` and read into :func:`msslib.export.formats.table`: a new format is one
+module there and its test. Which terms a format carries each term says itself
+(:attr:`msslib.terms.Term.export_formats`; a format may also take terms by its own rule), and a
+format that leaves one out says so in the file and on the command line, naming the model and the
+term.
 
 Units are SI throughout. The writers are in :mod:`msslib.export.text` (CSV, JSON, VTU) and
 :mod:`msslib.export.simulators` (MuJoCo, SOFA); :mod:`msslib.export.files` chooses formats and
@@ -59,7 +61,7 @@ to the same stem removes those it no longer writes, and nothing else; it never o
 that is not the export's.
 """
 
-from msslib.export.files import FORMAT_TABLE, FORMATS, SPRINGS_ONLY_FORMATS, Format
+from msslib.export.formats import Format
 from msslib.export.model import (
     C_HEADER_PATH,
     SCHEMA,
@@ -73,5 +75,5 @@ from msslib.export.model import (
     not_carried,
 )
 
-__all__ = ["FORMATS", "FORMAT_TABLE", "Format", "SPRINGS_ONLY_FORMATS", "SCHEMA", "SCHEMA_VERSION", "C_HEADER_PATH", "c_header_paths", "Column",
+__all__ = ["Format", "SCHEMA", "SCHEMA_VERSION", "C_HEADER_PATH", "c_header_paths", "Column",
            "Table", "MssExport", "build", "from_setup", "not_carried"]

@@ -18,14 +18,11 @@ import re
 import secrets
 import shutil
 import warnings
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
-from msslib.export import simulators as export_simulators
-from msslib.export import text as export_text
 from msslib.errors import MsslibWarning
-from msslib.export.model import C_HEADER_PATH, MssExport, _safe_name, c_header_paths
+from msslib.export import formats as format_table
+from msslib.export.model import MssExport, _safe_name
 from msslib.export.model import _version
 from msslib.results.staging import TEMP_TAG, StagedOutputs, terminate_raises
 
@@ -37,103 +34,34 @@ MANIFEST_SUFFIX = ".export-manifest.json"
 # --------------------------------------------------------------------------------------------
 
 
-def _text(make):
-    def write(path):
-        Path(path).write_text(make(), encoding="utf-8")
-    return write
-
-
-def _csv_files(exp, stem):
-    return [(f"CSV table {name}", stem.with_name(f"{stem.name}_{name}.csv"), name) for name in exp.tables()]
-
-
-def _one_file(what, suffix):
-    return lambda exp, stem: [(what, stem.with_name(f"{stem.name}{suffix}"), None)]
-
-
-def _c_files(exp, stem):
-    return [(f"C header {p.name}", stem.with_name(p.name), p.name) for p in c_header_paths()]
-
-
-@dataclass(frozen=True)
-class Format:
-    """One export format: its ``name`` (as ``--format`` takes it), ``files(exp, stem)`` -> ``[(what,
-    path, table)]`` of the files it writes, ``writer(exp, table)`` -> ``write(path)`` of one of them,
-    what it ``carries`` (a phrase), whether it is written by default only when it carries every term
-    of the model (``whole_only``: MuJoCo and SOFA; the others are always written by default), and
-    the ``help`` text of ``msslib export --format``. Which terms a format carries the terms say
-    themselves (:attr:`msslib.terms.Term.export_formats`)."""
-
-    name: str
-    files: Callable
-    writer: Callable
-    carries: str
-    help: str
-    whole_only: bool = False
-
-
-#: every format, in the order outputs are written
-FORMAT_TABLE: tuple[Format, ...] = (
-    Format("csv", _csv_files, lambda exp, table: _text(lambda: export_text.csv_text(exp.tables()[table])),
-           "every table: nodes, springs, fixed, loads, gravity and each term's own tables",
-           "one table per file STEM_TABLE.csv, header row with units"),
-    Format("json", _one_file("JSON document", ".json"), lambda exp, table: _text(lambda: export_text.json_text(exp)),
-           "every table and term, with a schema version", "one document STEM.json with a schema version"),
-    Format("vtu", _one_file("VTU file", ".vtu"), lambda exp, table: lambda path: export_text.write_vtu(path, exp),
-           "the springs as line cells, masses, fixed axes, loads and the terms' constant forces",
-           "springs as line cells STEM.vtu (ParaView)"),
-    Format("mjcf", _one_file("MuJoCo model", "_mujoco.xml"),
-           lambda exp, table: _text(lambda: export_simulators.mjcf_text(exp)),
-           "the springs as tendons, masses, fixed axes, loads, gravity and constant forces",
-           "a MuJoCo model STEM_mujoco.xml (springs only: other terms are named in a note)", whole_only=True),
-    Format("sofa", _one_file("SOFA scene", ".scn"), lambda exp, table: _text(lambda: export_simulators.sofa_text(exp)),
-           "the springs, masses, fixed axes, loads and constant forces",
-           "a SOFA scene STEM.scn (springs only: other terms are named in a note)", whole_only=True),
-    Format("c", _c_files,
-           lambda exp, table: _text(lambda: (C_HEADER_PATH.parent / (table or C_HEADER_PATH.name)).read_text(
-               encoding="utf-8")),
-           "the generated C headers (the formulas and kernels of every term)", "the generated C headers msslib_mss.h"),
-)
-FORMATS_BY_NAME = {f.name: f for f in FORMAT_TABLE}
-#: every format, in the order outputs are written
-FORMATS = tuple(FORMATS_BY_NAME)
-#: formats written by default only for models they carry whole (the springs-only formats)
-SPRINGS_ONLY_FORMATS = tuple(f.name for f in FORMAT_TABLE if f.whole_only)
-
-
 def format_help() -> str:
-    """The help of ``msslib export --format``, from :data:`FORMAT_TABLE`."""
+    """The help of ``msslib export --format``, from the format table (:mod:`msslib.export.formats`)."""
     return ("formats separated by commas (default: every format that carries the whole model): "
-            + "; ".join(f"{f.name}: {f.help}" for f in FORMAT_TABLE))
-
-
-def _format(fmt: str) -> Format:
-    try:
-        return FORMATS_BY_NAME[fmt]
-    except KeyError:
-        raise ValueError(f"unknown format {fmt!r}") from None
+            + "; ".join(f"{f.name}: {f.help}" for f in format_table.table()))
 
 
 def parse_formats(text: str | None) -> tuple[str, ...] | None:
-    """``"csv,mjcf"`` -> ``("csv", "mjcf")`` in :data:`FORMATS` order; None for None (the default).
+    """``"csv,mjcf"`` -> ``("csv", "mjcf")`` in the table's order; None for None (the default).
     ValueError naming an unknown or repeated format."""
     if text is None:
         return None
+    known = format_table.names()
     items = [s.strip() for s in text.split(",")]
     if not text.strip() or any(not s for s in items):
-        raise ValueError(f"--format {text!r}: give formats separated by commas, from {','.join(FORMATS)}")
+        raise ValueError(f"--format {text!r}: give formats separated by commas, from {','.join(known)}")
     for s in items:
-        if s not in FORMATS:
-            raise ValueError(f"--format {text!r}: {s!r} is not a format; expected some of {','.join(FORMATS)}")
+        if s not in known:
+            raise ValueError(f"--format {text!r}: {s!r} is not a format; expected some of {','.join(known)}")
         if items.count(s) > 1:
             raise ValueError(f"--format {text!r}: {s!r} is given twice")
-    return tuple(f for f in FORMATS if f in items)
+    return tuple(f for f in known if f in items)
 
 
 def default_formats(exp: MssExport) -> tuple[str, ...]:
-    """Every format that carries the whole model: MuJoCo and SOFA only when every term of the model
-    says they carry it."""
-    return tuple(f.name for f in FORMAT_TABLE if not (f.whole_only and exp.volume_terms))
+    """Every format that carries the whole model: the springs-only formats (MuJoCo, SOFA) only when
+    they carry every term of the model."""
+    return tuple(f.name for f in format_table.table()
+                 if not f.whole_only or all(f.carries_term(t) for t in exp.terms))
 
 
 def output_paths(exp: MssExport, stem: Path, formats) -> list[tuple[str, str, Path, str | None]]:
@@ -142,13 +70,13 @@ def output_paths(exp: MssExport, stem: Path, formats) -> list[tuple[str, str, Pa
     ``STEM.vtu``, MuJoCo ``STEM_mujoco.xml``, SOFA ``STEM.scn``, C ``msslib_mss.h`` and the headers it
     includes in the stem's directory (``table``: the header's file name)."""
     stem = Path(stem)
-    return [(fmt, what, path, table) for fmt in formats for what, path, table in _format(fmt).files(exp, stem)]
+    return [(fmt, what, path, table) for fmt in formats for what, path, table in format_table.get(fmt).files(exp, stem)]
 
 
 def file_writer(exp: MssExport, fmt: str, table: str | None = None):
     """``writer(path)`` that writes one output of ``fmt`` (for :class:`msslib.results.staging.StagedOutputs`,
     which then names the destination in any error)."""
-    return _format(fmt).writer(exp, table)
+    return format_table.get(fmt).writer(exp, table)
 
 
 def stem_for(out: Path, scene_name: str, directory: bool) -> Path:

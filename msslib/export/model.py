@@ -106,7 +106,10 @@ class MssExport:
     def volume_terms(self) -> list[str]:
         """One phrase per term of the model that MuJoCo and SOFA cannot carry (volume, angular and
         element-reading correction terms), naming its table."""
-        return [note for t in self.terms if (note := t.export_note("mjcf")) is not None]
+        from msslib.export import formats
+
+        mjcf = formats.get("mjcf")
+        return [t.export_note("mjcf") for t in self.terms if not mjcf.carries_term(t)]
 
     def forces(self) -> list[tuple[str, np.ndarray, str]]:
         """``(label, nodal forces at load factor 1, description)`` of the terms that the simulator
@@ -225,7 +228,10 @@ def _tables(exp: MssExport) -> dict[str, Table]:
 def not_carried(exp: MssExport, fmt: str) -> list[str]:
     """What of the model ``fmt`` leaves out (an empty list: all of it): each term says what the
     format leaves out of it (:meth:`msslib.terms.Term.export_note`)."""
-    out = [note for t in exp.terms if (note := t.export_note(fmt)) is not None]
+    from msslib.export import formats
+
+    form = formats.get(fmt)
+    out = [t.export_note(fmt) for t in exp.terms if not form.carries_term(t)]
     if fmt == "mjcf" and exp.damping[1] != 0.0:
         out.append(f"the stiffness-proportional damping beta = {exp.damping[1]!r} s (only the mass-proportional "
                    f"alpha is carried, as joint damping)")

@@ -115,7 +115,9 @@ class Term:
         non-conservative).
     ``export_formats``
         the export formats that carry it whole (``c``: the generated headers, which hold the
-        kernels of every term); :meth:`export_note` says what another format leaves out.
+        kernels of every term; a format may also take terms by its own rule,
+        :attr:`msslib.export.formats.Format.takes`); :meth:`export_note` says what another format
+        leaves out.
     ``cell_constants``
         ``(variable, attribute, CF unit, long name)`` of its per-cell constants for
         :func:`msslib.spring_constants`.
@@ -150,10 +152,8 @@ class Term:
         the term writes as constant forces (none by default)."""
         return []
 
-    def export_note(self, fmt: str) -> str | None:
-        """What format ``fmt`` leaves out of the term (None: it carries it whole)."""
-        if fmt in self.export_formats:
-            return None
+    def export_note(self, fmt: str) -> str:
+        """What format ``fmt``, which does not carry the term whole, leaves out of it (a phrase)."""
         return f"{self.export_label} on {self.export_count()} cells (table {self.export_name})"
 
     def export_count(self) -> int:

@@ -135,9 +135,7 @@ class BaudetCorrection(Term):
                 "forces_table": "baudet_correction_forces", "energy": None, "conservative": self.conservative,
                 "scales_with_load": self.scales_with_load}
 
-    def export_note(self, fmt: str) -> str | None:
-        if fmt in self.export_formats:
-            return None
+    def export_note(self, fmt: str) -> str:
         return "Baudet's per-cell correction factors (the nodal correction forces are carried)"
 
     def export_forces(self):
