@@ -21,7 +21,7 @@ import yaml
 from cli_helpers import assert_refused
 from cli_helpers import run_cli as _cli
 from msslib import cli
-from msslib.cli import inputs as cli_inputs
+from msslib.results import paraview
 from msslib import experiment as EXP
 from msslib import mesh as M
 from msslib.results import StagedOutputs, read_result, remove_stale_temporaries, write_result, write_text
@@ -155,7 +155,7 @@ def test_run_failing_vtu_keeps_old_result(work, capsys, monkeypatch, failure):
             raise OSError(failure.errno, failure.strerror, str(tmp))
         raise RuntimeError(f"{failure}: {tmp}")
 
-    monkeypatch.setattr(cli_inputs, "_write_vtu", failing_vtu)
+    monkeypatch.setattr(paraview, "write_state", failing_vtu)
     before = _snapshot(work)
     code, err = _cli(capsys, "run", work / "scene.yaml", "--out", out, "--vtu", vtu, "--quiet")
     assert_refused(code, err, vtu, str(failure.strerror if isinstance(failure, OSError) else failure))
@@ -294,13 +294,13 @@ def test_sigterm_during_cli_run_keeps_old_outputs(work):
     proc = _python("""
         import os, signal, sys, time
         from msslib import cli
-        from msslib.cli import inputs as cli_inputs
+        from msslib.results import paraview
 
         def killed(tmp, ds):  # SIGTERM arrives while both outputs are staged
             os.kill(os.getpid(), signal.SIGTERM)
             time.sleep(30)
 
-        cli_inputs._write_vtu = killed
+        paraview.write_state = killed
         sys.exit(cli.main(sys.argv[1:]))
     """, "run", work / "scene.yaml", "--out", out, "--vtu", vtu, "--quiet")
     assert proc.returncode == 143, proc.stderr

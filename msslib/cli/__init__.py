@@ -70,11 +70,7 @@ from msslib.cli.inputs import (  # noqa: F401
     _choice,
     _read_result,
     _vtu_path,
-    _write_vtu,
-    _paraview_what,
     _check_paraview,
-    _paraview_files,
-    _stage_paraview,
     RESULT_VARIABLES,
 )
 
@@ -97,26 +93,27 @@ def _add_run(subparsers) -> None:
 
 def _cmd_run(args) -> int:
     from msslib.results import StagedOutputs, stage_result
+    from msslib.results.paraview import ParaViewOutput
     from msslib.scene import run_scene
 
     scene = _load_scene(args.scene)
     out = Path(args.out)
     vtu = _vtu_path(scene, out, args.vtu)
+    view = ParaViewOutput(vtu) if vtu is not None else None
     inputs = [("scene file", Path(args.scene)), *_mesh_input(scene)]
-    outputs = [("output file", out), (_paraview_what(vtu) if vtu is not None else "VTU file", vtu)]
+    outputs = [("output file", out), *([(view.what, view.path)] if view is not None else [])]
     _check_distinct(outputs, inputs)
-    if vtu is not None:
-        _check_paraview(vtu, [*inputs, ("output file", out)])
+    if view is not None:
+        _check_paraview(view, [*inputs, ("output file", out)])
     for what, path in outputs:
-        if path is not None:
-            _check_writable(path, what)
+        _check_writable(path, what)
     ds = run_scene(scene, progress=not args.quiet)
-    files = _paraview_files(vtu, ds) if vtu is not None else []
+    files = view.files(ds) if view is not None else []
     _check_distinct([("output file", out), *files], inputs)  # every file of a series, links included
     with StagedOutputs() as staged:  # every file, or none
         stage_result(staged, out, ds)
-        if vtu is not None:
-            _stage_paraview(staged, vtu, ds)
+        if view is not None:
+            view.stage(staged, ds)
     if not args.quiet:
         extra = f" and {vtu}" if vtu is not None else ""
         if len(files) > 1:
@@ -278,19 +275,18 @@ def _add_vtu(subparsers) -> None:
 
 
 def _cmd_vtu(args) -> int:
-    from msslib.results import StagedOutputs
+    from msslib.results.paraview import ParaViewOutput
 
     src, out = Path(args.result), Path(args.out)
     if not src.exists():
         raise CommandError(f"result file not found: {str(src)!r}")
-    what = _paraview_what(out)
-    _check_distinct([(what, out)], [("result file", src)])
-    _check_paraview(out, [("result file", src)])
-    _check_writable(out, what)
+    view = ParaViewOutput(out)
+    _check_distinct([(view.what, out)], [("result file", src)])
+    _check_paraview(view, [("result file", src)])
+    _check_writable(out, view.what)
     ds = _read_result(src)
-    _check_distinct(_paraview_files(out, ds), [("result file", src)])
-    with StagedOutputs() as staged:  # every file of a series, or none
-        _stage_paraview(staged, out, ds)
+    _check_distinct(view.files(ds), [("result file", src)])
+    view.write(ds)  # every file of a series, or none
     return 0
 
 

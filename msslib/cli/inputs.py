@@ -203,85 +203,11 @@ def _vtu_path(scene, out: Path, cli_vtu: str | None) -> Path | None:
     return None
 
 
-def _write_vtu(path: Path, ds) -> None:
-    """The final state as one VTU file (:func:`msslib.results.paraview.write_state`)."""
-    from msslib.results.paraview import write_state
-
-    write_state(path, ds)
-
-
-def _paraview_what(path: Path) -> str:
-    from msslib.results.paraview import is_series
-
-    return "ParaView series" if is_series(path) else "VTU file"
-
-
-def _check_paraview(path: Path, others) -> None:
-    """Refuse, before anything runs, a ParaView output whose suffix is neither .vtu nor .pvd, or a
-    series whose files beside the .pvd (STEM_NNNN.vtu, STEM_springs.vtu) would be one of
-    ``others`` (pairs ``(what, path)``: the inputs and the other outputs)."""
-    from msslib.results.paraview import check_suffix, in_series, is_series
-
+def _check_paraview(view, others) -> None:
+    """Refuse, before anything runs, a ParaView output (a :class:`msslib.results.paraview.ParaViewOutput`)
+    whose suffix is neither .vtu nor .pvd, or a series that would write over one of ``others``
+    (pairs ``(what, path)``: the inputs and the other outputs) (:meth:`~msslib.results.paraview.ParaViewOutput.check`)."""
     try:
-        check_suffix(path, _paraview_what(path))
+        view.check(others)
     except ValueError as exc:
         raise CommandError(_one_line(exc)) from None
-    if is_series(path):
-        for what, other in others:
-            if other is not None and in_series(path, other):
-                raise CommandError(f"{what} {str(other)!r} would be overwritten by the ParaView series {str(path)!r} "
-                                   f"(it writes {path.stem}_NNNN.vtu and {path.stem}_springs.vtu beside it); "
-                                   f"give another .pvd name")
-        _check_series_members(path, others)
-
-
-def _check_series_members(pvd: Path, others) -> None:
-    """Refuse, before anything runs, a ParaView series at ``pvd`` when a file already beside it
-    with the name of one of its files (``STEM_NNNN.vtu``, ``STEM_springs.vtu``, whatever the number
-    of states) cannot be replaced (a directory, a device, a pipe) or is, through a link, one of
-    ``others`` (pairs ``(what, path)``).  One listing of the directory: linear in its size."""
-    import re
-
-    pattern = re.compile(re.escape(pvd.stem) + r"_(\d{4,}|springs)\.vtu")
-    directory = pvd.parent
-    try:
-        names = sorted(n for n in os.listdir(directory if str(directory) else ".") if pattern.fullmatch(n))
-    except OSError:
-        return  # a missing or unreadable directory is refused by _check_writable
-    if not names:
-        return
-    known = {}
-    for what, other in others:
-        if other is not None:
-            for key in _file_keys(Path(other)):
-                known.setdefault(key, (what, Path(other)))
-    for name in names:
-        member = directory / name
-        if member.is_dir() or (member.exists() and not member.is_file()):
-            kind = "a directory" if member.is_dir() else "not a regular file"
-            raise CommandError(f"ParaView series {str(pvd)!r}: {str(member)!r}, where it writes one of its files "
-                               f"({pvd.stem}_NNNN.vtu, {pvd.stem}_springs.vtu), is {kind}; move it away or give "
-                               f"another .pvd name")
-        for key in _file_keys(member):
-            if key in known:
-                what, other = known[key]
-                raise CommandError(f"{what} {str(other)!r} would be overwritten by the ParaView series {str(pvd)!r} "
-                                   f"(its file {str(member)!r} is a link to it); give another .pvd name")
-
-
-def _paraview_files(path: Path, ds) -> list:
-    """Every file of the ParaView export of ``ds`` at ``path``, pairs ``(what, path)``."""
-    from msslib.results.paraview import is_series, series_files, states
-
-    if not is_series(path):
-        return [("VTU file", path)]
-    return series_files(path, len(states(ds)[0]), "springs" in ds)
-
-
-def _stage_paraview(staged, path: Path, ds) -> None:
-    from msslib.results.paraview import is_series, stage
-
-    if is_series(path):
-        stage(staged, path, ds)
-    else:
-        staged.write(path, lambda tmp: _write_vtu(tmp, ds), what="VTU file")

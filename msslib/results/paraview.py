@@ -1,8 +1,9 @@
 """ParaView export of msslib results: the final state as one VTU file, or every saved state as a
 time series (a ``.pvd`` collection of VTU files).
 
-:func:`write` (and :func:`stage`, which adds the files to a :class:`msslib.results.staging.StagedOutputs`)
-decides by the suffix of the path:
+:class:`ParaViewOutput` is one such output at a path: what it is, the files it writes, the checks
+before a run (its suffix; a series's files beside the ``.pvd`` that must not be an input or a
+directory) and the staged writing (all files, or none). The suffix of the path decides:
 
 ``OUT.vtu``
     The final state (:func:`write_state`): the mesh at rest with the point data ``displacement``
@@ -36,20 +37,20 @@ decides by the suffix of the path:
 
 from __future__ import annotations
 
+import os
 import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["SUFFIXES", "check_suffix", "is_series", "states", "series_files", "in_series", "write_state",
-           "write_series", "stage", "write"]
+__all__ = ["SUFFIXES", "ParaViewOutput", "states", "series_files", "in_series", "write_state", "write"]
 
 #: suffix -> what is written
 SUFFIXES = {".vtu": "the final state (one VTU file)", ".pvd": "every saved state (ParaView series)"}
 
 
-def check_suffix(path, what: str = "ParaView file") -> Path:
+def _check_suffix(path, what: str = "ParaView file") -> Path:
     """``path`` if it ends in ``.vtu`` or ``.pvd`` (any case), else a one-line ValueError."""
     path = Path(path)
     if path.suffix.lower() not in SUFFIXES:
@@ -58,7 +59,7 @@ def check_suffix(path, what: str = "ParaView file") -> Path:
     return path
 
 
-def is_series(path) -> bool:
+def _is_series(path) -> bool:
     """True for a ``.pvd`` path (a time series), False for anything else."""
     return Path(path).suffix.lower() == ".pvd"
 
@@ -110,6 +111,14 @@ def series_files(path, n_states: int, springs: bool) -> list[tuple[str, Path]]:
     if springs:
         files.append(("springs VTU file", pvd.with_name(f"{pvd.stem}_springs.vtu")))
     return files
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """``a`` and ``b`` name one existing file (hard links, symbolic links, other spellings)."""
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):
+        return False
 
 
 def in_series(pvd, path) -> bool:
@@ -238,29 +247,77 @@ def _stage_series(staged, path, ds) -> list[Path]:
     return [dest for _, dest in files]
 
 
-def stage(staged, path, ds) -> list[Path]:
-    """Add the ParaView export of ``ds`` at ``path`` (``.vtu``: the final state, ``.pvd``: every
-    saved state) to ``staged`` (a :class:`msslib.results.staging.StagedOutputs`); returns the files."""
-    path = check_suffix(path)
-    if is_series(path):
-        return _stage_series(staged, path, ds)
-    staged.write(path, lambda tmp: write_state(tmp, ds), what="VTU file")
-    return [path]
+class ParaViewOutput:
+    """The ParaView output of a result at ``path``: ``.vtu`` the final state, ``.pvd`` every saved
+    state (see the module docstring). ``what`` names it in messages, ``series`` says which."""
 
+    def __init__(self, path):
+        self.path = Path(path)
+        self.series = _is_series(self.path)
+        self.what = "ParaView series" if self.series else "VTU file"
 
-def write_series(path, ds) -> list[Path]:
-    """Write every saved state of ``ds`` as a ParaView series at ``path`` (a ``.pvd``): all its
-    files are replaced together, or none is.  Returns the files, the ``.pvd`` first."""
-    if not is_series(path):
-        raise ValueError(f"ParaView series {str(path)!r}: the collection must end in .pvd")
-    return write(path, ds)
+    def __repr__(self) -> str:
+        return f"ParaViewOutput({str(self.path)!r})"
+
+    def check(self, others=()) -> None:
+        """Before anything runs: a one-line ValueError for a suffix other than ``.vtu`` or ``.pvd``,
+        and for a series whose files beside the ``.pvd`` (``STEM_NNNN.vtu``, ``STEM_springs.vtu``,
+        whatever the number of states) would overwrite one of ``others`` (pairs ``(what, path)``:
+        the inputs and the other outputs, also through a link) or are there as a directory or
+        anything but a regular file (one listing of the directory)."""
+        _check_suffix(self.path, self.what)
+        if not self.series:
+            return
+        pvd = self.path
+        beside = f"it writes {pvd.stem}_NNNN.vtu and {pvd.stem}_springs.vtu beside it"
+        for what, other in others:
+            if other is not None and in_series(pvd, other):
+                raise ValueError(f"{what} {str(other)!r} would be overwritten by the ParaView series {str(pvd)!r} "
+                                 f"({beside}); give another .pvd name")
+        pattern = re.compile(re.escape(pvd.stem) + r"_(\d{4,}|springs)\.vtu")
+        try:
+            names = sorted(n for n in os.listdir(pvd.parent if str(pvd.parent) else ".") if pattern.fullmatch(n))
+        except OSError:
+            return  # a missing or unreadable directory: the caller's check of the output refuses it
+        others = [(what, Path(other)) for what, other in others if other is not None]
+        for name in names:
+            member = pvd.parent / name
+            if member.is_dir() or (member.exists() and not member.is_file()):
+                kind = "a directory" if member.is_dir() else "not a regular file"
+                raise ValueError(f"ParaView series {str(pvd)!r}: {str(member)!r}, where it writes one of its files "
+                                 f"({pvd.stem}_NNNN.vtu, {pvd.stem}_springs.vtu), is {kind}; move it away or give "
+                                 f"another .pvd name")
+            for what, other in others:
+                if _same_file(member, other):
+                    raise ValueError(f"{what} {str(other)!r} would be overwritten by the ParaView series "
+                                     f"{str(pvd)!r} (its file {str(member)!r} is a link to it); give another .pvd name")
+
+    def files(self, ds) -> list[tuple[str, Path]]:
+        """Every file it writes for the result ``ds``: pairs ``(what, path)``, the ``.pvd`` first."""
+        if not self.series:
+            return [(self.what, self.path)]
+        return series_files(self.path, len(states(ds)[0]), "springs" in ds)
+
+    def stage(self, staged, ds) -> list[Path]:
+        """Add its files for ``ds`` to ``staged`` (a :class:`msslib.results.staging.StagedOutputs`:
+        they replace the old ones together with the other staged outputs, or none does); returns
+        the files."""
+        _check_suffix(self.path, self.what)
+        if self.series:
+            return _stage_series(staged, self.path, ds)
+        staged.write(self.path, lambda tmp: write_state(tmp, ds), what=self.what)
+        return [self.path]
+
+    def write(self, ds) -> list[Path]:
+        """Write its files for ``ds``, all together or none; returns them."""
+        from msslib.results.staging import StagedOutputs
+
+        with StagedOutputs() as staged:
+            files = self.stage(staged, ds)
+        return files
 
 
 def write(path, ds) -> list[Path]:
     """Write the ParaView export of the result ``ds`` at ``path`` (the suffix decides, see the
     module docstring), all files together or none; returns the files written."""
-    from msslib.results.staging import StagedOutputs
-
-    with StagedOutputs() as staged:
-        files = stage(staged, path, ds)
-    return files
+    return ParaViewOutput(path).write(ds)
