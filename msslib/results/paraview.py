@@ -10,7 +10,7 @@ directory) and the staged writing (all files, or none). The suffix of the path d
     (m), ``reaction_force`` (N) and ``fixed`` (0/1), and the cell data ``material``,
     ``cell_state`` and ``relative_jacobian`` (the final state's cell check, :mod:`msslib.mesh.quality`).
 ``OUT.pvd``
-    Every saved state (:func:`write_series`), written together (all files, or none):
+    Every saved state, written together (all files, or none):
 
     * ``OUT.pvd``: the collection, one ``DataSet`` per state with its ``timestep``: the time (s)
       of a dynamic run's saved states, the step number of a result stored along ``step``; a result
