@@ -11,6 +11,7 @@
 #   experiments/<paper>/<name>.yaml              an experiment: cases x model variants (msslib.experiment),
 #                                                and the figures drawn from its runs (its figures block)
 #   experiments/<paper>/studies/<study>.py       a sweep script writing one NetCDF
+#   experiments/<paper>/figures/curves.yaml      figures that draw a study result as error curves (data)
 #   experiments/<paper>/figures/<fig>.py         a figure that computes or draws something of its own
 #   experiments/<paper>/tables/<table>.py        one table
 #   experiments/<paper>/{figures,tables}/inputs.yaml   the results each of those scripts reads
@@ -92,12 +93,32 @@ def declared_figures():
 EXPERIMENT_FIGURES = declared_figures()
 
 
+def curve_figures():
+    """The figures declared in experiments/<paper>/figures/curves.yaml (study results drawn as error
+    curves): (paper, name) -> the study result each reads."""
+    from experiments.figures import load_curves
+
+    out = {}
+    for paper in PAPERS:
+        path = Path("experiments", paper, "figures", "curves.yaml")
+        if path.is_file():
+            for name, spec in load_curves(path).items():
+                if (paper, name) in EXPERIMENT_FIGURES or (paper, name) in scripts("figures"):
+                    raise ValueError(f"{path}: figure {name!r} of {paper} is declared twice")
+                out[(paper, name)] = spec["result"]
+    return out
+
+
+CURVE_FIGURES = curve_figures()
+
+
 # `snakemake --report`: figures, tables and the paper, one category per paper (captions in paper/report/)
 report: "paper/report/workflow.rst"
 
 COMPARISONS = [f"results/{p}/{n}/comparison.nc" for p, n in experiments()]
 STUDIES = [f"results/{p}/studies/{n}.nc" for p, n in scripts("studies")]
-FIGURES = sorted(f"paper/figures/{p}_{n}.png" for p, n in list(scripts("figures")) + list(EXPERIMENT_FIGURES))
+FIGURES = sorted(f"paper/figures/{p}_{n}.png"
+                 for p, n in list(scripts("figures")) + list(EXPERIMENT_FIGURES) + list(CURVE_FIGURES))
 TABLES = ([f"paper/tables/experiments/{p}_{n}.md" for p, n in experiments()]
           + [f"paper/tables/{p}_{n}.md" for p, n in scripts("tables")])
 
@@ -249,6 +270,27 @@ rule figure:
         "logs/{paper}/figures/{name}.log",
     shell:
         "python -m experiments.{wildcards.paper}.figures.{wildcards.name} --out paper/figures/{wildcards.paper}_{wildcards.name} {params.quick} > {log} 2>&1"
+
+
+rule curve_figure:
+    """A figure declared in experiments/<paper>/figures/curves.yaml: a study result as error curves."""
+    input:
+        spec="experiments/{paper}/figures/curves.yaml",
+        result=lambda wc: CURVE_FIGURES[(wc.paper, wc.name)],
+        code=["experiments/figures.py", "experiments/plotting.py", "experiments/script.py"],
+    output:
+        png=report("paper/figures/{paper}_{name}.png", caption="paper/report/figure.rst",
+                   category="{paper}", subcategory="figures", labels={"figure": "{name}"}),
+        pdf="paper/figures/{paper}_{name}.pdf",
+    wildcard_constraints:
+        name="|".join(sorted({n for _, n in CURVE_FIGURES})),
+    params:
+        quick=QFLAG,
+    log:
+        "logs/{paper}/figures/{name}.log",
+    shell:
+        "python -m experiments.figures {input.spec} {wildcards.name} --out paper/figures/{wildcards.paper}_{wildcards.name} "
+        "{params.quick} > {log} 2>&1"
 
 
 rule experiment_figure:

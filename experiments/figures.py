@@ -1,7 +1,9 @@
-"""Draw a figure declared in an experiment file (its ``figures`` block, checked by
-:mod:`msslib.experiment`) from the experiment's runs::
+"""Draw a figure declared as data: in an experiment file (its ``figures`` block, checked by
+:mod:`msslib.experiment`) from the experiment's runs, or in a curves file
+(``experiments/<paper>/figures/curves.yaml``) from a study's result::
 
     python -m experiments.figures experiments/lloyd/cone.yaml cone --out paper/figures/lloyd_cone
+    python -m experiments.figures experiments/baudet/figures/curves.yaml bulk_modulus --out paper/figures/baudet_bulk_modulus
 
 writes ``STEM.png`` and ``STEM.pdf``. The runs are read from ``--results DIR`` (default
 ``results/<paper>/<experiment file name>``, where ``python -m msslib experiment run-all`` writes them);
@@ -9,12 +11,17 @@ writes ``STEM.png`` and ``STEM.pdf``. The runs are read from ``--results DIR`` (
 runs it finds, reduced or not). Kind ``comparison``: one column per (case, variant, reference), the
 variant's wireframe (red) over the reference coloured by its displacement magnitude, the rest shape
 in grey, and the per-node distance between the two below
-(:func:`experiments.plotting.comparison_figure`, which takes the figure's options).
+(:func:`experiments.plotting.comparison_figure`, which takes the figure's options). A curves figure:
+one study variable as curves over one coordinate, one per Poisson's ratio, one panel per selection
+(:func:`experiments.plotting.curves_figure`; the keys are listed at the top of the curves file and in
+:data:`CURVES_KEYS`).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+
+import yaml
 
 from experiments import script
 from msslib.experiment import figure_runs, load_experiment
@@ -49,16 +56,93 @@ def draw(exp, name, results=None):
     return plotting.comparison_figure(pairs, **spec["options"])
 
 
+#: the keys of a figure in a curves file: required, and optional with their defaults
+CURVES_KEYS = {"required": ("result", "variable", "x", "xlabel", "ylabel", "panels"),
+               "optional": {"description": "", "dashed": None, "marks": None, "xscale": 100.0, "yscale": 100.0,
+                            "band": None, "height": None}}
+
+
+def load_curves(path) -> dict:
+    """The figures of a curves file, ``{name: spec}`` with the optional keys filled in; a one-line
+    ValueError naming the file, the figure and the key for anything else."""
+    path = Path(path)
+    raw = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+    if not isinstance(raw, dict) or not isinstance(raw.get("figures"), dict) or set(raw) - {"figures", "shared"}:
+        raise ValueError(f"{path}: a curves file holds 'figures' (name: figure) and optionally 'shared'")
+    out = {}
+    allowed = set(CURVES_KEYS["required"]) | set(CURVES_KEYS["optional"])
+    for name, spec in raw["figures"].items():
+        where = f"{path}: figure {name!r}"
+        if not isinstance(spec, dict):
+            raise ValueError(f"{where}: expected a mapping of {', '.join(sorted(allowed))}")
+        missing = [k for k in CURVES_KEYS["required"] if k not in spec]
+        unknown = sorted(set(spec) - allowed)
+        if missing or unknown:
+            raise ValueError(f"{where}: " + "; ".join(
+                ([f"missing {', '.join(missing)}"] if missing else []) + ([f"unknown {', '.join(unknown)}"] if unknown else []))
+                + f" (keys: {', '.join(sorted(allowed))})")
+        if not str(spec["result"]).startswith("results/") or not str(spec["result"]).endswith(".nc"):
+            raise ValueError(f"{where}: result {spec['result']!r} is not a results/....nc file")
+        for key in ("panels", "dashed", "marks"):
+            value = spec.get(key)
+            if value is not None and not (isinstance(value, dict) and value and all(
+                    isinstance(v, (dict, list)) for v in value.values())):
+                raise ValueError(f"{where}: {key} must map a title to a selection"
+                                 + (" (or to published points)" if key == "marks" else ""))
+        unknown_marks = sorted(set(spec.get("marks") or {}) - set(spec["panels"]))
+        if unknown_marks:
+            raise ValueError(f"{where}: marks for panels it does not draw: {', '.join(unknown_marks)}")
+        out[name] = {**CURVES_KEYS["optional"], **spec}
+    return out
+
+
+def draw_curves(spec):
+    """A curves figure (a spec of :func:`load_curves`) from its study result."""
+    import xarray as xr
+
+    from experiments import plotting
+
+    path = Path(spec["result"])
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: the study result the figure reads is missing; build it first")
+    with xr.open_dataset(path) as ds:
+        ds = ds.load()
+    for key in (spec["variable"], spec["x"]):
+        if key not in ds.variables:
+            raise ValueError(f"{path} has no {key!r}")
+    da = ds[spec["variable"]]
+    for title, sel in spec["panels"].items():
+        for extra in [{}, *(spec["dashed"] or {}).values()]:
+            unknown = sorted(set({**sel, **extra}) - set(da.dims))
+            open_dims = sorted(set(da.dims) - {"nu", spec["x"]} - set({**sel, **extra}))
+            if unknown or open_dims:
+                raise ValueError(f"{path}: {spec['variable']}: panel {title!r} "
+                                 + (f"selects {', '.join(unknown)}, not a dimension" if unknown else
+                                    f"leaves {', '.join(open_dims)} open")
+                                 + f" (dimensions: {', '.join(da.dims)})")
+    marks = {title: [tuple(m) for m in points] for title, points in (spec["marks"] or {}).items()} or None
+    return plotting.curves_figure(ds[spec["variable"]], ds[spec["x"]].values, xlabel=spec["xlabel"],
+                                  ylabel=spec["ylabel"], panels=spec["panels"], xscale=spec["xscale"],
+                                  yscale=spec["yscale"], dashed=spec["dashed"], marks=marks, band=spec["band"],
+                                  height=spec["height"])
+
+
 def main(argv=None):
     from experiments import plotting
 
     def extra(ap):
-        ap.add_argument("experiment", help="experiment file (YAML) with a figures block")
+        ap.add_argument("experiment", help="experiment file (YAML) with a figures block, or a curves file")
         ap.add_argument("name", help="the figure's name in that block")
         ap.add_argument("--results", help="folder of the runs (default: results/<paper>/<experiment>)")
 
     _, args = script.parse(__doc__, argv, extra=extra)
     try:
+        if Path(args.experiment).name == "curves.yaml":
+            figures = load_curves(args.experiment)
+            if args.name not in figures:
+                raise ValueError(f"{args.experiment}: no figure {args.name!r}; declared: {', '.join(sorted(figures))}")
+            plotting.save(draw_curves(figures[args.name]), args.out)
+            return
         exp = load_experiment(args.experiment)
         if args.name not in exp.figures:
             raise ValueError(f"{args.experiment}: no figure {args.name!r}; declared: "

@@ -13,6 +13,8 @@ deformation; this module provides the pieces, for 2D meshes (triangles, quads) a
 * :func:`comparison_figure` -- the usual layout: one column per load case, the variant's wireframe
   over the reference coloured by ``|u|`` on top, the error map below;
 * :func:`node_map` -- per-node values as coloured dots on the nodes (over a thin wireframe);
+* :func:`curves_figure` -- a study's error curves, one per Poisson's ratio, one panel per
+  selection of the study's other coordinates (one vertical scale for all panels);
 * :func:`shared_limits`, :func:`pareto_front`, :func:`label_log_axis`, :func:`unique_legend` --
   one colour scale for compared panels, the non-dominated points of a speed/error plot, log axes
   whose ticks all carry a plain-number label, legends without duplicate entries;
@@ -46,7 +48,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["LENGTH_UNITS", "figure", "deformed_mesh", "node_error", "error_map", "node_map", "comparison_figure",
-           "shared_limits", "pareto_front", "label_log_axis", "unique_legend", "save"]
+           "curves_figure", "NU_COLORS", "shared_limits", "pareto_front", "label_log_axis", "unique_legend", "save"]
 
 #: Scale factors from metres to the supported drawing units.
 LENGTH_UNITS = {"m": 1.0, "cm": 1e2, "mm": 1e3}
@@ -482,4 +484,78 @@ def comparison_figure(pairs: dict, *, plane: str = "yz", length_unit: str = "cm"
     fig.legend(handles=handles, loc="outside upper center", ncol=len(handles), frameon=False)
     if title:
         fig.suptitle(title)
+    return fig
+
+
+# ---------------------------------------------------------------------------------------------
+# a study's error curves
+# ---------------------------------------------------------------------------------------------
+
+#: one colour per Poisson's ratio, the same in every figure of curves
+NU_COLORS = {"0.1": "tab:blue", "0.2": "tab:orange", "0.25": "tab:brown", "0.3": "tab:green", "0.4": "tab:red",
+             "0.499": "tab:purple"}
+
+
+def curves_figure(da, x, *, xlabel, ylabel, panels, xscale=100.0, yscale=100.0, absolute=False, dashed=None,
+                  ylog=False, marks=None, band=None, height=None):
+    """Curves of ``da`` over ``x`` (drawn times ``xscale``), one per value of its coordinate ``nu``,
+    in one panel per entry of ``panels`` (``{title: selection}`` of ``da``'s other coordinates),
+    values times ``yscale``. ``dashed``: a second selection drawn dashed in the same panels
+    (``{label: selection}``); ``marks``: published points ``{title: [(x, y, nu label), ...]}``,
+    black-edged; ``band``: a signed logarithmic axis, linear within +-band, with the band shaded;
+    ``height``: the figure's height (inches). One vertical scale for all panels."""
+    import matplotlib.ticker
+    from matplotlib.lines import Line2D
+
+    n = len(panels)
+    fig = figure(figsize=(3.6 * n + 0.4, 3.4))
+    # one vertical scale for all panels: the panels compare readings and factors directly
+    axes = fig.subplots(1, n, squeeze=False, sharey=True)[0]
+    # with a second selection the solid curves are wide and pale and the dashed ones thin with markers
+    # on top, so that a dashed curve lying on its solid one stays visible
+    solid = {"lw": 3.0, "alpha": 0.45} if dashed else {}
+    every = max(len(x) // 8, 1)
+    for ax, (title, sel) in zip(axes, panels.items()):
+        for nu in da["nu"].values:
+            y = da.sel(**sel, nu=nu).values * yscale
+            ax.plot(x * xscale, np.abs(y) if absolute else y, color=NU_COLORS.get(str(nu)), label=f"nu = {nu}", **solid)
+            for sel2 in (dashed or {}).values():
+                y2 = da.sel(**{**sel, **sel2}, nu=nu).values * yscale
+                ax.plot(x * xscale, np.abs(y2) if absolute else y2, color=NU_COLORS.get(str(nu)), ls="--", lw=1.1,
+                        marker="x", ms=3.5, markevery=every)
+        for (px, py, nu) in (marks or {}).get(title, []):
+            ax.plot(px, py, "o", mfc=NU_COLORS.get(nu, "k"), mec="k", ms=6)
+        ax.set_title(title)
+        ax.set_xlabel(xlabel)
+        ax.grid(alpha=0.3)
+        if ylog:
+            ax.set_yscale("log")
+    axes[0].set_ylabel(ylabel)
+    handles, labels = axes[0].get_legend_handles_labels()
+    if dashed:
+        handles += [Line2D([], [], color="k", ls="-", label="solid: " + next(iter(panels.values())).get("geometry", ""),
+                           **solid),
+                    Line2D([], [], color="k", ls="--", lw=1.1, marker="x", ms=3.5, label="dashed: " + ", ".join(dashed))]
+    if marks:
+        handles.append(Line2D([], [], ls="", marker="o", mfc="w", mec="k", label="published (text)"))
+    fig.legend(handles=handles, loc="outside upper center", ncol=min(len(handles), 5), frameon=False)
+    if height is not None:
+        fig.set_size_inches(fig.get_size_inches()[0], height)
+    if band is not None:
+        lo = min(ax.get_ylim()[0] for ax in fig.axes)
+        hi = max(ax.get_ylim()[1] for ax in fig.axes)
+        ticks = [t for t in (-200, -100, -50, -20, -10, -5, 0, 5, 10, 20, 50, 100, 200) if lo <= t <= hi]
+        for ax in fig.axes:
+            # signed log scale: linear within the band (readable), logarithmic beyond
+            ax.set_yscale("symlog", linthresh=band, linscale=0.6)
+            ax.set_ylim(lo, hi)  # one scale for all panels
+            ax.set_yticks(ticks, [f"{t:g}" for t in ticks])
+            ax.yaxis.set_minor_locator(matplotlib.ticker.NullLocator())
+            ax.axhspan(-band, band, color="0.9", zorder=0)
+            ax.axhline(0.0, color="0.4", lw=0.6, zorder=0)
+            for sign in (1, -1):
+                ax.axhline(sign * band, color="k", ls=":", lw=1.0, zorder=1)
+                ax.annotate(f"{sign * band:+g} %", (0.0, sign * band), xycoords=("axes fraction", "data"),
+                            xytext=(3, 1 if sign > 0 else -1), textcoords="offset points", ha="left",
+                            va="bottom" if sign > 0 else "top", fontsize=8)
     return fig

@@ -1,6 +1,7 @@
 """Figures as data: the ``figures`` block of an experiment file (checked by msslib.experiment, drawn by
-``python -m experiments.figures``), the workflow's figure and table targets and their declarations, and
-the one command line (--out, --quick) of every study, figure and table."""
+``python -m experiments.figures``), the curves files (a study result as error curves), the workflow's
+figure and table targets and their declarations, and the one command line (--out, --quick) of every
+study, figure and table."""
 
 from __future__ import annotations
 
@@ -207,6 +208,13 @@ def _experiment_figures():
     return out
 
 
+def _curves(paper):
+    from experiments.figures import load_curves
+
+    path = ROOT / "experiments" / paper / "figures" / "curves.yaml"
+    return load_curves(path) if path.is_file() else {}
+
+
 def _declared(paper, kind):
     path = ROOT / "experiments" / paper / kind / "inputs.yaml"
     return (yaml.safe_load(path.read_text()) or {}) if path.is_file() else {}
@@ -231,6 +239,9 @@ def test_every_figure_and_table_target_has_a_declaration(workflow_targets):
         paper, name = Path(target).stem.split("_", 1)
         if rule == "experiment_figure":
             assert (paper, name) in declared, target
+        elif rule == "curve_figure":
+            assert name in _curves(paper), target
+            assert not (ROOT / "experiments" / paper / "figures" / f"{name}.py").exists(), target
         else:
             assert rule == "figure", target
             assert (ROOT / "experiments" / paper / "figures" / f"{name}.py").is_file(), target
@@ -337,8 +348,108 @@ def test_every_study_figure_and_table_takes_out_and_quick():
         assert found & {"script.args", "script.parse", "C.parse"}, f"{module}: not the shared command line"
 
 
-@pytest.mark.parametrize("module", ["experiments.baudet.figures.bulk_modulus", "experiments.performance.tables.pareto",
+@pytest.mark.parametrize("module", ["experiments.baudet.figures.cantilever_floor", "experiments.performance.tables.pareto",
                                     "experiments.lloyd.studies.sparsity", "experiments.figures"])
 def test_help_names_out_and_quick(module):
     r = subprocess.run([sys.executable, "-m", module, "--help"], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert r.returncode == 0 and "--out" in r.stdout and "--quick" in r.stdout, r.stdout + r.stderr
+
+
+# --------------------------------------------------------------------------------------------
+# curves files: a study result drawn as error curves, one per nu, one panel per selection
+# --------------------------------------------------------------------------------------------
+
+CURVES = """\
+shared:
+  panels: &panels
+    "reading a": {reading: a, geometry: cube}
+    "reading b": {reading: b, geometry: cube}
+figures:
+  errors:
+    result: results/demo/studies/errors.nc
+    variable: E_error
+    x: strain
+    xlabel: axial strain (%)
+    ylabel: E error (%)
+    panels: *panels
+    dashed: {"a beam": {geometry: beam}}
+    marks: {"reading b": [[10.0, 2.5, "0.3"]]}
+    band: 5.0
+"""
+
+
+def _errors_study(folder):
+    """A study-like result: E_error(reading, geometry, nu, strain), each value distinct."""
+    import xarray as xr
+
+    strain = np.linspace(0.0, 0.1, 6)
+    values = np.arange(2 * 2 * 2 * 6, dtype=float).reshape(2, 2, 2, 6) / 1000.0
+    ds = xr.Dataset({"E_error": (("reading", "geometry", "nu", "strain"), values)},
+                    coords={"reading": ["a", "b"], "geometry": ["cube", "beam"], "nu": [0.3, 0.4], "strain": strain})
+    path = folder / "results" / "demo" / "studies" / "errors.nc"
+    path.parent.mkdir(parents=True)
+    ds.to_netcdf(path)
+    return ds
+
+
+def test_a_curves_figure_draws_the_study_values_it_declares(tmp_path, monkeypatch):
+    from experiments import figures
+
+    (tmp_path / "curves.yaml").write_text(CURVES, encoding="utf-8")
+    ds = _errors_study(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    spec = figures.load_curves(tmp_path / "curves.yaml")["errors"]
+    fig = figures.draw_curves(spec)
+    axes = fig.axes
+    assert [ax.get_title() for ax in axes] == ["reading a", "reading b"]
+    for ax, reading in zip(axes, ["a", "b"]):
+        assert ax.get_yscale() == "symlog"  # the band: linear within +-5 %, logarithmic beyond
+        lines = [ln for ln in ax.get_lines() if len(ln.get_xdata()) == 6]
+        drawn = sorted((ln.get_linestyle(), tuple(ln.get_ydata())) for ln in lines)
+        expected = sorted((style, tuple(ds["E_error"].sel(reading=reading, geometry=geometry, nu=nu).values * 100.0))
+                          for geometry, style in (("cube", "-"), ("beam", "--")) for nu in (0.3, 0.4))
+        assert drawn == expected, reading
+        np.testing.assert_allclose(lines[0].get_xdata(), ds["strain"].values * 100.0)
+    marks = [ln for ln in axes[1].get_lines() if ln.get_marker() == "o"]
+    assert len(marks) == 1 and (marks[0].get_xdata()[0], marks[0].get_ydata()[0]) == (10.0, 2.5)
+
+
+@pytest.mark.parametrize("edit, says", [
+    (lambda f: f.pop("variable"), "missing variable"),
+    (lambda f: f.update(colour="red"), "unknown colour"),
+    (lambda f: f.update(result="elsewhere/errors.nc"), "is not a results/....nc file"),
+    (lambda f: f.update(marks={"reading c": [[1.0, 1.0, "0.3"]]}), "marks for panels it does not draw: reading c"),
+    (lambda f: f.update(panels=["reading a"]), "panels must map a title to a selection"),
+])
+def test_a_bad_curves_figure_is_refused_in_one_line(tmp_path, edit, says):
+    from experiments import figures
+
+    raw = yaml.safe_load(CURVES)
+    edit(raw["figures"]["errors"])
+    path = tmp_path / "curves.yaml"
+    path.write_text(yaml.safe_dump(raw), encoding="utf-8")
+    with pytest.raises(ValueError, match=re.escape(says)) as err:
+        figures.load_curves(path)
+    assert "\n" not in str(err.value) and "'errors'" in str(err.value)
+
+
+def test_the_paper_curves_files_load_and_read_study_results():
+    for paper in PAPERS:
+        for name, spec in _curves(paper).items():
+            study = Path(spec["result"])
+            assert study.parts[:3] == ("results", paper, "studies"), (paper, name)
+            assert (ROOT / "experiments" / paper / "studies" / f"{study.stem}.py").is_file(), (paper, name, study)
+
+
+def test_a_panel_that_leaves_a_dimension_open_is_refused(tmp_path, monkeypatch):
+    from experiments import figures
+
+    raw = yaml.safe_load(CURVES)
+    raw["figures"]["errors"]["panels"] = {"reading a": {"reading": "a"}}
+    raw["figures"]["errors"].pop("marks")
+    (tmp_path / "curves.yaml").write_text(yaml.safe_dump(raw), encoding="utf-8")
+    _errors_study(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    spec = figures.load_curves(tmp_path / "curves.yaml")["errors"]
+    with pytest.raises(ValueError, match="panel 'reading a' leaves geometry open"):
+        figures.draw_curves(spec)

@@ -234,61 +234,6 @@ def open_result(path):
         return ds.load()
 
 
-# the panels of the E, nu and B figures ({title: selection}): the cube under the boundary reading with the
-# derived and the printed factor, and under the element reading with the derived factor
-CUBE_PANELS = {"boundary reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "boundary"},
-               "boundary reading, printed factor": {"geometry": "cube", "factor": "printed", "reading": "boundary"},
-               "element reading, derived factor": {"geometry": "cube", "factor": "derived", "reading": "element"}}
-
-
-NU_COLORS = {"0.1": "tab:blue", "0.2": "tab:orange", "0.25": "tab:brown", "0.3": "tab:green", "0.4": "tab:red", "0.499": "tab:purple"}
-
-
-def curves(da, x, *, xlabel, ylabel, panels, xscale=100.0, yscale=100.0, absolute=False, dashed=None, ylog=False,
-           marks=None):
-    """Error curves per nu: one panel per entry of ``panels`` ({title: selection dict}); ``dashed``
-    an optional second selection drawn dashed in the same panel ({label: selection}). ``marks``:
-    published points {title: [(x, y, nu_label), ...]} drawn as black-edged markers."""
-    from matplotlib.lines import Line2D
-
-    from experiments import plotting
-
-    n = len(panels)
-    fig = plotting.figure(figsize=(3.6 * n + 0.4, 3.4))
-    # one vertical scale for all panels: the panels compare readings and factors directly
-    axes = fig.subplots(1, n, squeeze=False, sharey=True)[0]
-    # with a second selection the solid curves are wide and pale and the dashed ones thin with markers
-    # on top, so that a dashed curve lying on its solid one stays visible
-    solid = {"lw": 3.0, "alpha": 0.45} if dashed else {}
-    every = max(len(x) // 8, 1)
-    for ax, (title, sel) in zip(axes, panels.items()):
-        for nu in da["nu"].values:
-            y = da.sel(**sel, nu=nu).values * yscale
-            ax.plot(x * xscale, np.abs(y) if absolute else y, color=NU_COLORS.get(str(nu)), label=f"nu = {nu}", **solid)
-            if dashed:
-                for lab, sel2 in dashed.items():
-                    y2 = da.sel(**{**sel, **sel2}, nu=nu).values * yscale
-                    ax.plot(x * xscale, np.abs(y2) if absolute else y2, color=NU_COLORS.get(str(nu)), ls="--", lw=1.1,
-                            marker="x", ms=3.5, markevery=every)
-        for (px, py, nu) in (marks or {}).get(title, []):
-            ax.plot(px, py, "o", mfc=NU_COLORS.get(nu, "k"), mec="k", ms=6)
-        ax.set_title(title)
-        ax.set_xlabel(xlabel)
-        ax.grid(alpha=0.3)
-        if ylog:
-            ax.set_yscale("log")
-    axes[0].set_ylabel(ylabel)
-    handles, labels = axes[0].get_legend_handles_labels()
-    if dashed:
-        handles += [Line2D([], [], color="k", ls="-", label="solid: " + next(iter(panels.values())).get("geometry", ""),
-                           **solid),
-                    Line2D([], [], color="k", ls="--", lw=1.1, marker="x", ms=3.5, label="dashed: " + ", ".join(dashed))]
-    if marks:
-        handles.append(Line2D([], [], ls="", marker="o", mfc="w", mec="k", label="published (text)"))
-    fig.legend(handles=handles, loc="outside upper center", ncol=min(len(handles), 5), frameon=False)
-    return fig
-
-
 def section_deflection(ds):
     """Mean vertical (-z) displacement of every cross-section x = const of a result: the
     deflection of the neutral axis for a beam bent about y (x values, deflections, both in m)."""
