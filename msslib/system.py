@@ -17,14 +17,14 @@ import scipy.sparse as sp
 
 from msslib import mesh as _mesh
 from msslib.terms import ExternalForce, Springs, Term
-from msslib.terms.base import _ElementTerm
+from msslib.terms.base import ElementTerm
 from msslib.terms.assembly import (
-    _block_scatter_bsr,
-    _block_scatter_csr,
-    _expand_block_pattern,
-    _scatter_add,
-    _spring3d_hessian_bsr,
-    _spring3d_hessian_csr,
+    block_scatter_bsr,
+    block_scatter_csr,
+    expand_block_pattern,
+    scatter_add,
+    spring3d_hessian_bsr,
+    spring3d_hessian_csr,
 )
 
 __all__ = ["Model", "frozen_mesh"]
@@ -230,7 +230,7 @@ class Model:
         self._nnz = dim * dim * len(unique)
         self._indices = np.empty(self._nnz, dtype=idx_t)
         self._indptr = np.empty(n + 1, dtype=idx_t)
-        _expand_block_pattern(nptr, ucol, dim, self._indices, self._indptr)
+        expand_block_pattern(nptr, ucol, dim, self._indices, self._indptr)
         diag_pos = pos_all[-nn:].astype(np.int32)
         fills = []
         start = 0
@@ -307,10 +307,10 @@ class Model:
             for t, kind, p, s, assign in steps:
                 if kind == "springs":
                     _, rowptr, nb, k, L0 = t.symmetric_layout()
-                    _spring3d_hessian_csr(xc, rowptr, nb, k, L0, p, nptr, diag_pos, s, assign, data)
+                    spring3d_hessian_csr(xc, rowptr, nb, k, L0, p, nptr, diag_pos, s, assign, data)
                 else:
                     vals = t.hessian_values(x).reshape(len(t.conn), -1)
-                    _block_scatter_csr(vals, t.conn, p, nptr, self.dim, s, data)
+                    block_scatter_csr(vals, t.conn, p, nptr, self.dim, s, data)
         else:
             if data is None:
                 data = np.zeros(self._nnz)
@@ -319,7 +319,7 @@ class Model:
             for (t, _, _), scatter in zip(self._hessian_terms, self._scatter):
                 s = float(self._scale(t, load))
                 if s != 0.0:
-                    _scatter_add(data, scatter, t.hessian_values(x), s)
+                    scatter_add(data, scatter, t.hessian_values(x), s)
         # the pattern arrays are shared, not copied (54 MB for a 30^3 lattice): they are read-only,
         # so an operation that would change a returned matrix's structure in place fails loudly
         if out is not None:
@@ -367,10 +367,10 @@ class Model:
         for t, kind, p, s, assign in steps:
             if kind == "springs":
                 _, rowptr, nb, k, L0 = t.symmetric_layout()
-                _spring3d_hessian_bsr(x, rowptr, nb, k, L0, p, nptr, diag_pos, bmap, s, assign, data)
+                spring3d_hessian_bsr(x, rowptr, nb, k, L0, p, nptr, diag_pos, bmap, s, assign, data)
             else:
                 vals = t.hessian_values(x).reshape(len(t.conn), -1)
-                _block_scatter_bsr(vals, t.conn, p, nptr, bmap, s, data)
+                block_scatter_bsr(vals, t.conn, p, nptr, bmap, s, data)
         if out is not None:
             return out
         K = sp.bsr_matrix((data, bind, bptr), shape=shape, copy=False)
@@ -471,6 +471,6 @@ class Model:
 
 def _is_block_term(term, dim) -> bool:
     """True for element terms whose Hessian pattern is the dense block of all dofs of their nodes
-    (the default :meth:`msslib.terms.base._ElementTerm.hessian_pattern`)."""
-    return (isinstance(term, _ElementTerm) and type(term).hessian_pattern is _ElementTerm.hessian_pattern
-            and type(term).hessian_values is _ElementTerm.hessian_values and term.dim == dim)
+    (the default :meth:`msslib.terms.base.ElementTerm.hessian_pattern`)."""
+    return (isinstance(term, ElementTerm) and type(term).hessian_pattern is ElementTerm.hessian_pattern
+            and type(term).hessian_values is ElementTerm.hessian_values and term.dim == dim)

@@ -117,8 +117,27 @@ def test_package_faces_export_public_names_only():
         if "generated" in init.parts:
             continue
         for node in ast.walk(ast.parse(init.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.ImportFrom) and node.level:
-                bad += [f"{init.relative_to(ROOT)}: {a.name}" for a in node.names if a.name.startswith("_")]
+            if isinstance(node, ast.ImportFrom) and (node.level or (node.module or "").startswith("msslib")):
+                bad += [f"{init.relative_to(ROOT)}: {a.name}" for a in node.names
+                        if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not bad, bad
+
+
+def test_underscore_names_stay_inside_their_package():
+    """A name with a leading underscore is imported only by modules of the package that defines it
+    (``msslib.solvers.statics`` may take ``msslib.solvers.memo._Memo``, ``msslib.system`` may not take
+    ``msslib.terms.assembly``'s helpers): what another package needs is public in its module."""
+    bad = []
+    for path in (ROOT / "msslib").rglob("*.py"):
+        if "generated" in path.parts:
+            continue
+        name = ".".join(path.relative_to(ROOT).with_suffix("").parts).removesuffix(".__init__")
+        own = name.split(".")[:2]
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom) and not node.level and (node.module or "").startswith("msslib."):
+                if node.module.split(".")[:2] != own:
+                    bad += [f"{name}: {node.module}.{a.name}" for a in node.names
+                            if a.name.startswith("_") and not a.name.startswith("__")]
     assert not bad, bad
 
 

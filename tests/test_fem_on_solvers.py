@@ -6,6 +6,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from msslib import fem
+from msslib.fem import space as fem_space
 from msslib import mesh as M
 from msslib.solvers import linear as solvers_linear
 
@@ -19,14 +20,14 @@ def _block(n):
 
 def _counting(monkeypatch):
     calls = []
-    real = solvers_linear._linear_solve
+    real = solvers_linear.solve_linear_system
 
     def counted(A, b, method, *args, **kw):
         calls.append((A.shape[0], method))
         return real(A, b, method, *args, **kw)
 
-    monkeypatch.setattr(solvers_linear, "_linear_solve", counted)
-    monkeypatch.setattr("msslib.solvers.statics._linear_solve", counted)
+    monkeypatch.setattr(solvers_linear, "solve_linear_system", counted)
+    monkeypatch.setattr("msslib.solvers.statics.solve_linear_system", counted)
     return calls
 
 
@@ -38,9 +39,9 @@ def test_linear_fem_on_amg_cg_equals_superlu(monkeypatch):
     r = fem.solve_linear(m, 1e6, 0.3, fixed=fixed, body_force=[0.0, 0.0, -1e4])
     assert calls and calls[0][0] == 6084
     assert r.stats["solver"].endswith(": cg"), r.stats["solver"]
-    geo = fem._Geometry(m)
+    geo = fem_space._Geometry(m)
     lam, mu = fem.lame(np.full(m.n_cells, 1e6), np.full(m.n_cells, 0.3))
-    K = fem._linear_stiffness(geo, lam, mu).tocsc()
+    K = fem_space._linear_stiffness(geo, lam, mu).tocsc()
     free = ~fixed.ravel()
     f = geo.body_load([0.0, 0.0, -1e4], 1.0).ravel()
     u = np.zeros(K.shape[0])

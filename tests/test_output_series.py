@@ -14,7 +14,7 @@ import pytest
 import yaml
 
 from msslib import cli
-from msslib.cli.inputs import _check_distinct
+from msslib.cli.inputs import check_distinct
 from msslib.results import read_result
 from msslib.results.paraview import series_files
 from msslib.results.staging import StagedOutputs
@@ -73,7 +73,7 @@ def _check_time(n_states: int, tries: int = 1) -> float:
     best = float("inf")
     for _ in range(tries):
         t = time.perf_counter()
-        _check_distinct(files, inputs)
+        check_distinct(files, inputs)
         best = min(best, time.perf_counter() - t)
     return best
 
@@ -87,11 +87,11 @@ def test_checking_a_long_series_takes_linear_time():
 def test_checking_a_series_still_finds_two_names_of_one_file(tmp_path):
     files = series_files(tmp_path / "r.pvd", 5000, springs=False)
     with pytest.raises(cli.CommandError, match="r_4999.vtu.*the same file"):
-        _check_distinct([*files, ("copy", tmp_path / "." / "r_4999.vtu")])
+        check_distinct([*files, ("copy", tmp_path / "." / "r_4999.vtu")])
     (tmp_path / "m.vtu").write_text("mesh\n")
     os.link(tmp_path / "m.vtu", tmp_path / "r_2500.vtu")  # a hard link: the same file by another name
     with pytest.raises(cli.CommandError, match="r_2500.vtu.*is the mesh file"):
-        _check_distinct(files, [("mesh file", tmp_path / "m.vtu")])
+        check_distinct(files, [("mesh file", tmp_path / "m.vtu")])
 
 
 def _stage_time(n_files: int, directory) -> float:

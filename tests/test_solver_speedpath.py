@@ -150,7 +150,7 @@ def test_kept_hierarchy_is_given_up_at_the_iteration_limit():
     assert info == 0 and plain > 3 * limit  # unpreconditioned CG is far slower
     ctx = dict(ctx, cache={"M": identity, "shape": A.shape, "per_decade": 1.0})
     messages = []
-    x = S.linear._linear_solve(A, b, "cg", True, messages, ctx, rtol)
+    x = S.linear.solve_linear_system(A, b, "cg", True, messages, ctx, rtol)
     rebuilt = ctx["cache"]["M"]
     assert rebuilt is not identity
     _, info, fresh = S.linear._pcg(A, b, rebuilt, rtol, 5000)

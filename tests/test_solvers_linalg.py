@@ -42,7 +42,7 @@ def lattice_block(nx, ny, nz, *, k3=2.0, g=0.05):
 
 def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
     from msslib.solvers import PlanCache
-    from msslib.solvers.submatrices import _submatrix
+    from msslib.solvers.submatrices import submatrix
 
     rng = np.random.default_rng(4)
     plans = PlanCache()
@@ -53,13 +53,13 @@ def test_submatrix_plan_matches_fancy_indexing_and_is_reused():
         free = rng.random(40) < 0.7
         idx = np.flatnonzero(free)
         for _ in range(2):  # the second call goes through the cached plan
-            A = _submatrix(K, free, plans=plans)
+            A = submatrix(K, free, plans=plans)
             A.check_format(full_check=True)
             assert A.shape == (len(idx), len(idx))
             assert abs(A - K[idx][:, idx]).max() == 0 if A.nnz else K[idx][:, idx].nnz == 0
         K2 = K.copy()
         K2.data = rng.standard_normal(K2.nnz)  # same pattern, new values
-        assert abs(_submatrix(K2, free, plans=plans) - K2[idx][:, idx]).max() == 0 if K2[idx][:, idx].nnz else True
+        assert abs(submatrix(K2, free, plans=plans) - K2[idx][:, idx]).max() == 0 if K2[idx][:, idx].nnz else True
         assert plans.entries[0]["free"].tolist() == free.tolist()  # the plan was kept
 
 
@@ -76,7 +76,7 @@ def clamped_golec_block(nx, ny, nz, nu=0.3):
 
 def test_submatrix_refill_in_place_equals_fresh_extraction():
     from msslib.solvers import PlanCache
-    from msslib.solvers.submatrices import _submatrix
+    from msslib.solvers.submatrices import submatrix
 
     model = clamped_golec_block(3, 2, 2)
     free = model.free
@@ -84,19 +84,19 @@ def test_submatrix_refill_in_place_equals_fresh_extraction():
     rng = np.random.default_rng(5)
     K = model.stiffness(model.x0)
     plans = PlanCache()
-    A = _submatrix(K, free, plans=plans)
+    A = submatrix(K, free, plans=plans)
     for _ in range(2):
         x = model.x0 + 1e-3 * rng.standard_normal(model.n_dof)
         K = model.stiffness(x, out=K)
-        A2 = _submatrix(K, free, out=A, plans=plans)
+        A2 = submatrix(K, free, out=A, plans=plans)
         assert A2 is A  # values overwritten in place
         ref = K.tocsc()[idx][:, idx]
         assert abs(A2 - ref).max() == 0.0
     # a matrix of another pattern is not reused
     other = sp.csr_matrix(np.eye(len(idx)))
-    assert _submatrix(K, free, out=other, plans=plans) is not other
+    assert submatrix(K, free, out=other, plans=plans) is not other
     # without a plan cache the plan is made for the call: the result is not refilled in place
-    assert _submatrix(K, free, out=A) is not A
+    assert submatrix(K, free, out=A) is not A
 
 
 @pytest.mark.parametrize("shift", [0.0, -0.5])  # SPD (banded Cholesky) and indefinite (banded LU)
@@ -107,9 +107,9 @@ def test_banded_direct_solve_matches_dense(shift):
     prob = lattice_block(3, 3, 6)
     x = prob.x0()
     free = prob.free
-    from msslib.solvers.submatrices import _submatrix
+    from msslib.solvers.submatrices import submatrix
 
-    A = _submatrix(prob.stiffness(x) + shift * sp.eye(prob.n_dof, format="csr"), free)
+    A = submatrix(prob.stiffness(x) + shift * sp.eye(prob.n_dof, format="csr"), free)
     A = sp.csr_matrix(A)
     A.sum_duplicates()
     b = np.random.default_rng(0).standard_normal(A.shape[0])
@@ -229,7 +229,7 @@ def test_band_width_bound_never_exceeds_the_bandwidth_found(shape, monkeypatch):
     from msslib.solvers import BAND_AUTO_COST
     from msslib.solvers.direct import _band_plan
     from msslib.solvers.policy import _band_surely_wide
-    from msslib.solvers.submatrices import _bsr_entry, _eccentricity, _submatrix
+    from msslib.solvers.submatrices import _bsr_entry, _eccentricity, submatrix
     from msslib.solvers.context import _solver_context
 
     nx, ny, nz = shape
@@ -240,7 +240,7 @@ def test_band_width_bound_never_exceeds_the_bandwidth_found(shape, monkeypatch):
     e = _eccentricity(entry["bptr"], entry["bind"])
     # 26-neighbour lattice: Chebyshev distance from the first free node (a corner of layer x = 1)
     assert e == max(nx - 1, ny, nz)
-    A = _submatrix(K, model.free)
+    A = submatrix(K, model.free)
     import msslib.solvers as S
 
     monkeypatch.setattr(S.direct, "BAND_COST_MAX", float("inf"))  # a plan whatever the bandwidth

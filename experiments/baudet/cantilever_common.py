@@ -179,11 +179,11 @@ def solve_cubic(moduli, n, *, order=1, body_force=None, size=None):
     K = stiffness.assemble(basis)
     f = load.assemble(basis)
     clamped = basis.get_dofs(lambda x: np.isclose(x[0], 0.0)).all()
-    from msslib.fem import _solve_sparse
+    from msslib.fem import solve_sparse
 
     u = np.zeros(K.shape[0])
     free = np.setdiff1d(np.arange(K.shape[0]), clamped)
-    u[free] = _solve_sparse(K[free][:, free], f[free])
+    u[free] = solve_sparse(K[free][:, free], f[free])
     return CubicSolution(basis, u)
 
 

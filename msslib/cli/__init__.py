@@ -56,22 +56,19 @@ from pathlib import Path
 __all__ = ["main", "build_parser", "COMMANDS"]
 
 
-from msslib.cli.inputs import (  # noqa: F401
+from msslib.cli.inputs import (
     CommandError,
-    _one_line,
-    _same_file,
-    _check_distinct,
-    _check_writable,
-    _input_file,
-    _not_utf8,
-    _load_scene,
-    _mesh_input,
-    _load_experiment,
-    _choice,
-    _read_result,
-    _vtu_path,
-    _check_paraview,
-    RESULT_VARIABLES,
+    one_line,
+    check_distinct,
+    check_writable,
+    input_file,
+    load_scene,
+    mesh_input,
+    load_experiment,
+    choice,
+    read_result_file,
+    vtu_path,
+    check_paraview,
 )
 
 
@@ -96,20 +93,20 @@ def _cmd_run(args) -> int:
     from msslib.results.paraview import ParaViewOutput
     from msslib.scene import run_scene
 
-    scene = _load_scene(args.scene)
+    scene = load_scene(args.scene)
     out = Path(args.out)
-    vtu = _vtu_path(scene, out, args.vtu)
+    vtu = vtu_path(scene, out, args.vtu)
     view = ParaViewOutput(vtu) if vtu is not None else None
-    inputs = [("scene file", Path(args.scene)), *_mesh_input(scene)]
+    inputs = [("scene file", Path(args.scene)), *mesh_input(scene)]
     outputs = [("output file", out), *([(view.what, view.path)] if view is not None else [])]
-    _check_distinct(outputs, inputs)
+    check_distinct(outputs, inputs)
     if view is not None:
-        _check_paraview(view, [*inputs, ("output file", out)])
+        check_paraview(view, [*inputs, ("output file", out)])
     for what, path in outputs:
-        _check_writable(path, what)
+        check_writable(path, what)
     ds = run_scene(scene, progress=not args.quiet)
     files = view.files(ds) if view is not None else []
-    _check_distinct([("output file", out), *files], inputs)  # every file of a series, links included
+    check_distinct([("output file", out), *files], inputs)  # every file of a series, links included
     with StagedOutputs() as staged:  # every file, or none
         stage_result(staged, out, ds)
         if view is not None:
@@ -134,7 +131,7 @@ def _add_validate(subparsers) -> None:
 def _cmd_validate(args) -> int:
     from msslib.scene import prepare
 
-    scene = _load_scene(args.scene)
+    scene = load_scene(args.scene)
     setup = prepare(scene)
     mesh = setup.mesh
     kind = scene.solver["type"]
@@ -182,7 +179,7 @@ def _experiment_scenes(exp, pairs, quick):
     meshes = []
     for case, model in pairs:
         scene = load_scene(experiment.scene_of(exp, case, model, quick), base_dir=exp.base_dir)
-        meshes += [m for m in _mesh_input(scene) if m not in meshes]
+        meshes += [m for m in mesh_input(scene) if m not in meshes]
     return meshes
 
 
@@ -190,13 +187,13 @@ def _cmd_experiment_run(args) -> int:
     from msslib import experiment
     from msslib.results import write_result
 
-    exp = _load_experiment(args.experiment)
-    _choice("--case", args.case, list(exp.cases), f"case of experiment {exp.name}")
-    _choice("--model", args.model, list(exp.models), f"model of experiment {exp.name}")
+    exp = load_experiment(args.experiment)
+    choice("--case", args.case, list(exp.cases), f"case of experiment {exp.name}")
+    choice("--model", args.model, list(exp.models), f"model of experiment {exp.name}")
     meshes = _experiment_scenes(exp, [(args.case, args.model)], args.quick)
     out = Path(args.out)
-    _check_distinct([("output file", out)], [("experiment file", Path(args.experiment)), *meshes])
-    _check_writable(out, "output file")
+    check_distinct([("output file", out)], [("experiment file", Path(args.experiment)), *meshes])
+    check_writable(out, "output file")
     ds = experiment.run(exp, args.case, args.model, quick=args.quick, progress=not args.quiet)
     write_result(out, ds)
     return 0
@@ -206,17 +203,17 @@ def _cmd_experiment_run_all(args) -> int:
     from msslib import experiment
     from msslib.results import StagedOutputs, stage_result
 
-    exp = _load_experiment(args.experiment)
+    exp = load_experiment(args.experiment)
     out_dir = Path(args.out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise CommandError(f"--out-dir {str(out_dir)!r} is not a directory")
     runs = experiment.runs(exp)
     meshes = _experiment_scenes(exp, runs, args.quick)
     outputs = [("output file", out_dir / f"{case}__{model}.nc") for case, model in runs]
-    _check_distinct(outputs, [("experiment file", Path(args.experiment)), *meshes])
+    check_distinct(outputs, [("experiment file", Path(args.experiment)), *meshes])
     out_dir.mkdir(parents=True, exist_ok=True)
     for what, path in outputs:
-        _check_writable(path, what)
+        check_writable(path, what)
     with StagedOutputs() as staged:  # every result, or none
         for i, ((case, model), (_, out)) in enumerate(zip(runs, outputs), 1):
             if not args.quiet:
@@ -229,7 +226,7 @@ def _cmd_experiment_compare(args) -> int:
     from msslib import experiment
     from msslib.results import StagedOutputs, stage_result
 
-    exp = _load_experiment(args.experiment)
+    exp = load_experiment(args.experiment)
     out = Path(args.out)
     table = Path(args.table) if args.table else None
     results_dir = Path(args.results)
@@ -237,15 +234,15 @@ def _cmd_experiment_compare(args) -> int:
         raise CommandError(f"--results {str(results_dir)!r} is not a directory")
     paths = {(case, model): results_dir / f"{case}__{model}.nc" for case, model in experiment.runs(exp)}
     outputs = [("output file", out), ("table", table)]
-    _check_distinct(outputs, [("experiment file", Path(args.experiment)), *(("run", p) for p in paths.values())])
+    check_distinct(outputs, [("experiment file", Path(args.experiment)), *(("run", p) for p in paths.values())])
     for what, path in outputs:
         if path is not None:
-            _check_writable(path, what)
+            check_writable(path, what)
     results = {}
     for key, path in paths.items():
         if not path.is_file():
             raise CommandError(f"missing run {str(path)!r}")
-        results[key] = _read_result(path, "run")
+        results[key] = read_result_file(path, "run")
     ds = experiment.compare(exp, results)
     with StagedOutputs() as staged:  # both files, or neither
         stage_result(staged, out, ds, what="comparison")
@@ -257,7 +254,7 @@ def _cmd_experiment_compare(args) -> int:
 def _cmd_experiment_list(args) -> int:
     from msslib import experiment
 
-    exp = _load_experiment(args.experiment)
+    exp = load_experiment(args.experiment)
     for case, model in experiment.runs(exp):
         print(f"{case}__{model}")
     return 0
@@ -281,11 +278,11 @@ def _cmd_vtu(args) -> int:
     if not src.exists():
         raise CommandError(f"result file not found: {str(src)!r}")
     view = ParaViewOutput(out)
-    _check_distinct([(view.what, out)], [("result file", src)])
-    _check_paraview(view, [("result file", src)])
-    _check_writable(out, view.what)
-    ds = _read_result(src)
-    _check_distinct(view.files(ds), [("result file", src)])
+    check_distinct([(view.what, out)], [("result file", src)])
+    check_paraview(view, [("result file", src)])
+    check_writable(out, view.what)
+    ds = read_result_file(src)
+    check_distinct(view.files(ds), [("result file", src)])
     view.write(ds)  # every file of a series, or none
     return 0
 
@@ -308,11 +305,11 @@ def _cmd_compare(args) -> int:
     if vtu and vtu.suffix.lower() != ".vtu":
         raise CommandError(f"--vtu {str(vtu)!r}: the error field is one state; give a .vtu file")
     outputs = [("table", out), ("error field", vtu)]
-    _check_distinct(outputs, [("result file", src), ("reference file", ref)])
+    check_distinct(outputs, [("result file", src), ("reference file", ref)])
     for what, path in outputs:
         if path is not None:
-            _check_writable(path, what)
-    comparison = compare_results(_read_result(src, "result file"), _read_result(ref, "reference file"),
+            check_writable(path, what)
+    comparison = compare_results(read_result_file(src, "result file"), read_result_file(ref, "reference file"),
                                  result_name=str(src), reference_name=str(ref))
     with StagedOutputs() as staged:  # both files, or neither
         if out is not None:
@@ -369,11 +366,11 @@ def _read_front(path: Path, scene: Path):
 
     from msslib import planning
 
-    ds = _read_result(path, "front file", required=())
+    ds = read_result_file(path, "front file", required=())
     try:
         planning.check_front(ds, name=f"front file {str(path)!r}")
     except ValueError as exc:
-        raise CommandError(_one_line(exc)) from None
+        raise CommandError(one_line(exc)) from None
     raw, _ = planning._raw(scene)
     try:
         measured = yaml.safe_load(str(ds.attrs.get("scene", "")))
@@ -402,12 +399,12 @@ def _cmd_plan(args) -> int:
     if not 1 <= repeats <= planning.MAX_REPEATS:
         raise CommandError(f"--repeats must be an integer from 1 to {planning.MAX_REPEATS}, got {repeats}")
     budget = 30.0 if args.budget is None else _positive_number("--budget", args.budget, "seconds per run")
-    _input_file(scene, "scene file")
+    input_file(scene, "scene file")
     front_path = Path(args.front) if args.front is not None else None
     save = Path(args.save) if args.save is not None else None
-    _check_distinct([("--save file", save)], [("scene file", scene), ("--front file", front_path)])
+    check_distinct([("--save file", save)], [("scene file", scene), ("--front file", front_path)])
     if save is not None:
-        _check_writable(save, "--save file")
+        check_writable(save, "--save file")
     if front_path is not None:
         front = _read_front(front_path, scene)
     else:
@@ -452,9 +449,9 @@ def _cmd_export(args) -> int:
     try:
         formats = export_files.parse_formats(args.formats)
     except ValueError as exc:
-        raise CommandError(_one_line(exc)) from None
+        raise CommandError(one_line(exc)) from None
     scene_path = Path(args.scene)
-    scene = _load_scene(scene_path)
+    scene = load_scene(scene_path)
     if scene.is_fem:
         raise CommandError(f"scene file {str(scene_path)!r}: model {scene.model} is a FEM reference; export writes "
                            f"the mass-spring models")
@@ -466,15 +463,15 @@ def _cmd_export(args) -> int:
     chosen = formats if formats is not None else export_files.default_formats(exp)
     stem = export_files.stem_for(out, scene.name, directory)
     planned = export_files.output_paths(exp, stem, chosen)
-    inputs = [("scene file", scene_path), *_mesh_input(scene)]
+    inputs = [("scene file", scene_path), *mesh_input(scene)]
     if "c" in chosen:
         inputs.append(("generated C header", export.C_HEADER_PATH))
-    _check_distinct([(what, path) for _, what, path, _ in planned], inputs)
+    check_distinct([(what, path) for _, what, path, _ in planned], inputs)
     if directory and not out.exists():
-        _check_writable(out, "output directory")
+        check_writable(out, "output directory")
     else:
         for _, what, path, _ in planned:
-            _check_writable(path, what)
+            check_writable(path, what)
     skipped = [f for f in export_formats.whole_only() if formats is None and f not in chosen]
     if skipped:
         left_out = list(dict.fromkeys(n for f in skipped for n in export.not_carried(exp, f)))
@@ -532,7 +529,7 @@ def main(argv=None) -> int:
         # one line per distinct warning (a model built again, e.g. by plan's repeats, says the same
         # once): msslib's own as they are, others (numpy, scipy, ...) with their origin
         origin = "" if issubclass(category, MsslibWarning) else f" ({category.__name__} in {Path(filename).name})"
-        text = f"msslib: warning: {_one_line(message)}{origin}"
+        text = f"msslib: warning: {one_line(message)}{origin}"
         if text not in shown:
             shown.add(text)
             print(text, file=sys.stderr)
@@ -542,7 +539,7 @@ def main(argv=None) -> int:
         with terminate_raises():  # SIGTERM unwinds like SIGINT: temporary files are removed
             return int(args.func(args) or 0)
     except (CommandError, ValueError, OSError, ConvergenceError, DivergenceError, UnphysicalStateError) as exc:
-        print(f"msslib: error: {_one_line(exc)}", file=sys.stderr)
+        print(f"msslib: error: {one_line(exc)}", file=sys.stderr)
         return 1
     except Terminated:
         print("msslib: terminated", file=sys.stderr)
@@ -553,7 +550,7 @@ def main(argv=None) -> int:
     except Exception as exc:
         if getattr(exc, "msslib_output", None) is None:  # a failed write of an output names it
             raise
-        print(f"msslib: error: {_one_line(exc)}", file=sys.stderr)
+        print(f"msslib: error: {one_line(exc)}", file=sys.stderr)
         return 1
     finally:
         warnings.showwarning = previous

@@ -15,7 +15,7 @@ class CommandError(Exception):
     """A user-facing error reported as one line with exit code 1."""
 
 
-def _one_line(exc: BaseException) -> str:
+def one_line(exc: BaseException) -> str:
     text = " ".join(str(exc).split())
     return text or type(exc).__name__
 
@@ -25,7 +25,7 @@ def _one_line(exc: BaseException) -> str:
 # --------------------------------------------------------------------------------------------
 
 
-def _same_file(a: Path, b: Path) -> bool:
+def same_file(a: Path, b: Path) -> bool:
     """``a`` and ``b`` name one file: the same resolved path, or (existing files) the same inode
     (hard links, symbolic links, other spellings)."""
     try:
@@ -42,7 +42,7 @@ def _same_file(a: Path, b: Path) -> bool:
 def _file_keys(path: Path) -> list:
     """What identifies the file ``path`` names: its resolved path and, for an existing file, its
     device and inode (hard links, symbolic links, other spellings); two paths name one file when
-    they share a key (as :func:`_same_file` decides)."""
+    they share a key (as :func:`same_file` decides)."""
     keys = []
     try:
         keys.append(("path", str(path.resolve())))
@@ -56,7 +56,7 @@ def _file_keys(path: Path) -> list:
     return keys
 
 
-def _check_distinct(outputs, inputs=()) -> None:
+def check_distinct(outputs, inputs=()) -> None:
     """Refuse an output that is one of the inputs or another output (pairs ``(what, path)``).
 
     Linear in the number of paths (a series of 10 000 files is checked in a fraction of a second):
@@ -86,7 +86,7 @@ def _check_distinct(outputs, inputs=()) -> None:
             known_outputs.setdefault(key, (what, out))
 
 
-def _check_writable(path: Path, what: str) -> None:
+def check_writable(path: Path, what: str) -> None:
     """Fail early (before a long run) when ``path`` cannot be written."""
     if path.is_dir():
         raise CommandError(f"{what} {str(path)!r} is a directory")
@@ -101,7 +101,7 @@ def _check_writable(path: Path, what: str) -> None:
         raise CommandError(f"cannot write {what} {str(path)!r}: directory {str(directory)!r} is not writable")
 
 
-def _input_file(path: Path, what: str) -> Path:
+def input_file(path: Path, what: str) -> Path:
     path = Path(path)
     if not path.exists():
         raise CommandError(f"{what} not found: {str(path)!r}")
@@ -112,47 +112,47 @@ def _input_file(path: Path, what: str) -> Path:
     return path
 
 
-def _not_utf8(path, what, exc: UnicodeDecodeError) -> CommandError:
+def not_utf8(path, what, exc: UnicodeDecodeError) -> CommandError:
     return CommandError(f"{what} {str(path)!r} is not UTF-8 text (byte {exc.start}: {exc.reason})")
 
 
-def _load_scene(path):
+def load_scene(path):
     from msslib.scene import load_scene
 
-    _input_file(Path(path), "scene file")
+    input_file(Path(path), "scene file")
     try:
         return load_scene(path)
     except UnicodeDecodeError as exc:
-        raise _not_utf8(path, "scene file", exc) from None
+        raise not_utf8(path, "scene file", exc) from None
 
 
-def _mesh_input(scene):
+def mesh_input(scene):
     """``[("mesh file", path)]`` when the scene reads its mesh from a file."""
     return [("mesh file", scene.geometry["file"])] if "file" in scene.geometry else []
 
 
-def _load_experiment(path):
+def load_experiment(path):
     import yaml
 
     from msslib import experiment
 
-    _input_file(Path(path), "experiment file")
+    input_file(Path(path), "experiment file")
     try:
         return experiment.load_experiment(path)
     except UnicodeDecodeError as exc:
-        raise _not_utf8(path, "experiment file", exc) from None
+        raise not_utf8(path, "experiment file", exc) from None
     except yaml.YAMLError as exc:
-        raise CommandError(f"experiment file {str(path)!r}: invalid YAML: {_one_line(exc)}") from None
+        raise CommandError(f"experiment file {str(path)!r}: invalid YAML: {one_line(exc)}") from None
     except FileNotFoundError:
         raise
     except ValueError as exc:
-        raise CommandError(f"experiment file {str(path)!r}: {_one_line(exc)}") from None
+        raise CommandError(f"experiment file {str(path)!r}: {one_line(exc)}") from None
     except (TypeError, AttributeError, KeyError) as exc:  # a value of the wrong kind somewhere in the file
         raise CommandError(f"experiment file {str(path)!r} is not a valid experiment ({type(exc).__name__}: "
-                           f"{_one_line(exc)})") from None
+                           f"{one_line(exc)})") from None
 
 
-def _choice(option: str, value: str, allowed, what: str) -> str:
+def choice(option: str, value: str, allowed, what: str) -> str:
     if value not in allowed:
         raise CommandError(f"{option} {value!r} is not a {what}; expected one of {', '.join(map(str, allowed))}")
     return value
@@ -162,15 +162,15 @@ def _choice(option: str, value: str, allowed, what: str) -> str:
 RESULT_VARIABLES = ("rest_position", "displacement", "cells")
 
 
-def _read_result(path: Path, what: str = "result file", required=RESULT_VARIABLES):
+def read_result_file(path: Path, what: str = "result file", required=RESULT_VARIABLES):
     """Read an msslib result; CommandError naming ``path`` when it is not one."""
     from msslib.results import SCHEMA_VERSION, read_result
 
-    _input_file(path, what)
+    input_file(path, what)
     try:
         ds = read_result(path)
     except (OSError, ValueError, RuntimeError) as exc:
-        detail = _one_line(exc).replace(str(Path(path).resolve()), "").replace(str(path), "").strip(" :'")
+        detail = one_line(exc).replace(str(Path(path).resolve()), "").replace(str(path), "").strip(" :'")
         raise CommandError(f"{what} {str(path)!r} is not a NetCDF file msslib can read ({detail})") from None
     missing = [v for v in required if v not in ds.variables]
     if missing:
@@ -188,11 +188,11 @@ def _read_result(path: Path, what: str = "result file", required=RESULT_VARIABLE
         try:
             mesh_from_result(ds)
         except (ValueError, TypeError, KeyError) as exc:
-            raise CommandError(f"{what} {str(path)!r}: not a valid mesh ({_one_line(exc)})") from None
+            raise CommandError(f"{what} {str(path)!r}: not a valid mesh ({one_line(exc)})") from None
     return ds
 
 
-def _vtu_path(scene, out: Path, cli_vtu: str | None) -> Path | None:
+def vtu_path(scene, out: Path, cli_vtu: str | None) -> Path | None:
     if cli_vtu:
         return Path(cli_vtu)
     vtu = scene.output.get("vtu", False)
@@ -203,11 +203,11 @@ def _vtu_path(scene, out: Path, cli_vtu: str | None) -> Path | None:
     return None
 
 
-def _check_paraview(view, others) -> None:
+def check_paraview(view, others) -> None:
     """Refuse, before anything runs, a ParaView output (a :class:`msslib.results.paraview.ParaViewOutput`)
     whose suffix is neither .vtu nor .pvd, or a series that would write over one of ``others``
     (pairs ``(what, path)``: the inputs and the other outputs) (:meth:`~msslib.results.paraview.ParaViewOutput.check`)."""
     try:
         view.check(others)
     except ValueError as exc:
-        raise CommandError(_one_line(exc)) from None
+        raise CommandError(one_line(exc)) from None

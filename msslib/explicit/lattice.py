@@ -323,9 +323,9 @@ class LatticeExplicit:
         cached = getattr(self, "_omega_cache", None)
         if cached is not None and cached[0].shape == x.shape and np.array_equal(cached[0], x):
             return cached[1]
-        from msslib.solvers.stability import _omega_max_squared
+        from msslib.solvers.stability import omega_max_squared
 
-        omega = float(np.sqrt(_omega_max_squared(self.model, x, self.load)))
+        omega = float(np.sqrt(omega_max_squared(self.model, x, self.load)))
         self._omega_cache = (x.copy(), omega)
         return omega
 

@@ -36,7 +36,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from msslib.terms.jit import _U
+from msslib.terms.jit import UINT
 
 # fast-math without nnan/ninf: the monitor must see a non-finite state
 _FAST = {"nsz", "arcp", "contract", "afn"}
@@ -95,7 +95,7 @@ def records(x) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
-def _pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, advance):
+def fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, advance):
     """One pass: the force ``F`` at the positions ``R[:, :3]`` (springs + the accumulators
     ``R[:, 3:]``, which hold the other forces and are zeroed, + ``fext``), the monitor row
     ``mon[row]`` (over the free dofs, ``w != 0``; the masses are ``h / w``; its first column is
@@ -116,7 +116,7 @@ def _pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, adv
         ga1 = R[na, 4]
         ga2 = R[na, 5]
         for s in range(rowptr[na], rowptr[na + 1]):
-            b = _U(ib[_U(s)])
+            b = UINT(ib[UINT(s)])
             d0 = R[b, 0] - xa0
             d1 = R[b, 1] - xa1
             d2 = R[b, 2] - xa2
@@ -164,7 +164,7 @@ def _pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, adv
 
 
 @njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
-def _advance(R, v, F, w, damp, h):
+def fused_advance(R, v, F, w, damp, h):
     """The update of every node from the current force ``F`` (no force evaluation)."""
     for j in range(v.shape[0]):
         if w[j] != 0.0:
@@ -174,10 +174,10 @@ def _advance(R, v, F, w, damp, h):
 
 
 @njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
-def _steps(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, n_steps):
-    _advance(R, v, F, w, damp, h)
+def fused_steps(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, n_steps):
+    fused_advance(R, v, F, w, damp, h)
     for p in range(n_steps):
-        _pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, p, p + 1 < n_steps)
+        fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, p, p + 1 < n_steps)
 
 
 def network_forces(state, layout, mon, row: int = 0):
@@ -186,7 +186,7 @@ def network_forces(state, layout, mon, row: int = 0):
     fixed ones); ``F`` becomes the force."""
     R, v, F, w, damp, h, fext, x_ref, react = state
     rowptr, ib, kl = layout
-    _pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, False)
+    fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, False)
 
 
 def network_steps(state, layout, mon, n_steps: int):
@@ -195,4 +195,4 @@ def network_steps(state, layout, mon, n_steps: int):
     after the call.  The accumulators must be zero (spring-only networks)."""
     R, v, F, w, damp, h, fext, x_ref, react = state
     rowptr, ib, kl = layout
-    _steps(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, int(n_steps))
+    fused_steps(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, int(n_steps))

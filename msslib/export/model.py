@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from msslib.terms.base import Column, Table, _col
+from msslib.terms.base import Column, Table, make_column
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "C_HEADER_PATH", "c_header_paths", "Column", "Table", "MssExport", "build",
            "from_setup", "not_carried"]
@@ -186,34 +186,34 @@ def _tables(exp: MssExport) -> dict[str, Table]:
     nodes = np.arange(n)
     out = {}
     out["nodes"] = Table("nodes", f"node rest positions and masses ({exp.mass_source})", [
-        _col("node", None, nodes, "node index (0-based)", int),
-        *[_col(a, "m", exp.points[:, i], f"rest position, {a}") for i, a in enumerate(axes)],
-        _col("mass", "kg", exp.masses, "node mass"),
+        make_column("node", None, nodes, "node index (0-based)", int),
+        *[make_column(a, "m", exp.points[:, i], f"rest position, {a}") for i, a in enumerate(axes)],
+        make_column("mass", "kg", exp.masses, "node mass"),
     ])
     out["springs"] = Table("springs", "springs k/2 (|x_j - x_i| - L)^2 between node_i and node_j", [
-        _col("spring", None, np.arange(len(exp.pairs)), "spring index", int),
-        _col("node_i", None, exp.pairs[:, 0], "first node", int),
-        _col("node_j", None, exp.pairs[:, 1], "second node", int),
-        _col("stiffness", "N/m", exp.stiffness, "spring constant k, summed over the elements sharing the pair"),
-        _col("rest_length", "m", exp.rest_length, "rest length L (differs from the node distance for "
+        make_column("spring", None, np.arange(len(exp.pairs)), "spring index", int),
+        make_column("node_i", None, exp.pairs[:, 0], "first node", int),
+        make_column("node_j", None, exp.pairs[:, 1], "second node", int),
+        make_column("stiffness", "N/m", exp.stiffness, "spring constant k, summed over the elements sharing the pair"),
+        make_column("rest_length", "m", exp.rest_length, "rest length L (differs from the node distance for "
                                                   "prestrained springs)"),
     ])
     held = np.flatnonzero(exp.fixed.any(axis=1))
     out["fixed"] = Table("fixed", "nodes with fixed axes (1 fixed, 0 free) and the displacements prescribed "
                                   "on the fixed axes at load factor 1 (0 on free axes)", [
-        _col("node", None, held, "node index", int),
-        *[_col(f"fixed_{a}", None, exp.fixed[held, i].astype(int), f"axis {a} fixed", int) for i, a in enumerate(axes)],
-        *[_col(f"u_{a}", "m", exp.prescribed[held, i], f"prescribed displacement, {a}") for i, a in enumerate(axes)],
+        make_column("node", None, held, "node index", int),
+        *[make_column(f"fixed_{a}", None, exp.fixed[held, i].astype(int), f"axis {a} fixed", int) for i, a in enumerate(axes)],
+        *[make_column(f"u_{a}", "m", exp.prescribed[held, i], f"prescribed displacement, {a}") for i, a in enumerate(axes)],
     ])
     loaded = np.flatnonzero(np.any(exp.loads != 0, axis=1))
     out["loads"] = Table("loads", "surface loads (tractions and nodal forces of the scene) on the nodes at load "
                                   "factor 1, dead loads (gravity is in table gravity)", [
-        _col("node", None, loaded, "node index", int),
-        *[_col(f"f_{a}", "N", exp.loads[loaded, i], f"force, {a}") for i, a in enumerate(axes)],
+        make_column("node", None, loaded, "node index", int),
+        *[make_column(f"f_{a}", "N", exp.loads[loaded, i], f"force, {a}") for i, a in enumerate(axes)],
     ])
     g = np.zeros(dim) if exp.gravity is None else exp.gravity
     out["gravity"] = Table("gravity", "gravitational acceleration (each node carries its mass times it; zero: "
-                                      "no gravity)", [_col(f"g_{a}", "m/s^2", [g[i]], f"gravity, {a}")
+                                      "no gravity)", [make_column(f"g_{a}", "m/s^2", [g[i]], f"gravity, {a}")
                                                       for i, a in enumerate(axes)])
     for t in exp.terms:
         for table in t.export_tables(exp.setup.mesh):

@@ -60,9 +60,9 @@ assembly, boundary conditions and loads), :mod:`~msslib.fem.newton` (the solves 
 :mod:`msslib.solvers`), :mod:`~msslib.fem.solve` (the solves).
 """
 
-from msslib.fem.materials import _cell_materials, _check_plane, _det1m, _law, _law3d, lame  # noqa: F401
-from msslib.fem.solve import FemResult, _solve_sparse, element_stiffness, solve_linear, solve_nonlinear  # noqa: F401
-from msslib.fem.space import HEX_VTK_TO_SKFEM, _Geometry, _linear_stiffness, _skfem_linear_stiffness, to_skfem  # noqa: F401
+from msslib.fem.materials import lame
+from msslib.fem.solve import FemResult, element_stiffness, solve_linear, solve_nonlinear, solve_sparse
+from msslib.fem.space import HEX_VTK_TO_SKFEM, to_skfem
 
 __all__ = [
     "FemResult",
@@ -71,5 +71,6 @@ __all__ = [
     "lame",
     "solve_linear",
     "solve_nonlinear",
+    "solve_sparse",
     "to_skfem",
 ]

@@ -34,18 +34,18 @@ def linear_solve(K, rhs, free, points, dim: int, linear_solver="auto"):
     space). Returns ``(x, how)``, ``how`` naming the solver taken (``"direct"`` or ``"cg"``).
     Raises :class:`numpy.linalg.LinAlgError` for a singular matrix."""
     from msslib.solvers import context as _context
-    from msslib.solvers.linear import _linear_solve
-    from msslib.solvers.submatrices import _submatrix
-    from msslib.solvers.policy import _band_is_cheap, choose_linear_solver
-    from msslib.solvers.protocol import _NewtonFailure
+    from msslib.solvers.linear import solve_linear_system
+    from msslib.solvers.submatrices import submatrix
+    from msslib.solvers.policy import banded_cholesky_is_cheap, choose_linear_solver
+    from msslib.solvers.protocol import NewtonFailure
 
     ctx = _context._solver_context(SimpleNamespace(dim=dim), np.asarray(points, dtype=float).ravel(), free)
-    A = _submatrix(K.tocsr(), free, plans=ctx)
-    how = choose_linear_solver(linear_solver, A.shape[0], True, lambda: _band_is_cheap(A, ctx))
+    A = submatrix(K.tocsr(), free, plans=ctx)
+    how = choose_linear_solver(linear_solver, A.shape[0], True, lambda: banded_cholesky_is_cheap(A, ctx))
     messages: list = []
     try:
-        x = _linear_solve(A, np.asarray(rhs, dtype=float), linear_solver, True, messages, ctx, rtol=LINEAR_RTOL)
-    except _NewtonFailure as exc:
+        x = solve_linear_system(A, np.asarray(rhs, dtype=float), linear_solver, True, messages, ctx, rtol=LINEAR_RTOL)
+    except NewtonFailure as exc:
         raise np.linalg.LinAlgError(f"singular stiffness matrix (are rigid-body modes constrained?): {exc}") from None
     if not np.all(np.isfinite(x)):
         raise np.linalg.LinAlgError("singular stiffness matrix (are rigid-body modes constrained?)")

@@ -41,7 +41,7 @@ class FemResult:
 _SOLVER = "scipy.sparse.linalg.spsolve (SuperLU, MMD_AT_PLUS_A ordering)"
 
 
-def _solve_sparse(K: sp.spmatrix, rhs: np.ndarray) -> np.ndarray:
+def solve_sparse(K: sp.spmatrix, rhs: np.ndarray) -> np.ndarray:
     """Direct sparse solve; the minimum-degree ordering on K + K^T suits the symmetric stiffness
     matrices here (about twice as fast as the default COLAMD on 3D meshes)."""
     with warnings.catch_warnings():

@@ -124,7 +124,7 @@ def _checked_groups(kind: str, groups, size: int, facet_nodes: int | None) -> di
 # local numbering tables (VTK/meshio node order, see the docstring of msslib.mesh)
 # --------------------------------------------------------------------------------------------
 
-_LOCAL_EDGES = {
+LOCAL_EDGES = {
     "triangle": np.array([[0, 1], [1, 2], [2, 0]]),
     "quad": np.array([[0, 1], [1, 2], [2, 3], [3, 0]]),
     "tetra": np.array([[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]]),
@@ -137,8 +137,8 @@ _LOCAL_EDGES = {
 # oriented when the cell lies on its left, i.e. the outward normal is (dy, -dx).  In 3D the
 # right-hand-rule normal of the facet points out of the cell.
 _LOCAL_FACETS = {
-    "triangle": _LOCAL_EDGES["triangle"],
-    "quad": _LOCAL_EDGES["quad"],
+    "triangle": LOCAL_EDGES["triangle"],
+    "quad": LOCAL_EDGES["quad"],
     "tetra": np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]]),
     "hexahedron": np.array(
         [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]

@@ -12,7 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .core import _LOCAL_EDGES, _LOCAL_FACETS, COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _compact, _fmt_point
+from .core import LOCAL_EDGES, _LOCAL_FACETS, COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _compact, _fmt_point
 from .geometry import cell_measures
 from .groups import _renumbered_groups
 from .topology import facet_connected_cells
@@ -392,7 +392,7 @@ def cell_shapes(mesh: Mesh) -> tuple[np.ndarray, np.ndarray | None]:
     that of its neighbours.
     """
     x = mesh.points[mesh.cells]
-    edges = x[:, _LOCAL_EDGES[mesh.cell_type][:, 1]] - x[:, _LOCAL_EDGES[mesh.cell_type][:, 0]]
+    edges = x[:, LOCAL_EDGES[mesh.cell_type][:, 1]] - x[:, LOCAL_EDGES[mesh.cell_type][:, 0]]
     longest = np.linalg.norm(edges, axis=2).max(axis=1, initial=0.0)
     facets = x[:, _LOCAL_FACETS[mesh.cell_type]]  # (m, n_facets, nodes per facet, dim)
     if mesh.dim == 2:

@@ -12,7 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .core import _LOCAL_EDGES, _LOCAL_FACETS, Mesh
+from .core import LOCAL_EDGES, _LOCAL_FACETS, Mesh
 
 
 class NodePairs(NamedTuple):
@@ -61,14 +61,14 @@ def unique_edges(mesh: Mesh) -> NodePairs:
     sharing each edge (1 or 2 for a quad/hexahedron boundary/interior edge in 2D, up to 4 around
     an interior edge of a hexahedron grid, any number for tetrahedra).
     """
-    return _local_pairs(mesh, _LOCAL_EDGES[mesh.cell_type])
+    return _local_pairs(mesh, LOCAL_EDGES[mesh.cell_type])
 
 
 _FACE_DIAGONALS = {
     "quad": np.array([[0, 2], [1, 3]]),
     "hexahedron": _LOCAL_FACETS["hexahedron"][:, [[0, 2], [1, 3]]].reshape(-1, 2),
 }
-_INNER_DIAGONALS = np.array([[0, 6], [1, 7], [2, 4], [3, 5]])
+INNER_DIAGONALS = np.array([[0, 6], [1, 7], [2, 4], [3, 5]])
 
 
 def face_diagonals(mesh: Mesh) -> NodePairs:
@@ -85,7 +85,7 @@ def inner_diagonals(mesh: Mesh) -> NodePairs:
     """The four space diagonals (0-6, 1-7, 2-4, 3-5) of each hexahedron; counts are 1."""
     if mesh.cell_type != "hexahedron":
         raise ValueError(f"inner diagonals need hexahedron cells, got {mesh.cell_type}")
-    return _local_pairs(mesh, _INNER_DIAGONALS)
+    return _local_pairs(mesh, INNER_DIAGONALS)
 
 
 def _facet_table(mesh: Mesh):

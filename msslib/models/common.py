@@ -8,7 +8,7 @@ from functools import partial
 import numpy as np
 
 from msslib import mesh as _mesh
-from msslib.mesh.core import _LOCAL_EDGES
+from msslib.mesh.core import LOCAL_EDGES
 from msslib.models.checks import poisson, positive, same_shape, warn_nu
 from msslib.terms import Springs
 
@@ -139,7 +139,7 @@ def _pair_lengths(mesh, node_pairs):
 def _cube_edges(mesh, rtol=1e-6):
     """Edge length ``a`` per hexahedron; ValueError unless every cell is a cube (within rtol)."""
     x = mesh.points[mesh.cells]
-    edges = _LOCAL_EDGES["hexahedron"]
+    edges = LOCAL_EDGES["hexahedron"]
     lengths = np.linalg.norm(x[:, edges[:, 1]] - x[:, edges[:, 0]], axis=2)  # (m, 12)
     a = lengths.mean(axis=1)
     diag = np.linalg.norm(x[:, [6, 7, 4, 5]] - x[:, [0, 1, 2, 3]], axis=2)

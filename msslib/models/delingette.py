@@ -26,9 +26,9 @@ from msslib.models.checks import evaluate, poisson, positive, same_shape
 from msslib.models.common import _require, material_arrays
 from msslib.models.spec import Exactness, ModelSpec
 from msslib.terms import Term
-from msslib.terms.base import Table, _cell_columns, _col
-from msslib.terms.assembly import _block_pattern
-from msslib.terms.jit import _jit
+from msslib.terms.base import Table, cell_columns, make_column
+from msslib.terms.assembly import block_pattern
+from msslib.terms.jit import njit_cached
 
 __all__ = ["TriangleAngularSprings", "delingette_triangle"]  # the parameters (gathered by msslib.parameters)
 
@@ -118,12 +118,12 @@ class TriangleAngular(Term):
                       "D_i D_j, D_i = |x_b - x_a|^2 - L2_i the change of squared length of edge i = (node_0, node_1), "
                       "(node_1, node_2), (node_0, node_2) (msslib.models.delingette.TriangleAngular; thickness "
                       "included in the constants)", [
-                          *_cell_columns(self.conn, "triangle"),
-                          *[_col(f"k_{e}", "N/m^3", self.Q[:, i, i], f"tensile constant of edge {e}")
+                          *cell_columns(self.conn, "triangle"),
+                          *[make_column(f"k_{e}", "N/m^3", self.Q[:, i, i], f"tensile constant of edge {e}")
                             for i, e in enumerate(edges)],
-                          *[_col(f"c_{edges[i]}_{edges[j]}", "N/m^3", self.Q[:, i, j],
+                          *[make_column(f"c_{edges[i]}_{edges[j]}", "N/m^3", self.Q[:, i, j],
                                  f"angular constant of edges {edges[i]} and {edges[j]}") for i, j in PAIRS],
-                          *[_col(f"L2_{e}", "m^2", self.L2[:, i], f"rest squared length of edge {e}")
+                          *[make_column(f"L2_{e}", "m^2", self.L2[:, i], f"rest squared length of edge {e}")
                             for i, e in enumerate(edges)],
                       ])]
 
@@ -162,7 +162,7 @@ class TriangleAngular(Term):
 
     def hessian_pattern(self):
         if self._pattern is None:
-            self._pattern = _block_pattern(self.conn, 2)
+            self._pattern = block_pattern(self.conn, 2)
         return self._pattern
 
     def hessian_values(self, x) -> np.ndarray:
@@ -177,7 +177,7 @@ class TriangleAngular(Term):
 # s = Q D, and the Hessian is 1/2 J^T Q J (J = dD/dx: +-2 d_e) plus s_e (+-I) on the node blocks of
 # edge e.
 
-@_jit
+@njit_cached
 def _edge_state(x, conn, Q, L2, m, d, D, s):
     for e in range(3):
         a, b = conn[m, EDGES[e, 0]], conn[m, EDGES[e, 1]]
@@ -188,7 +188,7 @@ def _edge_state(x, conn, Q, L2, m, d, D, s):
         s[e] = Q[m, e, 0] * D[0] + Q[m, e, 1] * D[1] + Q[m, e, 2] * D[2]
 
 
-@_jit
+@njit_cached
 def _angular_energy(x, conn, Q, L2):
     d, D, s = np.empty((3, 2)), np.empty(3), np.empty(3)
     w = 0.0
@@ -198,7 +198,7 @@ def _angular_energy(x, conn, Q, L2):
     return w
 
 
-@_jit
+@njit_cached
 def _angular_gradient(x, conn, Q, L2, g):
     d, D, s = np.empty((3, 2)), np.empty(3), np.empty(3)
     for m in range(conn.shape[0]):
@@ -210,7 +210,7 @@ def _angular_gradient(x, conn, Q, L2, g):
                 g[2 * a + k] -= s[e] * d[e, k]
 
 
-@_jit
+@njit_cached
 def _angular_hessian(x, conn, Q, L2, out):
     d, D, s = np.empty((3, 2)), np.empty(3), np.empty(3)
     J = np.zeros((3, 6))

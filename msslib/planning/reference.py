@@ -45,7 +45,7 @@ def nearly_incompressible(setup) -> float | None:
 
 def _loads(setup):
     """``(nodal_forces, tractions, body_force)`` of the scene's loads."""
-    from msslib.scene.selection import _loaded_facets, _select
+    from msslib.scene.selection import loaded_facets, select_nodes
 
     mesh, dim = setup.mesh, setup.mesh.dim
     size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if mesh.n_nodes else 1.0
@@ -55,10 +55,10 @@ def _loads(setup):
     for i, load in enumerate(setup.scene.loads):
         path = f"scene.loads[{i}]"
         if load["type"] == "nodal_force":
-            nodes = _select(f"{path}.select", mesh, load["select"], tol)
+            nodes = select_nodes(f"{path}.select", mesh, load["select"], tol)
             nodal[nodes] += np.asarray(load["total"], dtype=float) / len(nodes)
         elif load["type"] == "traction":
-            facets = _loaded_facets(f"{path}.select", mesh, load["select"], tol, cache)
+            facets = loaded_facets(f"{path}.select", mesh, load["select"], tol, cache)
             tractions.append((facets, np.asarray(load["traction"], dtype=float)))
     body = None if setup.gravity is None else setup.cell_density[:, None] * setup.gravity[None, :]
     return nodal, tractions, body

@@ -13,7 +13,7 @@ import numpy as np
 from msslib import mesh as _mesh
 from msslib import models as _models
 from msslib.scene.schema import Scene
-from msslib.scene.selection import _build_mesh, _check_dim, _loaded_facets, _select
+from msslib.scene.selection import _build_mesh, _check_dim, loaded_facets, select_nodes
 from msslib.scene.validate import AXES, _fail
 
 
@@ -92,7 +92,7 @@ def prepare(scene: Scene) -> Setup:
     owner = np.full((n, dim), -1)
     for i, b in enumerate(scene.boundary):
         p = f"scene.boundary[{i}]"
-        nodes = _select(f"{p}.select", mesh, b["select"], default_tol)
+        nodes = select_nodes(f"{p}.select", mesh, b["select"], default_tol)
         axes = list(range(dim)) if b["fix"] is None else [AXES.index(a) for a in b["fix"]]
         for a in axes:
             if a >= dim:
@@ -128,13 +128,13 @@ def prepare(scene: Scene) -> Setup:
             gravity = g if gravity is None else gravity + g
         elif load["type"] == "nodal_force":
             total = _check_dim(f"{p}.total", load["total"], dim)
-            nodes = _select(f"{p}.select", mesh, load["select"], default_tol)
+            nodes = select_nodes(f"{p}.select", mesh, load["select"], default_tol)
             surface[nodes] += total / len(nodes)
         else:
             from msslib.terms import Traction
 
             traction = _check_dim(f"{p}.traction", load["traction"], dim)
-            loaded = _loaded_facets(f"{p}.select", mesh, load["select"], default_tol, facet_cache)
+            loaded = loaded_facets(f"{p}.select", mesh, load["select"], default_tol, facet_cache)
             surface += Traction(mesh, loaded, traction, thickness if dim == 2 else 1.0).nodal
     from msslib.hints import check_load_scale  # a load far above E (E in MPa, loads in Pa) is refused
 

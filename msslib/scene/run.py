@@ -79,13 +79,13 @@ def _solve_mss_static(setup: Setup, report):
 
 def _solve_mss_linear(setup: Setup):
     """One sparse solve with the model's stiffness (Hessian) at rest: the linearised MSS."""
-    from msslib.fem import _solve_sparse
+    from msslib.fem import solve_sparse
 
     model, t0 = setup.model, time.perf_counter()
     x = model.apply_prescribed(model.x0, 1.0)
     du, free = x - model.x0, model.free
     K, f = model.stiffness(model.x0, 1.0), model.force(model.x0, 1.0)
-    du[free] = _solve_sparse(K[free][:, free], f[free] - K[free][:, ~free] @ du[~free])
+    du[free] = solve_sparse(K[free][:, free], f[free] - K[free][:, ~free] @ du[~free])
     reaction = np.where(free, 0.0, K @ du - f).reshape(-1, model.dim)  # of the linearised forces
     stats = {"type": "static", "linear": True, "wall_time": time.perf_counter() - t0, "solver": "one solve with the "
              "stiffness at rest, scipy.sparse.linalg.spsolve (SuperLU, MMD_AT_PLUS_A ordering)"}

@@ -157,7 +157,7 @@ def _in_box(path, x, box, dim, tol):
     return keep
 
 
-def _select(path, mesh, sel, default_tol, group=None):
+def select_nodes(path, mesh, sel, default_tol, group=None):
     """Sorted ids of the selected nodes (``group``: the :func:`_group_members` of ``sel["group"]``
     if already looked up)."""
     if sel.get("all"):
@@ -166,7 +166,7 @@ def _select(path, mesh, sel, default_tol, group=None):
         group = _group_members(f"{path}.group", mesh, sel["group"]) if group is None else group
         if "plane" not in sel and "box" not in sel:
             return group[2]
-        nodes = np.intersect1d(_select(path, mesh, {k: v for k, v in sel.items() if k != "group"}, default_tol),
+        nodes = np.intersect1d(select_nodes(path, mesh, {k: v for k, v in sel.items() if k != "group"}, default_tol),
                                group[2])
         if len(nodes) == 0:
             where = " and ".join(f"plane [{sel['plane'][0]}, {sel['plane'][1]:g}]" if k == "plane" else f"box {sel[k]}"
@@ -189,7 +189,7 @@ def _select(path, mesh, sel, default_tol, group=None):
               f"{np.round(hi, 6).tolist()})")
 
 
-def _loaded_facets(path, mesh, sel, default_tol, cache):
+def loaded_facets(path, mesh, sel, default_tol, cache):
     """The facets a traction acts on: the facets of a facet group (each must be a boundary facet),
     the boundary facets of the cells of a cell group, else the boundary facets whose nodes are all
     selected; with plane and/or box, only those whose nodes are all in them too."""
@@ -213,7 +213,7 @@ def _loaded_facets(path, mesh, sel, default_tol, cache):
             candidates = members
         elif kind == "cells":
             candidates = candidates[np.isin(facet_cell, members)]
-    nodes = _select(path, mesh, sel, default_tol, group)
+    nodes = select_nodes(path, mesh, sel, default_tol, group)
     selected = np.zeros(mesh.n_nodes, dtype=bool)
     selected[nodes] = True
     on = selected[candidates].all(axis=1) if len(candidates) else np.zeros(0, dtype=bool)

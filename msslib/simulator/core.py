@@ -172,10 +172,10 @@ class Simulator:
     def _nodes(self, selection) -> np.ndarray:
         mesh = getattr(self.model, "mesh", None)
         if isinstance(selection, dict):  # the scene's selection syntax (group, plane, box)
-            from msslib.scene.selection import _select
+            from msslib.scene.selection import select_nodes
 
             size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if mesh.n_nodes else 1.0
-            nodes = np.asarray(_select("selection", mesh, selection, max(1e-8 * size, 1e-15)))
+            nodes = np.asarray(select_nodes("selection", mesh, selection, max(1e-8 * size, 1e-15)))
         else:
             a = np.asarray(selection)
             nodes = np.flatnonzero(a) if a.dtype == bool else a.astype(np.int64).reshape(-1)

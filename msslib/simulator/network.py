@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from msslib.errors import DivergenceError
-from msslib.explicit.network import N_MONITOR, _advance, _pass, _steps, network_layout, network_terms, records
+from msslib.explicit.network import N_MONITOR, fused_advance, fused_pass, fused_steps, network_layout, network_terms, records
 from msslib.solvers.dynamics import Integrator
 
 
@@ -77,7 +77,7 @@ class NetworkStepper(Integrator):
         self._update_external()
         self._preload()
         rowptr, ib, kl = self.layout
-        _pass(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self.x_ref, self.react,
+        fused_pass(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self.x_ref, self.react,
               self.mon, 0, False)
         self.stats["n_force_evals"] += 1
 
@@ -114,7 +114,7 @@ class NetworkStepper(Integrator):
         if self.drive is None and not self.others:
             if self.mon.shape[0] < n:
                 self.mon = np.zeros((n, N_MONITOR))
-            _steps(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self.x_ref, self.react,
+            fused_steps(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self.x_ref, self.react,
                    self.mon, n)
             self.stats["n_force_evals"] += n
             t0 = self.t
@@ -139,7 +139,7 @@ class NetworkStepper(Integrator):
 
     def _one(self, h, t_step):
         """One step without the detector: advance, move the driven dofs, evaluate."""
-        _advance(self.R, self.v, self.F, self.w, self.damp, h)
+        fused_advance(self.R, self.v, self.F, self.w, self.damp, h)
         if self.drive is not None:
             self.drive(t_step, self.x)
         self.evaluate()

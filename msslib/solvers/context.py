@@ -53,7 +53,7 @@ def _keep_context(problem, ctx) -> bool:
 
 
 def _solver_context(problem, x, free, plans: PlanCache | None = None):
-    """Context of :func:`msslib.solvers.linear._linear_solve`: spatial dimension and coordinates
+    """Context of :func:`msslib.solvers.linear.solve_linear_system`: spatial dimension and coordinates
     of the free nodes when the free dofs are whole nodes (all or none of a node's dofs free); the
     coordinates are ``x``, or the problem's ``coordinates`` attribute when it has one.
     ``plans``: a plan cache to share (default: the one of the context the problem keeps, if

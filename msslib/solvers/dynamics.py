@@ -14,8 +14,8 @@ from msslib.errors import ConvergenceError, DivergenceError
 
 from . import protocol
 from .context import _solver_context
-from .linear import _linear_solve
-from .submatrices import _submatrix
+from .linear import solve_linear_system
+from .submatrices import submatrix
 from .protocol import TINY, DynamicResult
 from .roundoff import _force_magnitude, convergence_threshold, roundoff_floor
 from .stability import EXPLICIT_METHODS, _mass_vector, _resolve_damping, check_time_step
@@ -266,7 +266,7 @@ class Integrator:
             f_load = protocol._load_vector(problem, x)
             self.f_scale = protocol._force_scale(problem, x, free, f_load)
             with np.errstate(all="ignore"):
-                K0 = _submatrix(problem.stiffness(x, load), free, plans=self.solver_context)
+                K0 = submatrix(problem.stiffness(x, load), free, plans=self.solver_context)
                 self.magnitude = _force_magnitude(K0, x[free], np.nan_to_num(np.abs(load * f_load[free])))
         # divergence detector (explicit methods): see _GROWTH_MIN
         omega = stats["omega_max"] or 0.0
@@ -303,7 +303,7 @@ class Integrator:
         """-(alpha M + beta K) v on the free dofs, ``vf`` the free velocities."""
         out = -self.alpha * self.mf * vf if self.alpha else np.zeros_like(vf)
         if self.beta:
-            out = out - self.beta * (_submatrix(self.problem.stiffness(xx, self.load), self.free,
+            out = out - self.beta * (submatrix(self.problem.stiffness(xx, self.load), self.free,
                                                 plans=self.solver_context) @ vf)
         return out
 
@@ -338,7 +338,7 @@ class Integrator:
                 f_old, f = f, self.force(x)
                 jterms = (v_half, f, f_old, f, h)
                 # second half-kick: mass-proportional damping at v+ (implicit), beta K at v_half
-                g = f - beta * (_submatrix(self.problem.stiffness(x, self.load), free, plans=self.solver_context)
+                g = f - beta * (submatrix(self.problem.stiffness(x, self.load), free, plans=self.solver_context)
                                 @ v_half) if beta else f
                 vf = (v_half + 0.5 * h * inv_m * g) / (1.0 + 0.5 * h * alpha)
             else:
@@ -399,7 +399,7 @@ def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, ma
         f = np.asarray(problem.force(xt, load), dtype=float)[free]
         R = mf * (w - vf) - h * (f - alpha * mf * w)
         if beta:
-            R = R + h * beta * (_submatrix(problem.stiffness(xt, load), free, plans=solver_context) @ w)
+            R = R + h * beta * (submatrix(problem.stiffness(xt, load), free, plans=solver_context) @ w)
         return R, xt
 
     w = vf.copy()
@@ -414,11 +414,11 @@ def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, ma
                 f"{_floor_text(floor)})",
                 iteration=it, residual=rn, x_last=x.copy(), step=step, time=t_new, load=load)
         it += 1
-        K = _submatrix(problem.stiffness(xt, load), free, plans=solver_context)
+        K = submatrix(problem.stiffness(xt, load), free, plans=solver_context)
         J = sp.diags(mf * (1.0 + h * alpha)) + (h * h + h * beta) * K
         try:
-            dw = _linear_solve(sp.csr_matrix(J), -R, linear_solver, symmetric, messages, solver_context)
-        except protocol._NewtonFailure as exc:
+            dw = solve_linear_system(sp.csr_matrix(J), -R, linear_solver, symmetric, messages, solver_context)
+        except protocol.NewtonFailure as exc:
             raise ConvergenceError(
                 f"implicit Euler linear solve failed at step {step}, t = {t_new:.6g} s, iteration {it}: {exc}",
                 iteration=it, residual=rn, x_last=x.copy(), step=step, time=t_new, load=load) from None

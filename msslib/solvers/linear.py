@@ -11,12 +11,12 @@ import numpy as np
 from .amg import _preconditioner
 from .amg_cycle import _matvec_of, _VCycle
 from .direct import _direct_solve
-from .policy import _band_is_cheap, choose_linear_solver
-from .protocol import _NewtonFailure
+from .policy import banded_cholesky_is_cheap, choose_linear_solver
+from .protocol import NewtonFailure
 
 
-def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10, truncate=False):
-    """Solve ``A x = b``; raise _NewtonFailure when the matrix is singular or the solve fails.
+def solve_linear_system(A, b, method, symmetric, messages, context=None, rtol=1e-10, truncate=False):
+    """Solve ``A x = b``; raise NewtonFailure when the matrix is singular or the solve fails.
 
     The solver is the one :func:`~msslib.solvers.policy.choose_linear_solver` chooses.
     ``context`` (optional dict) holds ``dim`` and ``coords`` (free nodes) for the AMG near-null
@@ -28,11 +28,11 @@ def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10, t
     (relative to ``||b||``).  With ``truncate``, a CG run that meets negative
     curvature returns its last iterate (truncated Newton: used under an energy line search)
     instead of falling back to sparse LU."""
-    choice = choose_linear_solver(method, A.shape[0], symmetric, lambda: _band_is_cheap(A, context))
+    choice = choose_linear_solver(method, A.shape[0], symmetric, lambda: banded_cholesky_is_cheap(A, context))
     if choice == "user":
         x = np.asarray(method(A, b), dtype=float)
         if not np.all(np.isfinite(x)):
-            raise _NewtonFailure("user linear solver returned non-finite values")
+            raise NewtonFailure("user linear solver returned non-finite values")
         return x
     n = A.shape[0]
     if choice == "cg":
@@ -83,9 +83,9 @@ def _linear_solve(A, b, method, symmetric, messages, context=None, rtol=1e-10, t
             warnings.simplefilter("ignore")
             x = _direct_solve(A, b, symmetric, context)
     except RuntimeError as exc:  # "Factor is exactly singular"
-        raise _NewtonFailure(f"singular stiffness matrix ({exc})") from None
+        raise NewtonFailure(f"singular stiffness matrix ({exc})") from None
     if not np.all(np.isfinite(x)):
-        raise _NewtonFailure("linear solve produced non-finite values (singular stiffness?)")
+        raise NewtonFailure("linear solve produced non-finite values (singular stiffness?)")
     return x
 
 

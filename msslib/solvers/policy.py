@@ -17,7 +17,7 @@ from collections.abc import Callable
 import scipy.sparse as sp
 
 from .direct import BAND_PLAN_MAX_DOFS, _band_plan
-from .submatrices import _bsr_entry, _eccentricity, _submatrix
+from .submatrices import _bsr_entry, _eccentricity, submatrix
 
 ITERATIVE_THRESHOLD = 2_000  # free dofs above which "auto" may use preconditioned CG (symmetric)
 BAND_AUTO_COST = 1.5e8  # ... unless the banded Cholesky costs at most this n (b + 1)^2
@@ -64,7 +64,7 @@ def _band_surely_wide(entry, dim) -> bool:
     return n * (b + 1.0) ** 2 > BAND_AUTO_COST
 
 
-def _band_is_cheap(A, context):
+def banded_cholesky_is_cheap(A, context):
     """Whether the banded Cholesky of the free-dof matrix ``A`` (canonical CSR) is cheap."""
     if A.shape[0] > BAND_PLAN_MAX_DOFS or not (sp.issparse(A) and A.format == "csr" and A.has_canonical_format):
         return False
@@ -89,6 +89,6 @@ def _wants_blocks(full_tangent, free, method, symmetric, context, block_tangent=
         entry = _bsr_entry(K_full, context["node_free"], context["dim"], context)
         if entry is not None and _band_surely_wide(entry, context["dim"]):
             return False
-        return _band_is_cheap(_submatrix(K_full, free, plans=context), context)
+        return banded_cholesky_is_cheap(submatrix(K_full, free, plans=context), context)
 
     return choose_linear_solver(method, int(free.sum()), symmetric, band_is_cheap) == "cg"

@@ -68,7 +68,7 @@ class DynamicResult:
     stats: dict
 
 
-class _NewtonFailure(Exception):
+class NewtonFailure(Exception):
     """Internal: a Newton iteration could not proceed (reason in the message)."""
 
 

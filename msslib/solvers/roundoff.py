@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit
 
-from .submatrices import _submatrix
+from .submatrices import submatrix
 
 EPS = np.finfo(float).eps
 ROUNDOFF_FACTOR = 1.0  # the floor is ROUNDOFF_FACTOR * eps * (force magnitude scale)
@@ -98,5 +98,5 @@ def _force_magnitude(K_free, x_free, load_abs_free) -> float:
 def _roundoff_floor_at(problem, x, free, load_abs_free, load=1.0) -> float:
     """The round-off floor at state ``x`` (assembles the tangent once)."""
     with np.errstate(all="ignore"):
-        K = _submatrix(problem.stiffness(x, load), free)
+        K = submatrix(problem.stiffness(x, load), free)
     return roundoff_floor(_force_magnitude(K, x[free], load_abs_free))

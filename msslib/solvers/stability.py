@@ -8,7 +8,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .submatrices import _submatrix
+from .submatrices import submatrix
 from .protocol import _free_mask
 
 
@@ -23,14 +23,14 @@ EXPLICIT_METHODS = ("symplectic_euler", "velocity_verlet")
 _EIG_TOL = 1e-4  # ARPACK's tolerance for omega_max^2: the Ritz residual is added (see below)
 
 
-def _omega_max_squared(problem, x, load: float = 1.0) -> float:
+def omega_max_squared(problem, x, load: float = 1.0) -> float:
     """Largest eigenvalue of ``M^-1 K`` on the free dofs at ``x`` (an estimate from above; see
     :func:`explicit_stability_limit`).  0.0 when no eigenvalue is positive."""
     free = _free_mask(problem)
     m = _mass_vector(problem)[free]
     if np.any(m <= 0):
         raise ValueError("masses of free dofs must be positive")
-    K = _submatrix(problem.stiffness(np.asarray(x, dtype=float), load), free)
+    K = submatrix(problem.stiffness(np.asarray(x, dtype=float), load), free)
     d = sp.diags(1.0 / np.sqrt(m))
     A = sp.csr_matrix(d @ K @ d)
     symmetric = bool(getattr(problem, "symmetric", True))
@@ -88,7 +88,7 @@ def explicit_stability_limit(problem, x, load: float = 1.0) -> float:
     exact value, 0.005 to 0.3 s).  Power iteration is the fallback.  Returns ``inf`` when no
     eigenvalue is positive.  See :func:`critical_time_step` for the effect of damping.
     """
-    lam = _omega_max_squared(problem, x, load)
+    lam = omega_max_squared(problem, x, load)
     return 2.0 / np.sqrt(lam) if lam > 0 else float("inf")
 
 
@@ -215,7 +215,7 @@ def _lanczos_omega(problem, x, load, rows) -> tuple[float, bool]:
     cache = getattr(problem, "_spectrum_cache", None)
     if cache is not None and key in cache:
         return cache[key], True
-    omega = float(np.sqrt(_omega_max_squared(problem, x, load)))
+    omega = float(np.sqrt(omega_max_squared(problem, x, load)))
     try:
         if cache is None:
             cache = {}

@@ -10,8 +10,8 @@ import numpy as np
 from msslib.errors import ConvergenceError
 
 from .context import _release_context, _solver_context, _static_context
-from .linear import _linear_solve
-from .submatrices import _submatrix, _submatrix_bsr
+from .linear import solve_linear_system
+from .submatrices import submatrix, _submatrix_bsr
 from .policy import _wants_blocks
 from .protocol import (
     StaticResult,
@@ -21,7 +21,7 @@ from .protocol import (
     _free_mask,
     _is_conservative,
     _load_vector,
-    _NewtonFailure,
+    NewtonFailure,
     _with_prescribed,
 )
 from .roundoff import (
@@ -76,7 +76,7 @@ def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy, resolve=N
                     et = _energy_or_none(problem, xt, load) if use_energy else None
                     return xt, rt, rtn, et, alpha
         alpha *= 0.5
-    raise _NewtonFailure(f"line search failed (no sufficient decrease down to step length {2 * alpha:.1e})")
+    raise NewtonFailure(f"line search failed (no sufficient decrease down to step length {2 * alpha:.1e})")
 
 
 def _natural_monotone(resolve, r_trial, alpha, dx_norm) -> bool:
@@ -87,7 +87,7 @@ def _natural_monotone(resolve, r_trial, alpha, dx_norm) -> bool:
         return False
     try:
         dx_bar = resolve(r_trial)
-    except _NewtonFailure:
+    except NewtonFailure:
         return False
     bar = float(np.linalg.norm(dx_bar))
     return bool(np.isfinite(bar) and bar <= (1.0 - 0.5 * alpha) * dx_norm)
@@ -127,7 +127,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
     the absolute load on the free dofs), so that no extra assembly is needed; for a problem with
     ``force_magnitude`` (protocol), from it at every iterate.
 
-    Raises _NewtonFailure with attributes ``iteration`` and ``residual`` on failure."""
+    Raises NewtonFailure with attributes ``iteration`` and ``residual`` on failure."""
     if scales is None:
         scales = {"floor": None, "load_abs": 0.0}
     with np.errstate(all="ignore"):
@@ -150,7 +150,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         floor = scales.get("floor")
         if floor is not None and rnorm > floor:
             reason = f"{reason}; residual {rnorm:.3e} is above the round-off floor {floor:.3e}"
-        exc = _NewtonFailure(reason)
+        exc = NewtonFailure(reason)
         exc.iteration = it
         exc.residual = rnorm
         exc.x, exc.r = x, r  # the failing iterate and its free residual, for the hint of the message
@@ -206,7 +206,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
                     if K_new is None:  # not made of node blocks: CSR from now on
                         blocks = context["blocks"] = False
                 if not blocks:
-                    K_new = _submatrix(K_full, free, out=K, plans=context)
+                    K_new = submatrix(K_full, free, out=K, plans=context)
             K = context["K"] = K_new
         if scales.get("floor") is None and not callable(magnitude_of):  # from this tangent: no extra assembly
             scales["floor"] = roundoff_floor(_force_magnitude(K, x[free], scales.get("load_abs", 0.0)))
@@ -216,9 +216,9 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         try:
             rtol = _forcing_term(rnorm, rnorm_prev, eta_prev, target())
             eta_prev, rnorm_prev = rtol, rnorm
-            dx = _linear_solve(K, r, linear_solver, symmetric, messages, context, rtol,
+            dx = solve_linear_system(K, r, linear_solver, symmetric, messages, context, rtol,
                                truncate=bool(line_search and use_energy))
-        except _NewtonFailure as exc:
+        except NewtonFailure as exc:
             raise fail(str(exc)) from None
         dx_norm = float(np.linalg.norm(dx))
         if monotone_step is not None and dx_norm >= monotone_step:
@@ -226,12 +226,12 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         if line_search:
             try:
                 resolve = None if not monotone else (  # the same tangent, for the natural monotonicity test
-                    lambda b, K=K, rtol=rtol: _linear_solve(K, b, linear_solver, symmetric, messages, context, rtol))
+                    lambda b, K=K, rtol=rtol: solve_linear_system(K, b, linear_solver, symmetric, messages, context, rtol))
                 rnorm_before = rnorm
                 x, r, rnorm, e, alpha = _line_search(problem, x, dx, free, load, r, rnorm, e, use_energy, resolve)
                 armijo = rnorm**2 <= (1.0 - 2.0 * _ARMIJO_C * alpha) * rnorm_before**2
                 monotone_step = None if (armijo or not monotone) else dx_norm
-            except _NewtonFailure as exc:
+            except NewtonFailure as exc:
                 raise fail(str(exc)) from None
         else:
             x = x.copy()
@@ -345,7 +345,7 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
                 x_new, it, hist = _newton(problem, guess, free, target, threshold, max_iter, line_search,
                                           linear_solver, symmetric, use_energy, messages, progress, step_index,
                                           solver_context, scales)
-            except _NewtonFailure as exc:
+            except NewtonFailure as exc:
                 dlam = 0.5 * (target - lam)
                 if cuts_this_step >= max_cuts or dlam < nominal * 0.5**max_cuts * (1.0 - 1e-12):
                     k = int(np.floor(lam / nominal + 1e-9)) + 1  # the nominal step it belongs to

@@ -317,7 +317,7 @@ def _submatrix_plan(K, free, plans=None):
     return entry
 
 
-def _submatrix(K, free, out=None, plans=None):
+def submatrix(K, free, out=None, plans=None):
     """Free-free block of ``K`` (CSR, sorted indices).  For a canonical CSR input the index arrays
     of the block are computed once per sparsity pattern and reused (each call only gathers the
     values), and the returned matrices share these (read-only) index arrays.  ``out``: an earlier result

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .jit import _FAST, _U, _jit, _jit_fast
+from .jit import _FAST, UINT, njit_cached, _jit_fast
 
 _inline = njit(inline="always", error_model="numpy", nogil=True, fastmath=_FAST)
 
@@ -20,9 +20,9 @@ _inline = njit(inline="always", error_model="numpy", nogil=True, fastmath=_FAST)
 def _put(data, i, v, assign):
     """``data[i] = v`` with ``assign``, else ``data[i] += v``."""
     if assign:
-        data[_U(i)] = v
+        data[UINT(i)] = v
     else:
-        data[_U(i)] += v
+        data[UINT(i)] += v
 
 
 @_inline
@@ -71,7 +71,7 @@ def _spring3d_hessian(x, rowptr, nb, k, L0, pos, nptr, diag, bmap, scale, assign
     for na in range(rowptr.shape[0] - 1):
         q0 = nptr[na]
         if blocked:
-            td = bmap[_U(q0 + diag[na])]
+            td = bmap[UINT(q0 + diag[na])]
             if td < 0:
                 continue
             qd = 9 * td  # the diagonal block, rows w apart
@@ -86,10 +86,10 @@ def _spring3d_hessian(x, rowptr, nb, k, L0, pos, nptr, diag, bmap, scale, assign
             c = np.empty((9, 2 * m))
         xa0, xa1, xa2 = x[a], x[a + 1], x[a + 2]
         for j in range(m):
-            b = 3 * nb[_U(s0 + j)]
-            c[6, j] = xa0 - x[_U(b)]
-            c[7, j] = xa1 - x[_U(b + 1)]
-            c[8, j] = xa2 - x[_U(b + 2)]
+            b = 3 * nb[UINT(s0 + j)]
+            c[6, j] = xa0 - x[UINT(b)]
+            c[7, j] = xa1 - x[UINT(b + 1)]
+            c[8, j] = xa2 - x[UINT(b + 2)]
         kk = k[s0:s0 + m]
         ll = L0[s0:s0 + m]
         for j in range(m):
@@ -122,7 +122,7 @@ def _spring3d_hessian(x, rowptr, nb, k, L0, pos, nptr, diag, bmap, scale, assign
             h22 -= c[5, j]
         if blocked:
             for j in range(m):
-                tb = bmap[_U(q0 + pos[_U(s0 + j)])]
+                tb = bmap[UINT(q0 + pos[UINT(s0 + j)])]
                 if tb >= 0:
                     _put_sym3(data, 9 * tb, 3, c[0, j], c[1, j], c[2, j], c[3, j], c[4, j], c[5, j], assign)
         else:
@@ -133,35 +133,35 @@ def _spring3d_hessian(x, rowptr, nb, k, L0, pos, nptr, diag, bmap, scale, assign
                 i2 = 2 if i == 0 else (4 if i == 1 else 5)
                 if assign:
                     for j in range(m):
-                        q = r0 + 3 * pos[_U(s0 + j)]
-                        data[_U(q)] = c[i0, j]
-                        data[_U(q + 1)] = c[i1, j]
-                        data[_U(q + 2)] = c[i2, j]
+                        q = r0 + 3 * pos[UINT(s0 + j)]
+                        data[UINT(q)] = c[i0, j]
+                        data[UINT(q + 1)] = c[i1, j]
+                        data[UINT(q + 2)] = c[i2, j]
                 else:
                     for j in range(m):
-                        q = r0 + 3 * pos[_U(s0 + j)]
-                        data[_U(q)] += c[i0, j]
-                        data[_U(q + 1)] += c[i1, j]
-                        data[_U(q + 2)] += c[i2, j]
+                        q = r0 + 3 * pos[UINT(s0 + j)]
+                        data[UINT(q)] += c[i0, j]
+                        data[UINT(q + 1)] += c[i1, j]
+                        data[UINT(q + 2)] += c[i2, j]
         _put_sym3(data, qd, w, h00, h01, h02, h11, h12, h22, assign)
 
 
 @_jit_fast
-def _spring3d_hessian_csr(x, rowptr, nb, k, L0, pos, nptr, diag, scale, assign, data):
+def spring3d_hessian_csr(x, rowptr, nb, k, L0, pos, nptr, diag, scale, assign, data):
     """:func:`_spring3d_hessian` into the values ``data`` of a CSR matrix."""
     _spring3d_hessian(x, rowptr, nb, k, L0, pos, nptr, diag, np.empty(0, dtype=np.int32), scale, assign, data)
 
 
 @_jit_fast
-def _spring3d_hessian_bsr(x, rowptr, nb, k, L0, pos, nptr, diag, bmap, scale, assign, data):
+def spring3d_hessian_bsr(x, rowptr, nb, k, L0, pos, nptr, diag, bmap, scale, assign, data):
     """:func:`_spring3d_hessian` into the ``(n_blocks, 3, 3)`` values ``data`` of a BSR matrix
     (``bmap`` not empty)."""
     _spring3d_hessian(x, rowptr, nb, k, L0, pos, nptr, diag, bmap, scale, assign, data.reshape(-1))
 
 
-@_jit
-def _block_scatter_bsr(vals, conn, pos, nptr, bmap, scale, data):
-    """:func:`_block_scatter_csr` into the ``(n_blocks, dim, dim)`` values of a BSR matrix that
+@njit_cached
+def block_scatter_bsr(vals, conn, pos, nptr, bmap, scale, data):
+    """:func:`block_scatter_csr` into the ``(n_blocks, dim, dim)`` values of a BSR matrix that
     keeps some of the node blocks (``bmap``: see :func:`_spring3d_hessian`)."""
     m, nv = conn.shape
     dim = data.shape[1]
@@ -170,17 +170,17 @@ def _block_scatter_bsr(vals, conn, pos, nptr, bmap, scale, data):
         for p in range(nv):
             q0 = nptr[conn[e, p]]
             for q in range(nv):
-                tb = bmap[_U(q0 + pos[e, p, q])]
+                tb = bmap[UINT(q0 + pos[e, p, q])]
                 if tb < 0:
                     continue
                 for i in range(dim):
                     off = (p * dim + i) * n_loc + q * dim
                     for j in range(dim):
-                        data[_U(tb), i, j] += scale * vals[e, off + j]
+                        data[UINT(tb), i, j] += scale * vals[e, off + j]
 
 
-@_jit
-def _block_scatter_csr(vals, conn, pos, nptr, dim, scale, data):
+@njit_cached
+def block_scatter_csr(vals, conn, pos, nptr, dim, scale, data):
     """Add ``scale`` times dense element blocks ``vals`` (m, (nv dim)^2, row-major) to CSR ``data``
     of a node-blocked pattern; ``pos[e, p, q]`` position of node ``conn[e, q]`` in node row
     ``conn[e, p]`` (see :func:`_spring3d_hessian`)."""
@@ -201,13 +201,13 @@ def _block_scatter_csr(vals, conn, pos, nptr, dim, scale, data):
                         data[col + j] += scale * vals[e, off + j]
 
 
-@_jit
-def _scatter_add(data, slots, vals, scale):
+@njit_cached
+def scatter_add(data, slots, vals, scale):
     for i in range(slots.shape[0]):
         data[slots[i]] += scale * vals[i]
 
 
-def _block_pattern(conn: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
+def block_pattern(conn: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
     """Rows and cols of dense element blocks, element-major, each block row-major."""
     m, nv = conn.shape
     dofs = (dim * conn[:, :, None] + np.arange(dim)).reshape(m, nv * dim)
@@ -218,7 +218,7 @@ def _block_pattern(conn: np.ndarray, dim: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 @njit(cache=True, nogil=True)
-def _expand_block_pattern(nptr, ucol, dim, indices, indptr):
+def expand_block_pattern(nptr, ucol, dim, indices, indptr):
     """Dof-level CSR (indices, indptr) of a node-level pattern (nptr, ucol): every node entry
     becomes a dim x dim block; row ``dim a + i`` lists ``dim b + j`` for the nodes ``b`` of node
     row ``a`` (sorted), ``j = 0..dim-1``."""

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .assembly import _block_pattern
+from .assembly import block_pattern
 
 # --------------------------------------------------------------------------------------------
 # helpers
@@ -84,15 +84,15 @@ class Table:
         return len(self.columns[0].values) if self.columns else 0
 
 
-def _col(name, unit, values, description="", dtype=float) -> Column:
+def make_column(name, unit, values, description="", dtype=float) -> Column:
     return Column(name, unit, np.ascontiguousarray(values, dtype=dtype), description)
 
 
-def _cell_columns(conn, solid: str) -> list[Column]:
+def cell_columns(conn, solid: str) -> list[Column]:
     """The columns that name each cell of a per-cell table: its index and its nodes ``conn`` (m, k),
     ``solid`` the kind of cell (``"tetrahedron"``, ``"hexahedron"``)."""
-    return [_col("cell", None, np.arange(len(conn)), "cell index", int),
-            *[_col(f"node_{a}", None, conn[:, a], f"node {a} of the {solid}", int) for a in range(conn.shape[1])]]
+    return [make_column("cell", None, np.arange(len(conn)), "cell index", int),
+            *[make_column(f"node_{a}", None, conn[:, a], f"node {a} of the {solid}", int) for a in range(conn.shape[1])]]
 
 
 # --------------------------------------------------------------------------------------------
@@ -194,7 +194,7 @@ class Term:
         return False
 
 
-class _ElementTerm(Term):
+class ElementTerm(Term):
     """A term made of elements with ``conn`` (m, nodes), parameters ``p`` and ``q`` per element,
     and three numba loops."""
 
@@ -221,7 +221,7 @@ class _ElementTerm(Term):
 
     def hessian_pattern(self):
         if getattr(self, "_pattern", None) is None:
-            self._pattern = _block_pattern(self.conn, self.dim)
+            self._pattern = block_pattern(self.conn, self.dim)
         return self._pattern
 
     def hessian_values(self, x) -> np.ndarray:

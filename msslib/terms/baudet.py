@@ -63,10 +63,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from msslib.mesh.core import _LOCAL_EDGES
-from msslib.mesh.topology import _INNER_DIAGONALS
-from msslib.terms.assembly import _block_pattern
-from msslib.terms.base import Table, Term, _cell_columns, _col, _per_element
+from msslib.mesh.core import LOCAL_EDGES
+from msslib.mesh.topology import INNER_DIAGONALS
+from msslib.terms.assembly import block_pattern
+from msslib.terms.base import Table, Term, cell_columns, make_column, _per_element
 from msslib.terms.external import sum_external_forces
 
 # local faces of a hexahedron (msslib.mesh order, right-hand normal outward) and the three pairs
@@ -148,15 +148,15 @@ class BaudetCorrection(Term):
         return [
             Table("baudet_correction", "Baudet's orthogonal correction per cube: factor c (F_perp = c F_i) and the "
                   f"elongation force of each face at load factor 1 ({faces}; msslib.terms.BaudetCorrection)", [
-                      *_cell_columns(mesh.cells, "hexahedron"),
-                      _col("factor", "1", self.factor, "correction factor c"),
-                      *[_col(f"face_force_{f}", "N", self.face_force[:, f], f"elongation force of face {f} (> 0 "
+                      *cell_columns(mesh.cells, "hexahedron"),
+                      make_column("factor", "1", self.factor, "correction factor c"),
+                      *[make_column(f"face_force_{f}", "N", self.face_force[:, f], f"elongation force of face {f} (> 0 "
                                                                             f"tension)") for f in range(6)],
                   ]),
             Table("baudet_correction_forces", "nodal forces of Baudet's correction at load factor 1 (they scale "
                                               "with the load; constant in the reference configuration)", [
-                _col("node", None, on, "node index", int),
-                *[_col(f"f_{a}", "N", fc[on, i], f"force, {a}") for i, a in enumerate("xyz"[:fc.shape[1]])],
+                make_column("node", None, on, "node index", int),
+                *[make_column(f"f_{a}", "N", fc[on, i], f"force, {a}") for i, a in enumerate("xyz"[:fc.shape[1]])],
             ]),
         ]
 
@@ -242,7 +242,7 @@ class BaudetCorrection(Term):
 READINGS = ("boundary", "element")
 """Readings of Baudet's correction force (model option ``correction``)."""
 
-_PAIRS = np.vstack([_LOCAL_EDGES["hexahedron"], _INNER_DIAGONALS])  # 12 edges, 4 inner diagonals
+_PAIRS = np.vstack([LOCAL_EDGES["hexahedron"], INNER_DIAGONALS])  # 12 edges, 4 inner diagonals
 _INCIDENCE = np.zeros((16, 8))
 _INCIDENCE[np.arange(16), _PAIRS[:, 0]] = 1.0  # force t u on the first node
 _INCIDENCE[np.arange(16), _PAIRS[:, 1]] = -1.0
@@ -301,11 +301,11 @@ class ElementBaudetCorrection(Term):
                       "distances of their nodes at rest, and the factor c; the correction force on the cube's nodes "
                       "is M_e s_e(x), s_e the forces of the cube's own springs, F_perp = c F_i on each face pair, "
                       "equilibrium form (not proportional to the load, no energy)", [
-                          *_cell_columns(self.cells, "hexahedron"),
-                          _col("k_edge", "N/m", self.k[:, 0], "spring constant of each of the cube's 12 edges"),
-                          _col("k_diagonal", "N/m", self.k[:, 12],
+                          *cell_columns(self.cells, "hexahedron"),
+                          make_column("k_edge", "N/m", self.k[:, 0], "spring constant of each of the cube's 12 edges"),
+                          make_column("k_diagonal", "N/m", self.k[:, 12],
                                "spring constant of each of the cube's 4 inner diagonals"),
-                          _col("factor", "1", self.factor, "correction factor c"),
+                          make_column("factor", "1", self.factor, "correction factor c"),
                       ])]
 
     def __init__(self, mesh, k_edge, k_diagonal, factor):
@@ -394,7 +394,7 @@ class ElementBaudetCorrection(Term):
 
     def hessian_pattern(self):
         if getattr(self, "_pattern", None) is None:
-            self._pattern = _block_pattern(self.cells, 3)
+            self._pattern = block_pattern(self.cells, 3)
         return self._pattern
 
     def hessian_values(self, x) -> np.ndarray:

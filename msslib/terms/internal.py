@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .bounds import spring3d_abs_rows
-from .base import Table, _as_flat, _cell_columns, _col, _connectivity, _ElementTerm, _format_bad, _per_element
+from .base import Table, _as_flat, cell_columns, make_column, _connectivity, ElementTerm, _format_bad, _per_element
 from .loops import (
     _hex_energy_loop,
     _hex_gradient_loop,
@@ -25,7 +25,7 @@ from .loops import (
 )
 
 
-class Springs(_ElementTerm):
+class Springs(ElementTerm):
     """Springs ``k/2 (|x_b - x_a| - L0)^2`` between node pairs.
 
     Parameters
@@ -159,7 +159,7 @@ def _check_rest_volumes(name, V0):
         raise ValueError(f"{name}: rest volumes V0 must be finite and > 0: {_format_bad(bad, V0, 'cell')}")
 
 
-class _VolumeTerm(_ElementTerm):
+class _VolumeTerm(ElementTerm):
     """A volume term of 3D cells with ``nodes`` nodes: one finite coefficient per cell (any
     sign: only finiteness is checked) and rest volumes ``V0`` > 0; the subclasses name the
     coefficient and give the loops."""
@@ -175,10 +175,10 @@ class _VolumeTerm(_ElementTerm):
 
     def export_tables(self, mesh) -> list[Table]:
         return [Table(self.export_name, self._table_description, [
-            *_cell_columns(self.conn, self._solid),
-            _col(self._coefficient, self._coefficient_unit, self._p,
+            *cell_columns(self.conn, self._solid),
+            make_column(self._coefficient, self._coefficient_unit, self._p,
                  f"volume coefficient {self._coefficient} (may be negative)"),
-            _col("V0", "m^3", self.V0, self._V0_description),
+            make_column("V0", "m^3", self.V0, self._V0_description),
         ])]
 
     def __init__(self, cells, coefficient, V0):

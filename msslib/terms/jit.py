@@ -39,7 +39,7 @@ def _drop_stale_numba_cache() -> None:
 
 _drop_stale_numba_cache()
 
-_jit = njit(cache=True, error_model="numpy", nogil=True)
+njit_cached = njit(cache=True, error_model="numpy", nogil=True)
 
 # fastmath without reassociation: results stay deterministic and agree with the plain loops to
 # round-off
@@ -49,8 +49,8 @@ _jit_fast = njit(cache=True, error_model="numpy", nogil=True, fastmath=_FAST)
 # Indexing with an unsigned integer: numba wraps negative signed indices around (a compare, a
 # shift and a conditional move per access), which doubles the instruction count of the scatter
 # loops (fast spring force, Hessian assembly); our indices are never negative, so the hot loops
-# index through ``_U(i)``.
-_U = np.uint64
+# index through ``UINT(i)``.
+UINT = np.uint64
 
 
 

@@ -17,7 +17,7 @@ from numba.extending import intrinsic, register_jitable
 
 from msslib.generated import kernels as _K
 
-from .jit import _U, _jit, _jit_fast
+from .jit import UINT, njit_cached, _jit_fast
 
 
 @intrinsic
@@ -88,7 +88,7 @@ def _element_loops(kind, energy, gradient, hessian, dim, n):
         loop.__name__ = loop.__qualname__ = f"_{kind}_{op}_loop"
     for kernel in (energy, gradient, hessian):
         register_jitable(error_model="numpy")(kernel)
-    return tuple(_jit(loop) for loop in loops)
+    return tuple(njit_cached(loop) for loop in loops)
 
 
 _spring2d_energy_loop, _spring2d_gradient_loop, _spring2d_hessian_loop = _element_loops(
@@ -120,21 +120,21 @@ def _spring3d_gradient_fast(x, rowptr, ib, k, L0, g):
         ga1 = 0.0
         ga2 = 0.0
         for s in range(rowptr[na], rowptr[na + 1]):
-            b = 3 * ib[_U(s)]
-            d0 = xa0 - x[_U(b)]
-            d1 = xa1 - x[_U(b + 1)]
-            d2 = xa2 - x[_U(b + 2)]
+            b = 3 * ib[UINT(s)]
+            d0 = xa0 - x[UINT(b)]
+            d1 = xa1 - x[UINT(b + 1)]
+            d2 = xa2 - x[UINT(b + 2)]
             l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-            c = k[_U(s)] * (L0[_U(s)] - l) / l
+            c = k[UINT(s)] * (L0[UINT(s)] - l) / l
             f0 = d0 * c
             f1 = d1 * c
             f2 = d2 * c
             ga0 -= f0
             ga1 -= f1
             ga2 -= f2
-            g[_U(b)] += f0
-            g[_U(b + 1)] += f1
-            g[_U(b + 2)] += f2
+            g[UINT(b)] += f0
+            g[UINT(b + 1)] += f1
+            g[UINT(b + 2)] += f2
         g[a] += ga0
         g[a + 1] += ga1
         g[a + 2] += ga2
