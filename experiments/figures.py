@@ -121,7 +121,7 @@ def draw_curves(spec):
                                     f"leaves {', '.join(open_dims)} open")
                                  + f" (dimensions: {', '.join(da.dims)})")
     marks = {title: [tuple(m) for m in points] for title, points in (spec["marks"] or {}).items()} or None
-    return plotting.curves_figure(ds[spec["variable"]], ds[spec["x"]].values, xlabel=spec["xlabel"],
+    return plotting.curves_figure(da, ds[spec["x"]].values, xlabel=spec["xlabel"],
                                   ylabel=spec["ylabel"], panels=spec["panels"], xscale=spec["xscale"],
                                   yscale=spec["yscale"], dashed=spec["dashed"], marks=marks, band=spec["band"],
                                   height=spec["height"])

@@ -294,34 +294,33 @@ def test_a_missing_number_fails_the_build_but_not_the_quick_build(tmp_path):
     assert f"x = {paper.QUICK_NA}, d = {paper.QUICK_NA}" in text
 
 
-def test_a_label_the_quick_build_does_not_run_is_marked_not_an_error(tmp_path):
-    """A quick study runs fewer points (e.g. fewer spring ratios): a value at a point it did not
-    run is "n/a (quick build)" and a claim on it is marked; in a full build it is an error."""
+def _mark_quick(tmp_path):
+    """Mark the demo result as the reduced quick build's (its attribute ``quick = 1``)."""
     import xarray as xr
 
-    source = make_paper(tmp_path, "x = {{value results/demo.nc E_error level=eps99}}\n"
-                                  "{{claim [results/demo.nc E_error level=eps99] < 1 | Small.}}\n")
-    with pytest.raises(KeyError, match="no such label"):
-        paper.fill(source, tmp_path / "paper" / "build" / "paper.md")
     path = tmp_path / "results" / "demo.nc"
     with xr.open_dataset(path) as ds:
         ds = ds.load()
     ds.attrs["quick"] = 1
     ds.to_netcdf(path)
+
+
+def test_a_label_the_quick_build_does_not_run_is_marked_not_an_error(tmp_path):
+    """A quick study runs fewer points (e.g. fewer spring ratios): a value at a point it did not
+    run is "n/a (quick build)" and a claim on it is marked; in a full build it is an error."""
+    source = make_paper(tmp_path, "x = {{value results/demo.nc E_error level=eps99}}\n"
+                                  "{{claim [results/demo.nc E_error level=eps99] < 1 | Small.}}\n")
+    with pytest.raises(KeyError, match="no such label"):
+        paper.fill(source, tmp_path / "paper" / "build" / "paper.md")
+    _mark_quick(tmp_path)
     text = paper.fill(source, tmp_path / "paper" / "build" / "paper.md").read_text(encoding="utf-8")
     assert f"x = {paper.QUICK_NA}" in text
     assert "Small." + paper.QUICK_MARK in text
 
 
 def test_false_claim_on_quick_results_is_marked(tmp_path):
-    import xarray as xr
-
     source = make_paper(tmp_path, "{{claim [results/demo.nc E_error level=eps10] < 0 | Negative.}}\n")
-    path = tmp_path / "results" / "demo.nc"
-    with xr.open_dataset(path) as ds:
-        ds = ds.load()
-    ds.attrs["quick"] = 1
-    ds.to_netcdf(path)
+    _mark_quick(tmp_path)
     text = paper.fill(source, tmp_path / "paper" / "build" / "paper.md").read_text(encoding="utf-8")
     assert "Negative." + paper.QUICK_MARK in text
 

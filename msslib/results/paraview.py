@@ -121,13 +121,19 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
+def _member_pattern(pvd: Path) -> re.Pattern:
+    """The names of the VTU files of a series at ``pvd`` beside it, whatever its number of states:
+    ``STEM_NNNN.vtu`` (four digits or more) and ``STEM_springs.vtu``."""
+    return re.compile(re.escape(pvd.stem) + r"_(\d{4,}|springs)\.vtu")
+
+
 def in_series(pvd, path) -> bool:
     """Whether ``path`` is, or would be, one of the files of a series written at ``pvd`` whatever
     its number of states: the ``.pvd`` itself, ``STEM_NNNN.vtu`` or ``STEM_springs.vtu`` in its
     directory (also through a symbolic link).  Used to refuse an export that would overwrite an
     input before anything runs."""
     pvd = Path(pvd)
-    pattern = re.compile(re.escape(pvd.stem) + r"_(\d{4,}|springs)\.vtu")
+    pattern = _member_pattern(pvd)
     try:
         directory = pvd.parent.resolve()
     except (OSError, RuntimeError):
@@ -274,7 +280,7 @@ class ParaViewOutput:
             if other is not None and in_series(pvd, other):
                 raise ValueError(f"{what} {str(other)!r} would be overwritten by the ParaView series {str(pvd)!r} "
                                  f"({beside}); give another .pvd name")
-        pattern = re.compile(re.escape(pvd.stem) + r"_(\d{4,}|springs)\.vtu")
+        pattern = _member_pattern(pvd)
         try:
             names = sorted(n for n in os.listdir(pvd.parent if str(pvd.parent) else ".") if pattern.fullmatch(n))
         except OSError:
