@@ -10,8 +10,17 @@ run, anything :func:`msslib.results.netcdf.write_result` wrote) against a refere
   shape functions (:func:`interpolate`), and the error is taken there.  Nodes of the result that
   lie outside the reference mesh (a curved boundary meshed at another resolution) take the
   displacement of the nearest reference node; how many there are and how far they lie is part of
-  the comparison.  Meshes that do not cover the same body (a node farther from the reference than
-  :data:`MAX_OUTSIDE` of its bounding-box diagonal) are refused.
+  the comparison.
+
+Meshes that do not cover the same body are refused, checked both ways: a node of the result
+farther from the reference mesh, or a boundary node of the reference farther from the result mesh,
+than :data:`OUTSIDE_TOLERANCE` times the element size (the largest distance between two nodes of
+one cell, of the coarser of the two meshes).  A curved boundary meshed at two resolutions stays
+within that (its chords lie about ``h^2 / 8R`` inside); a reference that extends beyond the result
+(a longer bar that contains it) or a result that extends beyond the reference does not.  Rest
+positions whose extent is 1000 or 100 times the other's are named as millimetres or centimetres.
+:func:`reference_at` is that one measurement: ``msslib compare``, ``msslib experiment compare``
+and the studies all take the reference displacement through it (or :func:`interpolate`).
 
 The statistics (:class:`Comparison`) are the mean, standard deviation and maximum of the per-node
 Euclidean error, in the result's unit (metres), and the same divided by the largest reference
@@ -26,11 +35,14 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Comparison", "compare_results", "interpolate", "write_error_field", "MAX_OUTSIDE"]
+__all__ = ["Comparison", "compare_results", "reference_at", "interpolate", "element_size", "write_error_field",
+           "OUTSIDE_TOLERANCE"]
 
-#: the farthest a result node may lie outside the reference mesh, relative to the reference's
-#: bounding-box diagonal, before the two are taken for different bodies
-MAX_OUTSIDE = 0.05
+#: the farthest a node of one mesh may lie outside the other mesh, relative to the element size
+#: (:func:`element_size`, the larger of the two meshes'), before the two are taken for different bodies
+OUTSIDE_TOLERANCE = 0.25
+#: extents this many times the other's: the rest positions are in that unit, not metres
+UNIT_FACTORS = ((1000.0, "millimetres"), (100.0, "centimetres"))
 #: points located at once in the reference mesh (bounds the element finder's memory)
 PROBE_BLOCK = 256
 
@@ -79,22 +91,172 @@ def _probe(ref_mesh, ref_u, points):
     return out, inside
 
 
-def _interpolate(ref_mesh, ref_u, points):
+def element_size(mesh) -> float:
+    """The largest distance between two nodes of one cell of ``mesh`` [m] (0 without cells)."""
+    cells = np.asarray(mesh.cells)
+    if not len(cells):
+        return 0.0
+    X = np.asarray(mesh.points, dtype=float)
+    k = cells.shape[1]
+    return float(max(np.linalg.norm(X[cells[:, a]] - X[cells[:, b]], axis=1).max()
+                     for a in range(k) for b in range(a + 1, k)))
+
+
+def _segment_distance(p, a, b):
+    """Distance of points ``p`` to segments ``a``-``b`` (broadcast over leading axes)."""
+    ab = b - a
+    t = np.einsum("...i,...i", p - a, ab) / np.maximum(np.einsum("...i,...i", ab, ab), 1e-300)
+    return np.linalg.norm(p - (a + np.clip(t, 0.0, 1.0)[..., None] * ab), axis=-1)
+
+
+def _triangle_distance(p, a, b, c):
+    """Distance of points ``p`` to triangles ``a b c`` in 3D (broadcast over leading axes)."""
+    n = np.cross(b - a, c - a)
+    nn = np.einsum("...i,...i", n, n)
+    ok = nn > 0
+    h = np.einsum("...i,...i", p - a, n) / np.where(ok, nn, 1.0)
+    q = p - h[..., None] * n  # projection onto the triangle's plane
+    inside = ok.copy()
+    for u, v in ((a, b), (b, c), (c, a)):
+        inside &= np.einsum("...i,...i", np.cross(v - u, q - u), n) >= 0
+    edges = np.minimum(np.minimum(_segment_distance(p, a, b), _segment_distance(p, b, c)), _segment_distance(p, c, a))
+    return np.where(inside, np.abs(h) * np.sqrt(np.where(ok, nn, 0.0)), edges)
+
+
+def _distance_to_mesh(mesh, points, candidates: int = 16):
+    """Distance [m] of ``points`` (outside ``mesh``) to the boundary of ``mesh``: exact, over the
+    boundary facets nearest to each point (all of them where those cannot be shown closest)."""
     from scipy.spatial import cKDTree
 
-    out, inside = _probe(ref_mesh, np.asarray(ref_u, dtype=float), np.asarray(points, dtype=float))
+    from msslib.mesh import boundary_facets
+
+    points = np.asarray(points, dtype=float)
+    if not len(points):
+        return np.zeros(0)
+    X = np.asarray(mesh.points, dtype=float)
+    facets = boundary_facets(mesh)
+    if not len(facets):
+        return cKDTree(X).query(points)[0]
+    corners = X[facets]  # (f, k, dim)
+    if corners.shape[1] == 4:  # quadrilaterals: two triangles each
+        corners = np.concatenate([corners[:, [0, 1, 2]], corners[:, [0, 2, 3]]])
+
+    def dist(p, c):  # p (m, 1, dim), c (m or 1, f, k, dim) -> (m, f)
+        if c.shape[-2] == 2:
+            return _segment_distance(p, c[..., 0, :], c[..., 1, :])
+        return _triangle_distance(p, c[..., 0, :], c[..., 1, :], c[..., 2, :])
+
+    centre = corners.mean(axis=1)
+    radius = float(np.linalg.norm(corners - centre[:, None, :], axis=2).max())
+    k = min(candidates, len(corners))
+    dc, near = cKDTree(centre).query(points, k=k)
+    dc, near = dc.reshape(len(points), k), near.reshape(len(points), k)
+    out = dist(points[:, None, :], corners[near]).min(axis=1)
+    if k < len(corners):  # a facet beyond the k nearest centres could be closer: check against all
+        for i in np.flatnonzero(out > dc[:, -1] - radius):
+            out[i] = dist(points[i][None, None, :], corners[None]).min()
+    return out
+
+
+def _interpolate(ref_mesh, ref_u, points):
+    """(values, inside mask, distance of each point to the reference mesh [m], 0 inside)."""
+    from scipy.spatial import cKDTree
+
+    ref_u = np.asarray(ref_u, dtype=float)
+    points = np.asarray(points, dtype=float)
+    out, inside = _probe(ref_mesh, ref_u, points)
     distance = np.zeros(len(points))
     if not inside.all():
-        distance[~inside], nearest = cKDTree(ref_mesh.points).query(points[~inside])
-        out[~inside] = ref_u[nearest]
+        distance[~inside] = _distance_to_mesh(ref_mesh, points[~inside])
+        out[~inside] = ref_u[cKDTree(ref_mesh.points).query(points[~inside])[1]]
     return out, inside, distance
 
 
+def _fmt_point(x) -> str:
+    return "(" + ", ".join(f"{float(v):.6g}" for v in x) + ")"
+
+
+def _unit_hint(X, Xr, result_name, reference_name) -> str:
+    """The unit of rest positions whose extent is 1000 or 100 times the other's (or ``""``)."""
+    ext, ext_ref = np.ptp(X, axis=0), np.ptp(Xr, axis=0)
+    use = (ext > 0) & (ext_ref > 0)
+    if not use.any() or (ext > 0).tolist() != (ext_ref > 0).tolist():
+        return ""
+    ratio = ext[use] / ext_ref[use]
+    for factor, unit in UNIT_FACTORS:
+        for r, name, other in ((ratio, result_name, reference_name), (1.0 / ratio, reference_name, result_name)):
+            if np.all(np.abs(r / factor - 1.0) < 0.05):
+                return (f"the rest positions of {name} span {float(factor):g} times those of {other}: they look like "
+                        f"{unit}; results are compared in metres (give the mesh in metres, or scale it)")
+    return ""
+
+
+def reference_at(ref_mesh, ref_u, at, *, result_name: str = "result", reference_name: str = "reference"):
+    """The reference displacement ``ref_u`` (one row per node of ``ref_mesh``) at the nodes of the
+    result mesh ``at`` (a :class:`~msslib.mesh.Mesh`; or only its node positions, then only the
+    result's side is checked), with the reference's shape functions: ``(values, relation,
+    n_outside, outside_distance)``.
+
+    The one measurement behind every comparison.  Raises ValueError naming both when the two are
+    not meshes of the same body (see the module docstring): a result node outside the reference,
+    or a boundary node of the reference outside the result, farther than
+    :data:`OUTSIDE_TOLERANCE` times the element size; rest positions in millimetres or
+    centimetres are named as such."""
+    from scipy.spatial import cKDTree
+
+    mesh = None if isinstance(at, np.ndarray) or not hasattr(at, "points") else at
+    X = np.asarray(at.points if mesh is not None else at, dtype=float)
+    Xr = np.asarray(ref_mesh.points, dtype=float)
+    ref_u = np.asarray(ref_u, dtype=float)
+    if X.ndim != 2 or X.shape[1] != Xr.shape[1]:
+        raise ValueError(f"{result_name} has {X.shape[-1] if X.ndim == 2 else '?'}D points and {reference_name} "
+                         f"{Xr.shape[1]}D: a result can only be compared with a reference of its own dimension")
+    size = float(np.linalg.norm(np.ptp(Xr, axis=0))) if len(Xr) else 0.0
+    if X.shape == Xr.shape and np.allclose(X, Xr, rtol=0.0, atol=1e-12 * max(size, float(np.abs(Xr).max()))):
+        return ref_u, "same mesh", 0, 0.0
+    h = max(element_size(ref_mesh), element_size(mesh) if mesh is not None else 0.0)
+    tol = OUTSIDE_TOLERANCE * h
+
+    def refuse(detail):
+        unit = _unit_hint(X, Xr, result_name, reference_name)
+        raise ValueError(f"{result_name} and {reference_name} are not meshes of the same body: "
+                         f"{unit or detail}")
+
+    if len(X) and len(Xr):
+        unit = _unit_hint(X, Xr, result_name, reference_name)
+        if unit:
+            refuse(unit)
+    values, inside, distance = _interpolate(ref_mesh, ref_u, X)
+    far = float(distance.max(initial=0.0))
+    if far > tol:
+        worst = int(np.argmax(distance))
+        refuse(f"node {worst} of {result_name} at {_fmt_point(X[worst])} lies {far:.3g} m outside the reference "
+               f"mesh (allowed: {OUTSIDE_TOLERANCE:g} of the element size {h:.3g} m, {tol:.3g} m)")
+    if mesh is not None and len(X):
+        from msslib.mesh import boundary_facets
+
+        edge = np.unique(boundary_facets(ref_mesh)) if len(np.asarray(ref_mesh.cells)) else np.arange(len(Xr))
+        d_node = cKDTree(X).query(Xr[edge])[0]
+        check = edge[d_node > tol]  # nearer than tol to a result node: within tol of the result
+        if len(check):
+            _, located = _probe(mesh, np.zeros((len(X), 1)), Xr[check])
+            check = check[~located]
+        if len(check):
+            d = _distance_to_mesh(mesh, Xr[check])
+            if d.max() > tol:
+                worst = int(np.argmax(d))
+                refuse(f"the reference extends beyond the result: node {int(check[worst])} of {reference_name} at "
+                       f"{_fmt_point(Xr[check[worst]])} lies {float(d[worst]):.3g} m outside the mesh of {result_name} "
+                       f"(allowed: {OUTSIDE_TOLERANCE:g} of the element size {h:.3g} m, {tol:.3g} m)")
+    return values, "interpolated", int((~inside).sum()), far
+
+
 def interpolate(ref_mesh, ref_u, points):
-    """Reference displacement ``ref_u`` (one row per node of ``ref_mesh``) at ``points``, with the
-    reference mesh's shape functions; points outside the reference mesh take the displacement of
-    the nearest reference node."""
-    return _interpolate(ref_mesh, ref_u, points)[0]
+    """Reference displacement ``ref_u`` (one row per node of ``ref_mesh``) at ``points`` (or at the
+    nodes of a mesh), with the reference mesh's shape functions: :func:`reference_at`'s values.
+    Points outside the reference mesh, within its tolerance, take the displacement of the nearest
+    reference node; farther ones (and, given a mesh, a reference beyond it) are a ValueError."""
+    return reference_at(ref_mesh, ref_u, points)[0]
 
 
 @dataclass(frozen=True, eq=False)
@@ -181,21 +343,8 @@ def compare_results(result, reference, *, result_name: str = "result",
     if mesh.dim != ref_mesh.dim:
         raise ValueError(f"{result_name} is {mesh.dim}D and {reference_name} {ref_mesh.dim}D: "
                          f"a result can only be compared with a reference of its own dimension")
-    X, Xr = mesh.points, ref_mesh.points
-    size = float(np.linalg.norm(Xr.max(axis=0) - Xr.min(axis=0)))
-    n_outside, far = 0, 0.0
-    if X.shape == Xr.shape and np.allclose(X, Xr, rtol=0.0, atol=1e-12 * max(size, np.abs(Xr).max())):
-        relation, ur = "same mesh", u_ref
-    else:
-        relation = "interpolated"
-        ur, inside, distance = _interpolate(ref_mesh, u_ref, X)
-        n_outside, far = int((~inside).sum()), float(distance.max(initial=0.0))
-        if far > MAX_OUTSIDE * size:
-            worst = int(np.argmax(distance))
-            raise ValueError(
-                f"{result_name} and {reference_name} are not meshes of the same body: node {worst} of "
-                f"{result_name} at {tuple(np.round(X[worst], 6))} lies {far:.3g} m from the reference mesh "
-                f"(allowed: {MAX_OUTSIDE:g} of its size, {MAX_OUTSIDE * size:.3g} m)")
+    ur, relation, n_outside, far = reference_at(ref_mesh, u_ref, mesh, result_name=result_name,
+                                                reference_name=reference_name)
     reference_max = float(np.linalg.norm(u_ref, axis=1).max())
     error = displacement_error(u, ur, relative_to=reference_max if reference_max > 0 else None)
     models = (str(result.attrs.get("model", "")), str(reference.attrs.get("model", "")))

@@ -35,7 +35,9 @@ comparison (:func:`compare`) measures every non-reference variant against the re
 same case (per-node Euclidean distance: mean, standard deviation and maximum, absolute and relative
 to the largest reference displacement) and puts the published values beside them. When the meshes
 differ (a reference computed at another resolution), the reference displacement is interpolated at
-the variant's nodes with the reference's own shape functions.
+the variant's nodes with the reference's own shape functions. It is ``msslib compare``'s
+measurement (:func:`msslib.compare.compare_results`): results that are not of the reference's body
+are refused the same way.
 
 A figure (``figures``) is data: its kind, its columns and the kind's drawing options, checked here
 (:func:`figure_runs` names the runs it reads); ``experiments.figures`` draws it.
@@ -259,9 +261,7 @@ def compare(exp: Experiment, results: dict):
     (case, variant) of error statistics against the reference and the published values."""
     import xarray as xr
 
-    from msslib.compare import interpolate
-    from msslib.results import mesh_from_result
-    from msslib.metrics import displacement_error
+    from msslib.compare import compare_results
 
     variants = [m for m in exp.models if m != exp.reference]
     cases = list(exp.cases)
@@ -283,14 +283,10 @@ def compare(exp: Experiment, results: dict):
             u = ds["displacement"].transpose("node", "axis").values
             data["max_displacement"][i, j] = np.linalg.norm(u, axis=1).max()
             data["wall_time"][i, j] = float(ds.attrs.get("wall_time_s", np.nan))
-            if ref is not None:
-                X = ds["rest_position"].transpose("node", "axis").values
-                Xr = ref["rest_position"].transpose("node", "axis").values
-                if X.shape == Xr.shape and np.allclose(X, Xr, atol=1e-12 * np.abs(Xr).max()):
-                    ur = u_ref
-                else:
-                    ur = interpolate(mesh_from_result(ref), u_ref, X)
-                err = displacement_error(u, ur, relative_to=data["reference_max_displacement"][i])
+            if ref is not None:  # the one measurement of `msslib compare`
+                err = compare_results(
+                    ds, ref, result_name=str(ds.encoding.get("source") or f"the run ({case}, {model})"),
+                    reference_name=str(ref.encoding.get("source") or f"the run ({case}, {exp.reference})")).error
                 for s in METRICS:
                     data[f"error_{s}"][i, j] = getattr(err, s)
                     data[f"relative_error_{s}"][i, j] = getattr(err, f"rel_{s}")

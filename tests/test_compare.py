@@ -90,8 +90,8 @@ def test_points_on_reference_nodes_and_points_located_in_blocks(monkeypatch):
     np.testing.assert_array_equal(~inside, flagged)
     np.testing.assert_allclose(values[inside], _affine(points[inside]), rtol=0, atol=1e-15)
     np.testing.assert_array_equal(values[:n_nodes], u[::3])  # on the nodes: the nodes' own values
-    nearest = np.linalg.norm(points[flagged][:, None, :] - fine.points[None, :, :], axis=2).min(axis=1)
-    assert distance[flagged] == pytest.approx(nearest, rel=1e-12)  # outside: to the nearest reference node
+    assert distance[flagged] == pytest.approx([2e-3, 1e-3], rel=1e-9)  # outside: to the reference's boundary
+    assert (distance[~flagged] == 0).all()
 
 
 def test_a_curved_boundary_is_counted_and_different_bodies_refused(tmp_path):
@@ -170,3 +170,104 @@ def test_an_experiment_of_ones_own_runs_and_compares(tmp_path):
     (tmp_path / "typo.yaml").write_text(yaml.safe_dump({**exp, "paper": "loyd"}))
     bad = _cli("experiment", "list", "typo.yaml", cwd=tmp_path)
     assert bad.returncode == 1 and "leave it out" in bad.stderr
+
+
+def _bars(tmp_path):
+    """A 10 cm bar's result and a 20 cm bar's result that contains it: one field, two bodies."""
+    short, long = hex_grid(0.1, 0.02, 0.02, 10, 2, 2), hex_grid(0.2, 0.02, 0.02, 20, 2, 2)
+    return (_result(tmp_path / "short.nc", short, _affine(short.points), model="mss"),
+            _result(tmp_path / "long.nc", long, _affine(long.points), model="fem"))
+
+
+def test_a_reference_that_extends_beyond_the_result_is_refused_both_ways(tmp_path):
+    """The short bar lies inside the long one, so every short-bar node is on the reference: only the
+    reference's side shows the other body (10 cm beyond, the element size 0.017 m)."""
+    short, long = _bars(tmp_path)
+    with pytest.raises(ValueError, match=r"not meshes of the same body: the reference extends beyond the result: "
+                                         r"node \d+ of .*long.nc at \(0.2, [0-9.]+, [0-9.]+\) lies 0.1 m outside"):
+        compare_results(short, long)
+    with pytest.raises(ValueError, match=r"not meshes of the same body: node \d+ of .*long.nc at \(0.2, "
+                                         r"[0-9.]+, [0-9.]+\) lies 0.1 m outside the reference mesh"):
+        compare_results(long, short)
+    # a coarser mesh of the same bar (not nested) is still the same body
+    coarse = hex_grid(0.1, 0.02, 0.02, 3, 1, 1)
+    c = compare_results(_result(tmp_path / "coarse.nc", coarse, _affine(coarse.points)), short)
+    assert c.relation == "interpolated" and c.error.max < 1e-15
+
+
+def test_a_curved_boundary_at_two_resolutions_is_the_same_body(tmp_path):
+    """A disc as polygons of 8 and 64 sides (the chords of the coarse one lie 0.08 R inside the
+    fine one's): within the tolerance, and each side's out-of-mesh distance is the exact gap."""
+    from msslib.mesh import Mesh
+
+    def disc(n):
+        t = 2 * np.pi * np.arange(n) / n
+        points = np.vstack([[0.0, 0.0], 0.05 * np.column_stack([np.cos(t), np.sin(t)])])
+        return Mesh(points, np.column_stack([np.zeros(n, int), 1 + np.arange(n), 1 + (1 + np.arange(n)) % n]),
+                    "triangle")
+
+    coarse, fine = disc(8), disc(64)
+    u = lambda X: X @ np.array([[1e-3, 2e-4], [0.0, -3e-4]]).T  # noqa: E731
+    a = _result(tmp_path / "coarse.nc", coarse, u(coarse.points))
+    b = _result(tmp_path / "fine.nc", fine, u(fine.points))
+    c = compare_results(a, b)
+    assert c.n_outside == 0  # the coarse polygon's corners are corners of the fine one
+    back = compare_results(b, a)
+    gap = 0.05 * (1 - np.cos(np.pi / 8))  # the fine nodes halfway between coarse corners: the sagitta
+    assert back.n_outside == 56 and back.outside_distance == pytest.approx(gap, rel=1e-9)
+
+
+@pytest.mark.parametrize("factor, unit", [(1000.0, "millimetres"), (100.0, "centimetres")])
+def test_rest_positions_in_another_unit_are_named(tmp_path, factor, unit):
+    mesh = hex_grid(0.1, 0.02, 0.02, 5, 1, 1)
+    scaled = hex_grid(0.1 * factor, 0.02 * factor, 0.02 * factor, 5, 1, 1)
+    a = _result(tmp_path / "a.nc", scaled, _affine(mesh.points))
+    b = _result(tmp_path / "b.nc", mesh, _affine(mesh.points))
+    with pytest.raises(ValueError, match=f"a.nc span {factor:g} times those of .*b.nc: they look like {unit}"):
+        compare_results(a, b)
+    with pytest.raises(ValueError, match=f"a.nc span {factor:g} times those of .*b.nc: they look like {unit}"):
+        compare_results(b, a)
+
+
+def test_messages_print_plain_numbers(tmp_path):
+    ref = hex_grid(0.1, 0.05, 0.05, 2, 1, 1)
+    elsewhere = hex_grid(0.1, 0.05, 0.05, 2, 1, 1, origin=(1.0, 0.0, 0.0))
+    with pytest.raises(ValueError) as info:
+        compare_results(_result(tmp_path / "e.nc", elsewhere, _affine(elsewhere.points)),
+                        _result(tmp_path / "r.nc", ref, _affine(ref.points)))
+    assert "np.float" not in str(info.value) and "at (1.1, 0, 0) lies 1 m outside" in str(info.value)
+
+
+def test_experiment_compare_refuses_what_compare_refuses(tmp_path):
+    """`msslib experiment compare` takes the same road as `msslib compare`: the short bar against
+    the long one is refused by both, in one line, and no output is written."""
+    short, long = _bars(tmp_path)
+    (tmp_path / "runs").mkdir()
+    short.rename(tmp_path / "runs" / "default__mss.nc")
+    long.rename(tmp_path / "runs" / "default__fem.nc")
+    exp = {"title": "bars", "scene": {"geometry": {"generator": "hex_grid", "args": {
+        "lx": 0.1, "ly": 0.02, "lz": 0.02, "nx": 1, "ny": 1, "nz": 1}}, "materials": [{"E": 1.0e6, "nu": 0.3}]},
+        "models": {"mss": {"model": "golec_cube"}, "fem": {"model": "fem_linear"}}, "reference": "fem"}
+    (tmp_path / "mine.yaml").write_text(yaml.safe_dump(exp))
+    one = _cli("compare", "runs/default__mss.nc", "runs/default__fem.nc", cwd=tmp_path)
+    both = _cli("experiment", "compare", "mine.yaml", "--results", "runs", "--out", "cmp.nc", cwd=tmp_path)
+    for run in (one, both):
+        assert run.returncode == 1 and run.stderr.startswith("msslib: error:") and len(run.stderr.splitlines()) == 1
+        assert "not meshes of the same body: the reference extends beyond the result" in run.stderr, run.stderr
+        assert "default__fem.nc" in run.stderr
+    assert not (tmp_path / "cmp.nc").exists()
+
+
+def test_a_boundary_clash_prints_plain_numbers():
+    """Two boundary conditions that prescribe different displacements on one node: the message
+    names both values as numbers (not NumPy reprs)."""
+    from msslib.scene import load_scene, prepare
+
+    scene = load_scene({"model": {"type": "golec_cube"}, "geometry": {"generator": "hex_grid", "args": {"lx": 0.1, "ly": 0.1, "lz": 0.1,
+                                                                        "nx": 1, "ny": 1, "nz": 1}},
+                        "materials": [{"E": 1.0e6, "nu": 0.3}],
+                        "boundary": [{"select": {"plane": ["z", 0.0]}, "fix": "all"},
+                                     {"select": {"plane": ["x", 0.0]}, "fix": "x", "displacement": [0.001, 0, 0]}]})
+    with pytest.raises(ValueError, match=r"scene.boundary\[1\].displacement.*already fixed by scene.boundary\[0\] "
+                                         r"with displacement 0, here 0.001$"):
+        prepare(scene)

@@ -107,7 +107,7 @@ def prepare(scene: Scene) -> Setup:
             if clash.any():
                 j = int(owner[nodes, a][clash][0])
                 _fail(f"{p}.displacement", f"node {int(nodes[clash][0])} axis {AXES[a]} is already fixed by "
-                      f"scene.boundary[{j}] with displacement {prescribed[nodes[clash][0], a]!r}, here {disp[a]!r}")
+                      f"scene.boundary[{j}] with displacement {float(prescribed[nodes[clash][0], a]):g}, here {float(disp[a]):g}")
             fixed[nodes, a] = True
             prescribed[nodes, a] = disp[a]
             owner[nodes, a] = i
