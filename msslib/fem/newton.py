@@ -27,11 +27,12 @@ NEWTON = "Newton (msslib.solvers.static_solve, no line search), linear solves by
 LINEAR_RTOL = 1e-12
 
 
-def linear_solve(K, rhs, free, points, dim: int, linear_solver="auto"):
+def linear_solve(K, rhs, free, points, dim: int, linear_solver="auto", symmetric: bool = True):
     """``K[free][:, free]^-1 rhs`` by the linear-solver policy of :mod:`msslib.solvers`.
 
     ``points`` ``(n_scalar, dim)``: the location of every scalar dof (for the AMG near-null
     space). Returns ``(x, how)``, ``how`` naming the solver taken (``"direct"`` or ``"cg"``).
+    ``symmetric``: whether ``K`` is (CG is chosen for symmetric systems only).
     Raises :class:`numpy.linalg.LinAlgError` for a singular matrix."""
     from msslib.solvers import context as _context
     from msslib.solvers.linear import solve_linear_system
@@ -41,10 +42,11 @@ def linear_solve(K, rhs, free, points, dim: int, linear_solver="auto"):
 
     ctx = _context._solver_context(SimpleNamespace(dim=dim), np.asarray(points, dtype=float).ravel(), free)
     A = submatrix(K.tocsr(), free, plans=ctx)
-    how = choose_linear_solver(linear_solver, A.shape[0], True, lambda: banded_cholesky_is_cheap(A, ctx))
+    how = choose_linear_solver(linear_solver, A.shape[0], symmetric, lambda: banded_cholesky_is_cheap(A, ctx))
     messages: list = []
     try:
-        x = solve_linear_system(A, np.asarray(rhs, dtype=float), linear_solver, True, messages, ctx, rtol=LINEAR_RTOL)
+        x = solve_linear_system(A, np.asarray(rhs, dtype=float), linear_solver, symmetric, messages, ctx,
+                                rtol=LINEAR_RTOL)
     except NewtonFailure as exc:
         raise np.linalg.LinAlgError(f"singular stiffness matrix (are rigid-body modes constrained?): {exc}") from None
     if not np.all(np.isfinite(x)):

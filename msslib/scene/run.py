@@ -78,17 +78,20 @@ def _solve_mss_static(setup: Setup, report):
 
 
 def _solve_mss_linear(setup: Setup):
-    """One sparse solve with the model's stiffness (Hessian) at rest: the linearised MSS."""
-    from msslib.fem import solve_sparse
+    """One sparse solve with the model's stiffness (Hessian) at rest: the linearised MSS, by the
+    solver layer of :mod:`msslib.solvers` (the policy of every solve, as linear FEM's)."""
+    from msslib.fem.newton import SOLVER, linear_solve
 
     model, t0 = setup.model, time.perf_counter()
     x = model.apply_prescribed(model.x0, 1.0)
     du, free = x - model.x0, model.free
     K, f = model.stiffness(model.x0, 1.0), model.force(model.x0, 1.0)
-    du[free] = solve_sparse(K[free][:, free], f[free] - K[free][:, ~free] @ du[~free])
+    K = K.tocsr()
+    du[free], how = linear_solve(K, f[free] - K[free][:, ~free] @ du[~free], free, model.x0.reshape(-1, model.dim),
+                                 model.dim, symmetric=bool(getattr(model, "symmetric", True)))
     reaction = np.where(free, 0.0, K @ du - f).reshape(-1, model.dim)  # of the linearised forces
-    stats = {"type": "static", "linear": True, "wall_time": time.perf_counter() - t0, "solver": "one solve with the "
-             "stiffness at rest, scipy.sparse.linalg.spsolve (SuperLU, MMD_AT_PLUS_A ordering)"}
+    stats = {"type": "static", "linear": True, "wall_time": time.perf_counter() - t0,
+             "solver": f"one solve with the stiffness at rest, {SOLVER}: {how}"}
     return {"displacement": du.reshape(-1, model.dim), "reaction": reaction, "stats": stats,
             "extra_attrs": {"potential_energy": "None"}}
 

@@ -37,6 +37,7 @@ from scipy.stats import spearmanr
 from experiments import script
 from experiments.script import LoadSegment
 from msslib.compare import interpolate
+from msslib.fem import solve_sparse
 from msslib.results import mesh_from_result, write_result
 from msslib.mesh.quality import relative_jacobians
 from msslib.scene import load_scene, prepare, run_scene
@@ -156,7 +157,7 @@ def assemble(mesh, Ke):
 def linear_solve(K, forces, fixed):
     free = ~fixed.ravel()
     u = np.zeros(K.shape[0])
-    u[free] = spl.spsolve(K[free][:, free].tocsc(), forces.ravel()[free])
+    u[free] = solve_sparse(K[free][:, free], forces.ravel()[free])  # the library's solver layer
     return u.reshape(-1, 3)
 
 
