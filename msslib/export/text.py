@@ -134,14 +134,20 @@ def write_vtu(path, exp: MssExport) -> Path:
     """The springs as VTK line cells with cell data ``stiffness`` (N/m) and ``rest_length`` (m), on
     the rest positions, with point data ``mass`` (kg), ``fixed`` (0/1 per axis),
     ``prescribed_displacement`` (m), ``load`` (N) and the constant forces of the terms
-    (``baudet_correction``, N, when present: :meth:`MssExport.forces`)."""
+    (``baudet_correction``, N, when present: :meth:`MssExport.forces`).  A model without springs
+    has one vertex cell per mass instead, and no cell data: a VTU file without cells is valid VTK,
+    but meshio cannot read it back."""
     import meshio
 
     point_data = {"mass": exp.masses, "fixed": _pad3(exp.fixed.astype(np.int8)),
                   "prescribed_displacement": _pad3(exp.prescribed), "load": _pad3(exp.loads)}
     for label, forces, _ in exp.forces():
         point_data[label] = _pad3(forces)
-    mesh = meshio.Mesh(_pad3(exp.points), [("line", exp.pairs.astype(np.int64))], point_data=point_data,
-                       cell_data={"stiffness": [exp.stiffness], "rest_length": [exp.rest_length]})
+    if len(exp.pairs):
+        cells = [("line", exp.pairs.astype(np.int64))]
+        cell_data = {"stiffness": [exp.stiffness], "rest_length": [exp.rest_length]}
+    else:
+        cells, cell_data = [("vertex", np.arange(len(exp.points), dtype=np.int64)[:, None])], {}
+    mesh = meshio.Mesh(_pad3(exp.points), cells, point_data=point_data, cell_data=cell_data)
     meshio.write(path, mesh, file_format="vtu")
     return Path(path)

@@ -36,6 +36,41 @@ def check_mesh_suffix(path) -> None:
                          f"{' '.join(sorted(known))}")
 
 
+def _vtk_points_without_cells(path: Path) -> int | None:
+    """The number of points of a VTK file (XML ``.vtu`` or legacy ``.vtk`` unstructured grid) that
+    declares no cells, else None.  meshio fails on such files with messages about arrays and
+    indices; this is what they are."""
+    import re
+
+    suffix = path.suffix.lower()
+    if suffix not in (".vtu", ".vtk"):
+        return None
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return None
+    if suffix == ".vtu":
+        pieces = re.findall(rb"<Piece\b[^>]*>", data)
+        if not pieces:
+            return None
+        points, cells = 0, 0
+        for piece in pieces:
+            n_points = re.search(rb'NumberOfPoints\s*=\s*"(\d+)"', piece)
+            n_cells = re.search(rb'NumberOfCells\s*=\s*"(\d+)"', piece)
+            if n_points is None:
+                return None
+            points += int(n_points.group(1))
+            cells += int(n_cells.group(1)) if n_cells else 0
+        return points if cells == 0 else None
+    if not re.search(rb"DATASET\s+UNSTRUCTURED_GRID", data):
+        return None
+    n_points = re.search(rb"(?m)^\s*POINTS\s+(\d+)", data)
+    n_cells = re.search(rb"(?m)^\s*CELL_TYPES\s+(\d+)", data)  # (CELLS counts offsets in format 5)
+    if n_points is None or (n_cells is not None and int(n_cells.group(1)) > 0):
+        return None
+    return int(n_points.group(1))
+
+
 def _meshio_read(path: Path):
     """``meshio.read`` that never exits the interpreter: any failure (meshio calls ``sys.exit``
     for some files and raises anything from ``struct.error`` to ``UnicodeDecodeError`` for others)
@@ -52,6 +87,10 @@ def _meshio_read(path: Path):
         try:
             m = meshio.read(path)
         except (Exception, SystemExit) as exc:  # noqa: BLE001 - every failure of a reader is bad input
+            points = _vtk_points_without_cells(path)
+            if points is not None:  # meshio cannot read a VTK file without cells: say what it is
+                raise ValueError(f"{path}: the mesh has no cells ({points} points); allowed: "
+                                 f"{', '.join(CELL_TYPES)} cells") from None
             said = " ".join(" ".join(messages).replace("Error:", " ").split())
             if isinstance(exc, UnicodeDecodeError):
                 detail = (f"not UTF-8 text where the {path.suffix or 'chosen'} reader expects text "
