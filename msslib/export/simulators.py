@@ -101,6 +101,23 @@ def _springs_only_model(exp: MssExport):
 
 #: the MuJoCo model steps at this fraction of the stability limit 2/omega_max of its springs
 MJCF_SAFETY = 0.5
+#: bytes of MuJoCo's arena (``<size memory>``) per degree of freedom, tendon, body and actuator:
+#: exported spring models (about 4 tendons per degree of freedom, contacts off) use about 190 bytes
+#: of stack and arena per degree of freedom when stepped (MuJoCo 4, 0.9 k to 12 k degrees of
+#: freedom), so this leaves a margin of 3 or more.  Without it MuJoCo sizes the arena itself, in
+#: proportion to the tendons times the degrees of freedom, and cannot allocate it from about 50 k
+#: springs up.
+MJCF_ARENA_BYTES_PER_ELEMENT = 128
+#: the smallest arena the MJCF asks for [bytes]
+MJCF_ARENA_MIN = 8 << 20
+
+
+def mjcf_memory(n_dofs: int, n_tendons: int, n_bodies: int, n_actuators: int) -> int:
+    """The ``<size memory>`` [bytes, a whole number of MiB] of an MJCF model of that size:
+    :data:`MJCF_ARENA_BYTES_PER_ELEMENT` per element, at least :data:`MJCF_ARENA_MIN`."""
+    need = MJCF_ARENA_BYTES_PER_ELEMENT * (n_dofs + n_tendons + n_bodies + n_actuators)
+    mib = 1 << 20
+    return max(MJCF_ARENA_MIN, -(-need // mib) * mib)
 
 
 @dataclass(frozen=True)
@@ -202,6 +219,7 @@ def mjcf_text(exp: MssExport) -> str:
                            "biasprm F 0 0). The scene's static solve ramps the loads; MuJoCo reaches the same "
                            "equilibrium when damped to rest. "))
     ET.SubElement(root, "compiler", angle="radian", autolimits="true")
+    size = ET.SubElement(root, "size")  # memory: set below, from the model's size
     g = np.zeros(3)
     if exp.gravity is not None:
         g[:dim] = exp.gravity
@@ -251,6 +269,13 @@ def mjcf_text(exp: MssExport) -> str:
                 if F[i, a] != 0.0 and not exp.fixed[i, a]:
                     actuators.append(dict(name=f"{label}_node{i}_{AXES[a]}", joint=f"node{i}_{AXES[a]}", gainprm="0",
                                           biastype="affine", biasprm=f"{_f(F[i, a])} 0 0"))
+    n_dofs = int(sum(int((~exp.fixed[i]).sum()) for i in range(n)))
+    memory = mjcf_memory(n_dofs, len(exp.pairs), n + 1, len(actuators))
+    size.set("memory", f"{memory >> 20}M")
+    root.insert(list(root).index(size), ET.Comment(
+        f" MuJoCo's arena: {memory >> 20} MiB for {n_dofs} degrees of freedom, {len(exp.pairs)} tendons, {n + 1} "
+        f"bodies and {len(actuators)} actuators ({MJCF_ARENA_BYTES_PER_ELEMENT} bytes each, at least "
+        f"{MJCF_ARENA_MIN >> 20} MiB); MuJoCo's default grows with tendons times degrees of freedom "))
     if actuators:
         act = ET.SubElement(root, "actuator")
         act.append(ET.Comment(" constant forces (N) at load factor 1: surface loads (load_*) and Baudet's "
