@@ -19,6 +19,8 @@ one study variable as curves over one coordinate, one per Poisson's ratio, one p
 
 from __future__ import annotations
 
+import math
+import shlex
 from pathlib import Path
 
 import yaml
@@ -48,8 +50,10 @@ def draw(exp, name, results=None):
     files = inputs(exp, name, results)
     missing = [str(p) for p in files if not p.is_file()]
     if missing:
+        folder = Path(results) if results is not None else results_dir(exp)
         raise FileNotFoundError(f"figure {name!r} of {exp.path} reads {len(missing)} missing run file(s), "
-                                f"first {missing[0]}; run `python -m msslib experiment run-all {exp.path}` first")
+                                f"first {missing[0]}; run `python -m msslib experiment run-all "
+                                f"{shlex.quote(str(exp.path))} --out-dir {shlex.quote(str(folder))}` first")
     data = dict(zip(figure_runs(exp, name), (read_result(p) for p in files)))
     pairs = {c["title"]: (data[(c["case"], c["variant"])], data[(c["case"], c["reference"])])
              for c in spec["columns"]}
@@ -81,18 +85,47 @@ def load_curves(path) -> dict:
             raise ValueError(f"{where}: " + "; ".join(
                 ([f"missing {', '.join(missing)}"] if missing else []) + ([f"unknown {', '.join(unknown)}"] if unknown else []))
                 + f" (keys: {', '.join(sorted(allowed))})")
-        if not str(spec["result"]).startswith("results/") or not str(spec["result"]).endswith(".nc"):
-            raise ValueError(f"{where}: result {spec['result']!r} is not a results/....nc file")
+        spec = {**CURVES_KEYS["optional"], **spec}
+        result = spec["result"]
+        if not isinstance(result, str) or not result.startswith("results/") or not result.endswith(".nc"):
+            raise ValueError(f"{where}: result {result!r} is not a results/....nc file")
+        for key in ("variable", "x", "xlabel", "ylabel", "description"):
+            if not isinstance(spec.get(key, ""), str) or (key != "description" and not spec[key].strip()):
+                raise ValueError(f"{where}: {key} {spec[key]!r}: expected a non-empty string")
+        for key, low, high, what in (("xscale", 0.0, None, "a number above 0"), ("yscale", 0.0, None, "a number above 0"),
+                                     ("band", 0.0, None, "a number above 0 (%), or leave it out"),
+                                     ("height", 0.0, 20.0, "a height in inches above 0 and at most 20, or leave it out")):
+            value = spec.get(key)
+            if value is None and key in ("band", "height"):
+                continue
+            if (not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value)
+                    or not value > low or (high is not None and value > high)):
+                raise ValueError(f"{where}: {key} {value!r}: expected {what}")
         for key in ("panels", "dashed", "marks"):
             value = spec.get(key)
             if value is not None and not (isinstance(value, dict) and value and all(
-                    isinstance(v, (dict, list)) for v in value.values())):
-                raise ValueError(f"{where}: {key} must map a title to a selection"
-                                 + (" (or to published points)" if key == "marks" else ""))
+                    isinstance(t, str) and isinstance(v, list if key == "marks" else dict) for t, v in value.items())):
+                raise ValueError(f"{where}: {key} must map a title to "
+                                 + ("published points [[x, y, nu], ...]" if key == "marks" else "a selection"))
+            for title, sel in (value or {}).items():
+                if key == "marks":
+                    bad = [m for m in sel if not (isinstance(m, list) and len(m) == 3 and all(
+                        isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in m[:2])
+                        and isinstance(m[2], (str, int, float)) and not isinstance(m[2], bool))]
+                    if bad or not sel:
+                        raise ValueError(f"{where}: marks {title!r}: {bad[0] if bad else sel!r} is not a list of "
+                                         "published points [x, y, nu] (x and y finite numbers)")
+                    continue
+                bad = {d: v for d, v in sel.items() if not isinstance(d, str) or isinstance(v, bool)
+                       or not isinstance(v, (str, int, float))}
+                if bad:
+                    d, v = next(iter(bad.items()))
+                    raise ValueError(f"{where}: {key} {title!r}: {d}: {v!r} is not one coordinate value "
+                                     "(a string or a number)")
         unknown_marks = sorted(set(spec.get("marks") or {}) - set(spec["panels"]))
         if unknown_marks:
             raise ValueError(f"{where}: marks for panels it does not draw: {', '.join(unknown_marks)}")
-        out[name] = {**CURVES_KEYS["optional"], **spec}
+        out[name] = spec
     return out
 
 
@@ -148,6 +181,9 @@ def main(argv=None):
             raise ValueError(f"{args.experiment}: no figure {args.name!r}; declared: "
                              f"{', '.join(sorted(exp.figures)) or 'none'}")
         fig = draw(exp, args.name, args.results)
+    except yaml.YAMLError as exc:
+        raise SystemExit(f"experiments.figures: error: {args.experiment}: invalid YAML: "
+                         f"{' '.join(str(exc).split())}") from None
     except (OSError, ValueError) as exc:
         raise SystemExit(f"experiments.figures: error: {exc}") from None
     plotting.save(fig, args.out)

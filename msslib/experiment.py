@@ -46,6 +46,7 @@ A figure (``figures``) is data: its kind, its columns and the kind's drawing opt
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -62,6 +63,8 @@ METRICS = ("mean", "std", "max")
 FIGURE_OPTIONS = {"comparison": {"plane": str, "length_unit": str, "panel_width": float, "panel_height": float,
                                  "magnify": float, "node_errors": bool, "show_rest": bool, "variant_label": str,
                                  "reference_label": str, "title": str}}
+#: the figure options that are sizes (inches) or a factor: finite, above 0, at most the bound
+FIGURE_RANGES = {"panel_width": 20.0, "panel_height": 20.0, "magnify": 1e6}
 FIGURE_PLANES = ("xy", "xz", "yz", "yx", "zx", "zy")
 FIGURE_LENGTH_UNITS = ("m", "cm", "mm")
 COLUMN_KEYS = ("title", "case", "variant", "reference")
@@ -89,6 +92,24 @@ def _fail(path, msg):
     raise ValueError(f"{path}: {msg}")
 
 
+def _text(where, value, what, required=True):
+    """``value`` as a string of text; a missing one (None) fails as missing when ``required``."""
+    if value is None:
+        if required:
+            _fail(where, f"missing: {what}")
+        return value
+    if not isinstance(value, str):
+        _fail(where, f"expected a string ({what}), got {value!r}")
+    return value
+
+
+def _one_of(where, value, names, what):
+    """``value`` a name among ``names`` (a mapping or a list)."""
+    if not isinstance(value, str) or value not in names:
+        _fail(where, f"{value!r} is not one of {list(names)} ({what}, a string)")
+    return value
+
+
 def load_experiment(path) -> Experiment:
     path = Path(path)
     if not path.is_file():
@@ -96,7 +117,7 @@ def load_experiment(path) -> Experiment:
     raw = yaml.safe_load(path.read_text(encoding="utf-8"))
     if not isinstance(raw, dict):
         _fail("experiment", "must be a mapping")
-    unknown = sorted(set(raw) - KEYS)
+    unknown = sorted(map(str, set(raw) - KEYS))
     if unknown:
         _fail(f"experiment.{unknown[0]}", f"unknown key; expected one of {', '.join(sorted(KEYS))}")
     for key in ("scene", "models"):
@@ -110,21 +131,35 @@ def load_experiment(path) -> Experiment:
     for key, val in (("cases", cases), ("models", models), ("scene", raw["scene"])):
         if not isinstance(val, dict) or not val:
             _fail(f"experiment.{key}", "must be a non-empty mapping")
-    for name in list(cases) + list(models):
-        if "__" in name or "/" in name:
-            _fail("experiment", f"case/model name {name!r} must not contain '__' or '/'")
+    for key, names in (("cases", cases), ("models", models)):
+        for name in names:
+            if not isinstance(name, str) or not name or "__" in name or "/" in name:
+                _fail(f"experiment.{key}", f"name {name!r}: a case or model name is a non-empty string without "
+                                          "'__' or '/'")
+    for key in ("name", "title", "section", "description"):
+        if key in raw and not isinstance(raw[key], (str, int, float) if key == "section" else str):
+            _fail(f"experiment.{key}", f"expected a string, got {raw[key]!r}")
+    for key in ("quick", "published"):
+        if not isinstance(raw.get(key) or {}, dict):
+            _fail(f"experiment.{key}", f"expected a mapping, got {raw[key]!r}")
     ref = raw.get("reference")
-    if ref is not None and ref not in models:
-        _fail("experiment.reference", f"{ref!r} is not one of the models {sorted(models)}")
+    if ref is not None:
+        _one_of("experiment.reference", ref, sorted(models), "a model of the experiment")
     published = raw.get("published") or {}
     for case, per_model in published.items():
-        if case not in cases:
+        if not isinstance(case, str) or case not in cases:
             _fail(f"experiment.published.{case}", f"unknown case; expected one of {sorted(cases)}")
+        if not isinstance(per_model, dict):
+            _fail(f"experiment.published.{case}", f"expected a mapping of model to values, got {per_model!r}")
         for model, values in per_model.items():
-            if model not in models:
+            if not isinstance(model, str) or model not in models:
                 _fail(f"experiment.published.{case}.{model}", f"unknown model; expected one of {sorted(models)}")
+            if not isinstance(values, dict):
+                _fail(f"experiment.published.{case}.{model}", f"expected a mapping of metric to [value, unit], "
+                                                             f"got {values!r}")
             for metric, v in values.items():
-                if not (isinstance(v, list) and len(v) == 2 and v[1] in UNITS):
+                if not (isinstance(v, list) and len(v) == 2 and isinstance(v[1], str) and v[1] in UNITS
+                        and isinstance(v[0], (int, float)) and not isinstance(v[0], bool) and math.isfinite(v[0])):
                     _fail(f"experiment.published.{case}.{model}.{metric}", f"expected [value, unit] with unit in {sorted(UNITS)}, got {v!r}")
     figures = _figures(raw.get("figures") or {}, cases, models, ref)
     return Experiment(name=raw.get("name", path.stem), paper=paper, title=raw.get("title", path.stem),
@@ -146,15 +181,13 @@ def _figures(raw, cases, models, reference):
             _fail(where, "a figure name is letters, digits, '_' and '-' (it names the output file)")
         if not isinstance(fig, dict):
             _fail(where, "must be a mapping with kind, caption and columns")
-        kind = fig.get("kind")
-        if kind not in FIGURE_OPTIONS:
-            _fail(f"{where}.kind", f"{kind!r} is not one of {sorted(FIGURE_OPTIONS)}")
+        kind = _one_of(f"{where}.kind", fig.get("kind"), sorted(FIGURE_OPTIONS), "a figure kind")
         allowed = {"kind", "caption", "columns", *FIGURE_OPTIONS[kind]}
         unknown = sorted(set(fig) - allowed)
         if unknown:
             _fail(f"{where}.{unknown[0]}", f"unknown key; expected one of {', '.join(sorted(allowed))}")
-        if not isinstance(fig.get("caption"), str) or not fig["caption"].strip():
-            _fail(f"{where}.caption", "missing: one line saying what the figure shows")
+        if not (_text(f"{where}.caption", fig.get("caption"), "one line saying what the figure shows") or "").strip():
+            _fail(f"{where}.caption", "empty: one line saying what the figure shows")
         options = {}
         for key, typ in FIGURE_OPTIONS[kind].items():
             if key not in fig:
@@ -164,11 +197,14 @@ def _figures(raw, cases, models, reference):
                                                           if typ is float else isinstance(v, typ))
             if not ok:
                 _fail(f"{where}.{key}", f"expected a {typ.__name__}, got {v!r}")
+            if key in FIGURE_RANGES and not 0.0 < float(v) <= FIGURE_RANGES[key]:
+                _fail(f"{where}.{key}", f"{float(v)} is out of range; expected a number above 0 and at most "
+                                        f"{FIGURE_RANGES[key]:g}")
             options[key] = float(v) if typ is float else v
-        if "plane" in options and options["plane"] not in FIGURE_PLANES:
-            _fail(f"{where}.plane", f"{options['plane']!r} is not one of {FIGURE_PLANES}")
-        if options.get("length_unit", "cm") not in FIGURE_LENGTH_UNITS:
-            _fail(f"{where}.length_unit", f"{options['length_unit']!r} is not one of {FIGURE_LENGTH_UNITS}")
+        if "plane" in options:
+            _one_of(f"{where}.plane", options["plane"], FIGURE_PLANES, "a plane")
+        if "length_unit" in options:
+            _one_of(f"{where}.length_unit", options["length_unit"], FIGURE_LENGTH_UNITS, "a length unit")
         columns = fig.get("columns")
         if not isinstance(columns, list) or not columns:
             _fail(f"{where}.columns", "must be a non-empty list of {title, case, variant, reference}")
@@ -188,13 +224,12 @@ def _column(where, col, cases, models, reference):
     if unknown:
         _fail(f"{where}.{unknown[0]}", f"unknown key; expected one of {', '.join(COLUMN_KEYS)}")
     col = {"case": next(iter(cases)) if len(cases) == 1 else None, "reference": reference, **col}
-    for key, names in (("case", cases), ("variant", models), ("reference", models)):
+    for key, names, what in (("case", cases, "a case"), ("variant", models, "a model"),
+                             ("reference", models, "a model")):
         if col.get(key) is None:
             _fail(f"{where}.{key}", "missing" + (" (the experiment has no reference)" if key == "reference" else ""))
-        if col[key] not in names:
-            _fail(f"{where}.{key}", f"{col[key]!r} is not one of {sorted(names)}")
-    if not isinstance(col.get("title"), str):
-        _fail(f"{where}.title", "missing: the column's title")
+        _one_of(f"{where}.{key}", col[key], sorted(names), f"{what} of the experiment")
+    _text(f"{where}.title", col.get("title"), "the column's title")
     return {k: col[k] for k in COLUMN_KEYS}
 
 
