@@ -187,3 +187,110 @@ def test_materials_of_a_name_that_is_only_a_facet_group_are_refused(tmp_path):
     data["materials"] = {"base": MAT}
     with pytest.raises(ValueError, match=r"scene\.materials\.base: the mesh has no cell group 'base'"):
         prepare(load_scene(data, base_dir=tmp_path))
+
+
+# ---- groups that share elements: gmsh 4 gives an element every group of its entity ----------------
+
+STIFF_T = np.array([0.0, 0.0, -40.0])  # Pa on the end face x = LX (1 m^2)
+
+
+def _overlapping(path: Path, version: float = 4.1, binary: bool = False) -> Path:
+    """The box [0, LX] x [0, LY] x [0, LZ] as two volumes x < 1 and x > 1; every physical group
+    shares its elements with another, in every dimension, and the later group is the one meshio
+    drops: the volume "stiff" (x > 1) inside the volume "body" (both); the surface "stiff" (the end
+    face x = LX, 1 m^2) inside the surface "tip" (that face and the top faces, 3 m^2); the surface
+    "base" (x = 0); the curves "edge" and "rim" (the end face's top edge); the points "corner" and
+    "pin" (the corner (LX, LY, LZ))."""
+    _start("overlap")
+    try:
+        occ = gmsh.model.occ
+        occ.fragment([(3, occ.addBox(0, 0, 0, 1.0, LY, LZ))], [(3, occ.addBox(1.0, 0, 0, 1.0, LY, LZ))])
+        occ.synchronize()
+        volumes = [t for _, t in gmsh.model.getEntities(3)]
+        right = [t for t in volumes if occ.getCenterOfMass(3, t)[0] > 1.0]
+        end, top = _entities_at(2, 0, LX), _entities_at(2, 2, LZ)
+        edge = [t for t in _entities_at(1, 0, LX) if abs(occ.getCenterOfMass(1, t)[2] - LZ) < 1e-9]
+        corner = [t for _, t in gmsh.model.getEntities(0) if np.allclose(gmsh.model.getValue(0, t, []), [LX, LY, LZ])]
+        assert len(right) == 1 and len(end) == 1 and len(top) == 2 and len(edge) == 1 and len(corner) == 1
+        gmsh.model.addPhysicalGroup(3, volumes, name="body")
+        gmsh.model.addPhysicalGroup(3, right, name="stiff")
+        gmsh.model.addPhysicalGroup(2, end + top, name="tip")
+        gmsh.model.addPhysicalGroup(2, end, name="stiff")
+        gmsh.model.addPhysicalGroup(2, _entities_at(2, 0, 0.0), name="base")
+        gmsh.model.addPhysicalGroup(1, edge, name="edge")
+        gmsh.model.addPhysicalGroup(1, edge, name="rim")
+        gmsh.model.addPhysicalGroup(0, corner, name="corner")
+        gmsh.model.addPhysicalGroup(0, corner, name="pin")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.4)
+        gmsh.model.mesh.generate(3)
+        return _write(path, version, binary)
+    finally:
+        gmsh.finalize()
+
+
+def test_the_entities_groups_in_every_gmsh_4_encoding(tmp_path):
+    """The physical groups of each entity read alike from ASCII and binary gmsh 4.1 and ASCII 4.0
+    (which meshio reads only for some meshes): the end face carries "tip" and "stiff"."""
+    from msslib.mesh.files import _gmsh_entity_groups
+
+    lists = [_gmsh_entity_groups(_overlapping(tmp_path / f"o{i}.msh", v, b))
+             for i, (v, b) in enumerate([(4.1, False), (4.1, True), (4.0, False)])]
+    assert lists[0] == lists[1] == lists[2]
+    assert sorted(len(tags) for tags in lists[0].values() if len(tags) > 1) == [2, 2, 2, 2]
+    assert _gmsh_entity_groups(_overlapping(tmp_path / "o2.msh", 2.2)) is None
+
+
+@pytest.mark.parametrize("version, binary", [(4.1, False), (4.1, True)])
+def test_groups_that_share_elements_are_all_kept(tmp_path, version, binary):
+    mesh = M.read(_overlapping(tmp_path / "overlap.msh", version, binary))
+    assert set(mesh.cell_groups) == {"body", "stiff"}
+    assert set(mesh.facet_groups) == {"tip", "stiff", "base"} and set(mesh.node_groups) == {"edge", "rim", "corner",
+                                                                                             "pin"}
+    np.testing.assert_array_equal(mesh.cell_groups["body"], np.arange(mesh.n_cells))
+    centroids = mesh.points[mesh.cells].mean(axis=1)
+    np.testing.assert_array_equal(mesh.cell_groups["stiff"], np.flatnonzero(centroids[:, 0] > 1.0))
+    measures = M.cell_measures(mesh)
+    assert measures[mesh.cell_groups["stiff"]].sum() == pytest.approx(1.0 * LY * LZ, rel=1e-12)
+    assert M.facet_areas(mesh, mesh.facet_groups["stiff"]).sum() == pytest.approx(LY * LZ, rel=1e-12)
+    np.testing.assert_allclose(mesh.points[mesh.facet_groups["stiff"]][..., 0], LX, atol=1e-12)
+    assert M.facet_areas(mesh, mesh.facet_groups["tip"]).sum() == pytest.approx(LY * LZ + LX * LY, rel=1e-12)
+    np.testing.assert_array_equal(mesh.node_groups["edge"], mesh.node_groups["rim"])
+    edge = mesh.points[mesh.node_groups["edge"]]
+    np.testing.assert_allclose(edge[:, [0, 2]], np.tile([LX, LZ], (len(edge), 1)), atol=1e-12)
+    assert np.ptp(edge[:, 1]) == pytest.approx(LY)
+    for name in ("corner", "pin"):
+        np.testing.assert_allclose(mesh.points[mesh.node_groups[name]], [[LX, LY, LZ]], atol=1e-12)
+
+
+def test_a_traction_on_a_surface_that_shares_its_triangles_loads_that_surface(tmp_path):
+    """The reaction at the clamped base balances 40 Pa on the 1 m^2 of the surface "stiff" (40 N),
+    not on the 5 m^2 outline of the volume "stiff" (meshio's single tag keeps the triangles in
+    "tip" alone, and the selection then took the volume's faces)."""
+    _overlapping(tmp_path / "overlap.msh")
+    data = {"geometry": {"file": "overlap.msh"}, "materials": {"body": MAT}, "model": "fem_linear",
+            "boundary": [{"select": {"group": "base"}, "fix": "all"}],
+            "loads": [{"type": "traction", "select": {"group": "stiff"}, "traction": STIFF_T.tolist()}]}
+    scene = load_scene(data, base_dir=tmp_path)
+    with pytest.warns(MsslibWarning, match="'stiff' names a group of cells and a group of boundary facets"):
+        ds = run_scene(scene, progress=False)
+    x = ds["rest_position"].transpose("node", "axis").values[:, 0]
+    reaction = ds["reaction_force"].transpose("node", "axis").values
+    np.testing.assert_allclose(reaction[np.abs(x) < 1e-12].sum(axis=0), -STIFF_T * LY * LZ, rtol=1e-6, atol=1e-6)
+
+
+def test_a_gmsh_2_file_with_shared_cells_is_refused(tmp_path):
+    """gmsh 2 writes an element once per group: the shared tetrahedra are refused as duplicates."""
+    with pytest.raises(ValueError, match="have the same nodes .*gmsh 2 file repeats an element for every physical "
+                                         "group"):
+        M.read(_overlapping(tmp_path / "overlap.msh", 2.2))
+
+
+@pytest.mark.parametrize("version", [4.1, 2.2])
+def test_a_named_physical_group_without_elements_is_refused(tmp_path, version):
+    path = _box(tmp_path / "box.msh", version)
+    text = path.read_text()
+    count = int(text.split("$PhysicalNames\n", 1)[1].split("\n", 1)[0])
+    path.write_text(text.replace(f"$PhysicalNames\n{count}\n", f'$PhysicalNames\n{count + 1}\n2 99 "ghost"\n', 1))
+    with pytest.raises(ValueError, match=r"box.msh: the physical group 'ghost' \(dimension 2, tag 99\) has no "
+                                         r"elements in the file; allowed: physical groups with elements"):
+        M.read(path)

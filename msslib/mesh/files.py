@@ -128,10 +128,13 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
     assign materials by group, :func:`materials_from_groups`).  Two cells on the same nodes are
     an error (a gmsh 2 file repeats an element for every physical group it belongs to).
 
-    Groups (:class:`Mesh`): the gmsh physical groups (``cell_data["gmsh:physical"]``, named by
-    the file's ``$PhysicalNames`` with their dimension, since meshio's ``field_data``
-    ``{name: [tag, dim]}`` keeps one group of each name; a group without a name is known by its
-    tag, ``"3"``; meshio keeps one physical tag per element, the first) and meshio's
+    Groups (:class:`Mesh`): the gmsh physical groups (named by the file's ``$PhysicalNames`` with
+    their dimension, since meshio's ``field_data`` ``{name: [tag, dim]}`` keeps one group of each
+    name; a group without a name is known by its tag, ``"3"``): in a gmsh 4 file every group of an
+    element's entity, from the file's ``$Entities`` (meshio's ``cell_data["gmsh:physical"]`` keeps
+    the first only, and a group whose elements are also in another would vanish); in a gmsh 2 file,
+    which repeats an element for each of its groups, ``gmsh:physical``.  A physical group of the
+    file without elements is an error naming it.  Also meshio's
     ``cell_sets`` (gmsh 4 named groups, Abaqus ELSET, ...; sets named ``gmsh:...`` are meshio's bookkeeping and are
     skipped) become ``cell_groups`` for elements of the chosen cell type, ``facet_groups`` for
     elements of its facet type (lines in 2D, triangles for tetra, quads for hexahedron cells) and
@@ -240,7 +243,8 @@ def _mesh_from_meshio(path: Path, m, material_key: str):
         material = np.rint(values).astype(np.int64)
     _check_duplicate_cells(path, cells, cell_type)
     used = np.unique(cells)  # file numbers of the nodes the cells use, ascending
-    groups, notes = _file_groups(m, cell_type, blocks, used, _gmsh_physical_names(path))
+    groups, notes = _file_groups(m, cell_type, blocks, used, _gmsh_physical_names(path), _gmsh_entity_groups(path),
+                                 source=str(path))
     points = points[used]
     cells = np.searchsorted(used, cells)
     bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
@@ -343,6 +347,77 @@ def _gmsh_physical_names(path: Path) -> dict | None:
         return None
 
 
+def _gmsh_entity_groups(path: Path) -> dict | None:
+    """``{(dim, entity tag): [physical tags]}`` from the ``$Entities`` section of a gmsh 4 file
+    (ASCII or binary, format 4.0 or 4.1), or None when the file has none (gmsh 2, or not gmsh).
+
+    In gmsh 4 the physical groups belong to the entities, and an element to one entity: its groups
+    are all those of its entity.  meshio keeps the first only (``gmsh:physical``), so a group whose
+    entities also carry another group loses its elements; this is the full list."""
+    import struct
+
+    try:
+        with open(path, "rb") as f:
+            if f.readline().strip() != b"$MeshFormat":
+                return None
+            version, file_type, data_size = f.readline().split()[:3]
+            major = int(float(version))
+            if major != 4:
+                return None
+            binary, size_t = int(file_type) == 1, int(data_size)
+            order = "<"
+            if binary:
+                one = f.read(4)
+                order = "<" if struct.unpack("<i", one)[0] == 1 else ">"
+            for line in f:
+                line = line.strip()
+                if line == b"$Entities":
+                    break
+                if line in (b"$PartitionedEntities", b"$Nodes", b"$Elements"):
+                    return None
+            else:
+                return None
+            n_bbox = 6 if float(version) < 4.1 else 3  # the coordinates of a point entity
+            groups = {}
+            if not binary:
+                tokens = []
+                for line in f:
+                    if line.strip() == b"$EndEntities":
+                        break
+                    tokens.extend(line.split())
+                pos = 4
+                counts = [int(t) for t in tokens[:4]]
+                for dim, count in enumerate(counts):
+                    for _ in range(count):
+                        tag = int(tokens[pos])
+                        pos += 1 + (n_bbox if dim == 0 else 6)
+                        n_phys = int(tokens[pos])
+                        groups[(dim, tag)] = [int(t) for t in tokens[pos + 1:pos + 1 + n_phys]]
+                        pos += 1 + n_phys
+                        if dim > 0:
+                            pos += 1 + int(tokens[pos])
+                return groups
+            st = {8: "Q", 4: "I"}[size_t]
+
+            def read(fmt):
+                fmt = order + fmt
+                return struct.unpack(fmt, f.read(struct.calcsize(fmt)))
+
+            counts = read(f"4{st}")
+            for dim, count in enumerate(counts):
+                for _ in range(count):
+                    (tag,) = read("i")
+                    read(f"{n_bbox if dim == 0 else 6}d")
+                    (n_phys,) = read(st)
+                    groups[(dim, tag)] = list(read(f"{n_phys}i"))
+                    if dim > 0:
+                        (n_bound,) = read(st)
+                        read(f"{n_bound}i")
+            return groups
+    except (OSError, ValueError, IndexError, KeyError, struct.error):  # meshio has read the file: its tags
+        return None
+
+
 #: topological dimension of meshio cell types that may carry groups (others are looked up in meshio)
 _TOPOLOGICAL_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
                     "quad9": 2, "polygon": 2, "tetra": 3, "tetra10": 3, "hexahedron": 3, "hexahedron20": 3,
@@ -362,13 +437,16 @@ def _block_dim(cell_type: str) -> int | None:
     return topological_dimension.get(cell_type)
 
 
-def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray,
-                 physical_names: dict | None = None) -> tuple[dict, list]:
+def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray, physical_names: dict | None = None,
+                 entity_groups: dict | None = None, source: str = "mesh") -> tuple[dict, list]:
     """The groups of a meshio mesh (see :func:`read`) as keyword arguments of :class:`Mesh` (cell
     indices into the concatenated ``blocks``, node indices into ``used``), and the notes on the
     groups dropped because they touch nodes no chosen cell uses.  ``physical_names``: the
     ``{(dim, tag): name}`` of a gmsh file (:func:`_gmsh_physical_names`), which name the physical
-    groups that meshio's ``field_data`` lost."""
+    groups that meshio's ``field_data`` lost.  ``entity_groups``: the physical groups of each
+    entity of a gmsh 4 file (:func:`_gmsh_entity_groups`): an element is in every group of its
+    entity (``gmsh:geometrical``), where meshio keeps the first.  A physical group of the file with
+    no element is a ValueError naming it."""
     dim = CELL_TYPES[cell_type][0]
     offsets = {}
     start = 0
@@ -382,7 +460,48 @@ def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray,
             names[(int(value[1]), int(value[0]))] = str(name)
     names.update(physical_names or {})  # the file's own list: meshio keeps one group of each name
     physical = (m.cell_data or {}).get("gmsh:physical")
+    geometrical = (m.cell_data or {}).get("gmsh:geometrical") if entity_groups is not None else None
     cell_sets = {str(k): v for k, v in (m.cell_sets or {}).items() if not str(k).startswith("gmsh:")}
+    if geometrical is not None:  # meshio's cell sets of a gmsh 4 file: its copy of the physical groups
+        cell_sets = {}
+
+    def physical_members(k, bdim, n):
+        """(dim, tag, element indices in block k) of every physical group of block k's elements."""
+        out = []
+        tags = None
+        if physical is not None and k < len(physical):
+            tags = np.asarray(physical[k]).reshape(n, -1)[:, 0]
+            if tags.dtype.kind not in "iuf":
+                tags = None
+        if geometrical is not None and k < len(geometrical) and bdim is not None:
+            entities = np.asarray(geometrical[k]).reshape(n, -1)[:, 0]
+            for entity in np.unique(entities):
+                idx = np.flatnonzero(entities == entity)
+                listed = entity_groups.get((bdim, int(entity)))
+                if listed is None:  # not in $Entities: meshio's tag
+                    listed = [] if tags is None else [int(t) for t in np.unique(tags[idx]) if t == int(t)]
+                    out += [(bdim, t, idx[tags[idx] == t]) for t in listed]
+                else:
+                    out += [(bdim, int(t), idx) for t in listed]
+            return out
+        if tags is not None:
+            out += [(bdim, int(t), np.flatnonzero(tags == t)) for t in np.unique(tags) if t == int(t)]
+        return out
+
+    declared = set(physical_names or {})
+    for (d, _), tags in (entity_groups or {}).items():
+        declared |= {(d, int(t)) for t in tags}
+    found = set()
+    for k, block in enumerate(m.cells):
+        if len(block.data):
+            found |= {(d, t) for d, t, idx in physical_members(k, _block_dim(block.type), len(block.data)) if len(idx)}
+    empty = sorted(declared - found)
+    if empty:
+        d, t = empty[0]
+        name = names.get((d, t), str(t))
+        raise ValueError(f"{source}: the physical group {name!r} (dimension {d}, tag {t}) has no elements in the file"
+                         f"{f' ({len(empty)} such groups)' if len(empty) > 1 else ''}; allowed: physical groups with "
+                         f"elements (mesh its entities, or remove the group)")
     cells_acc, facets_acc, nodes_acc = {}, {}, {}
     for k, block in enumerate(m.cells):
         n = len(block.data)
@@ -397,14 +516,7 @@ def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray,
             continue  # another cell type of the same or a higher dimension: not in the mesh
         else:
             target = facets_acc if (bdim == dim - 1 and block.type == _FACET_TYPE[cell_type]) else nodes_acc
-        members = []  # (group name, element indices in the block)
-        if physical is not None and k < len(physical):
-            tags = np.asarray(physical[k]).reshape(n, -1)[:, 0]
-            if tags.dtype.kind in "iuf":
-                for tag in np.unique(tags):
-                    if tag != int(tag):
-                        continue
-                    members.append((names.get((bdim, int(tag)), str(int(tag))), np.flatnonzero(tags == tag)))
+        members = [(names.get((d, t), str(t)), idx) for d, t, idx in physical_members(k, bdim, n)]
         for name, per_block in cell_sets.items():
             if k < len(per_block) and per_block[k] is not None and len(per_block[k]):
                 members.append((name, np.asarray(per_block[k], dtype=np.int64).ravel()))
