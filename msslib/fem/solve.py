@@ -329,8 +329,12 @@ def solve_nonlinear(
     pl = plane if d == 2 else None
     parts = _parts(mesh, geo, lam_c, mu_c, volumetric, pl)
 
+    pattern = []  # the tangent's CSR pattern, computed once (msslib.fem.kernels)
+
     def internal(u, tangent=True):
-        fint, energy, K, fabs = 0.0, 0.0, None, 0.0
+        from msslib.fem.kernels import add_tangent, dof_pattern
+
+        fint, energy, K, fabs, data = 0.0, 0.0, None, 0.0, None
         for g, lam_q, mu_q in parts:
             m, nb = g.dphi.shape[2], g.dphi.shape[0]
             H = g.displacement_gradient(u.reshape(-1, d))
@@ -341,9 +345,17 @@ def solve_nonlinear(
             energy += float(np.sum(W * g.dx) * w)
             if tangent:
                 fabs = fabs + g.assemble_vector(np.abs(fe))  # the size of what fint sums: its round-off scale
-                ke = np.einsum("aJmq,iJkLmq,bLmq,mq->maibk", g.dphi, A, g.dphi, g.dx, optimize=True)
-                Kp = g.assemble_matrix(ke.reshape(m, nb * d, nb * d) * w)
-                K = Kp if K is None else K + Kp
+                if not pattern:
+                    pattern.append(dof_pattern(g.nodes, g.n_scalar, d))
+                indptr, indices = pattern[0]
+                if data is None:
+                    data = np.zeros(indices.size)
+                # every part has the same dofs: its element matrices are added into the same values
+                add_tangent(np.ascontiguousarray(g.dphi), np.ascontiguousarray(A), np.ascontiguousarray(g.dx), float(w),
+                            np.ascontiguousarray(g.nodes), d, indptr, indices, data)
+        if tangent:
+            indptr, indices = pattern[0]
+            K = sp.csr_matrix((data, indices, indptr), shape=(geo.n_dofs, geo.n_dofs))
         return fint, K, energy, (fabs if tangent else None)
 
     u, newton = newton_solve(internal, f_ext, cons, presc, geo.points, steps=steps, tol=tol, max_iter=max_iter,

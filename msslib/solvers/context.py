@@ -95,6 +95,7 @@ def _static_context(problem, x, free, linear_solver):
         old["cg_iterations"] = 0
         old.pop("negative_curvature", None)
         old.pop("band_indefinite", None)  # judged afresh by each solve
+        old.pop("indefinite", None)
         return old
     if old is not None and old.get("lock") is not None and old["lock"].locked():  # in use: keep its own
         return ctx

@@ -144,12 +144,29 @@ def _banded_cholesky_solve(A, b, context):
 
 
 def _direct_solve(A, b, symmetric, context=None):
-    """Symmetric: banded Cholesky in a bandwidth-reducing ordering when it is cheap and the matrix
-    is positive definite; otherwise SuperLU with the minimum-degree ordering of A^T + A (less fill
-    than the default COLAMD on lattice stiffnesses).  Non-symmetric: SuperLU with COLAMD."""
+    """The factorisation :func:`msslib.solvers.policy.choose_factorisation` takes.  Symmetric:
+    banded Cholesky in a bandwidth-reducing ordering when it is cheap and the matrix is positive
+    definite; above ``PARDISO_MIN_DOFS`` MKL Pardiso (symmetric indefinite, its analysis kept in
+    ``context`` for the later matrices of the pattern; :mod:`msslib.solvers.pardiso`) where it
+    is installed; otherwise SuperLU with the minimum-degree ordering of A^T + A (less fill than
+    the default COLAMD on lattice stiffnesses).  Non-symmetric: SuperLU with COLAMD."""
+    from .policy import choose_factorisation
+
     if symmetric:
         x = _banded_cholesky_solve(A, b, context)
         if x is not None:
             return x
+    if choose_factorisation(A.shape[0], symmetric) == "pardiso":
+        from .pardiso import PardisoFactor
+
+        state = context if context is not None else {}
+        factor = state.get("pardiso")
+        if factor is None:
+            factor = state["pardiso"] = PardisoFactor()
+        x = factor.solve(A, b)
+        state["direct_solver"] = "pardiso"
+        if factor.inertia is not None and factor.inertia[1] > 0:
+            state["indefinite"] = True  # CG is not tried again on this problem's tangents
+        return x
     spec = "MMD_AT_PLUS_A" if symmetric else "COLAMD"
     return spla.splu(sp.csc_matrix(A), permc_spec=spec).solve(np.asarray(b, dtype=float))

@@ -11,7 +11,7 @@ import numpy as np
 from .amg import _preconditioner
 from .amg_cycle import _matvec_of, _VCycle
 from .direct import _direct_solve
-from .policy import banded_cholesky_is_cheap, choose_linear_solver
+from .policy import banded_cholesky_is_cheap, choose_factorisation, choose_linear_solver
 from .protocol import NewtonFailure
 
 
@@ -28,7 +28,10 @@ def solve_linear_system(A, b, method, symmetric, messages, context=None, rtol=1e
     (relative to ``||b||``).  With ``truncate``, a CG run that meets negative
     curvature returns its last iterate (truncated Newton: used under an energy line search)
     instead of falling back to sparse LU."""
-    choice = choose_linear_solver(method, A.shape[0], symmetric, lambda: banded_cholesky_is_cheap(A, context))
+    indefinite = (not truncate and context is not None and bool(context.get("indefinite"))
+                  and choose_factorisation(A.shape[0], symmetric) == "pardiso")
+    choice = choose_linear_solver(method, A.shape[0], symmetric, lambda: banded_cholesky_is_cheap(A, context),
+                                  indefinite)
     if choice == "user":
         x = np.asarray(method(A, b), dtype=float)
         if not np.all(np.isfinite(x)):
@@ -73,11 +76,13 @@ def solve_linear_system(A, b, method, symmetric, messages, context=None, rtol=1e
                         context["negative_curvature"] = context.get("negative_curvature", 0) + 1
                     return x
             cache.clear()
+            if info < 0 and context is not None:
+                context["indefinite"] = True  # a symmetric indefinite factorisation takes the next ones
             what = "met negative curvature" if info < 0 else f"did not converge in {maxiter} iterations"
-            messages.append(f"CG {what}; falling back to sparse LU")
+            messages.append(f"CG {what}; falling back to a direct solve")
         except (RuntimeError, ValueError, ArithmeticError) as exc:
             cache.clear()
-            messages.append(f"preconditioned CG failed ({exc}); falling back to sparse LU")
+            messages.append(f"preconditioned CG failed ({exc}); falling back to a direct solve")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
