@@ -231,13 +231,13 @@ def _overlapping(path: Path, version: float = 4.1, binary: bool = False) -> Path
 def test_the_entities_groups_in_every_gmsh_4_encoding(tmp_path):
     """The physical groups of each entity read alike from ASCII and binary gmsh 4.1 and ASCII 4.0
     (which meshio reads only for some meshes): the end face carries "tip" and "stiff"."""
-    from msslib.mesh.files import _gmsh_entity_groups
+    from msslib.mesh.gmsh_file import entity_groups
 
-    lists = [_gmsh_entity_groups(_overlapping(tmp_path / f"o{i}.msh", v, b))
+    lists = [entity_groups(_overlapping(tmp_path / f"o{i}.msh", v, b))
              for i, (v, b) in enumerate([(4.1, False), (4.1, True), (4.0, False)])]
     assert lists[0] == lists[1] == lists[2]
     assert sorted(len(tags) for tags in lists[0].values() if len(tags) > 1) == [2, 2, 2, 2]
-    assert _gmsh_entity_groups(_overlapping(tmp_path / "o2.msh", 2.2)) is None
+    assert entity_groups(_overlapping(tmp_path / "o2.msh", 2.2)) is None
 
 
 @pytest.mark.parametrize("version, binary", [(4.1, False), (4.1, True)])
