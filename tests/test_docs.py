@@ -128,8 +128,9 @@ def _chromium() -> str:
         return found
     if os.geteuid() != 0 or not shutil.which("apt-get"):
         pytest.fail("the headless-browser check needs chromium: install Debian's package (apt-get install -y chromium)")
-    run = subprocess.run(["apt-get", "install", "-y", "-q", "chromium"], capture_output=True, text=True, timeout=600,
-                         env={**os.environ, "DEBIAN_FRONTEND": "noninteractive"})
+    from system_packages import apt_install
+
+    run = apt_install(["chromium"])  # one installing test at a time, waiting for dpkg's lock
     found = shutil.which("chromium")
     if run.returncode != 0 or not found:
         pytest.fail(f"apt-get install -y chromium failed (exit {run.returncode}): {run.stderr.strip()[-300:]}")

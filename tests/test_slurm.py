@@ -25,6 +25,8 @@ import pytest
 import xarray as xr
 import yaml
 
+from system_packages import install_lock
+
 ROOT = Path(__file__).resolve().parents[1]
 PROFILE = Path("profiles", "slurm")
 CLUSTER = ROOT / PROFILE / "cluster.sh"
@@ -80,7 +82,8 @@ def cluster():
     """A one-node cluster for this test alone: its own folder (a short path, for munge's socket),
     munge key and ports. Yields (folder, environment for its clients)."""
     folder = Path(tempfile.mkdtemp(prefix="msslib-slurm-"))
-    up = subprocess.run(["bash", str(CLUSTER), "up", str(folder)], capture_output=True, text=True, timeout=900)
+    with install_lock():  # up may install slurm and munge: not while another test installs
+        up = subprocess.run(["bash", str(CLUSTER), "up", str(folder)], capture_output=True, text=True, timeout=900)
     if up.returncode != 0:
         shutil.rmtree(folder, ignore_errors=True)
         lines = (up.stderr or up.stdout).strip().splitlines()

@@ -7,8 +7,16 @@
 #                                         points sbatch, squeue, srun (and snakemake) at it
 #   profiles/slurm/cluster.sh down DIR    cancel its jobs and stop its daemons (DIR and its logs stay)
 #
+# Any other use prints `cluster.sh: error: usage: profiles/slurm/cluster.sh up [DIR] | down DIR`.
+# `up` checks DIR before it installs or starts anything: a new or empty folder (an existing file,
+# a folder that already holds a cluster, white space, or a munge socket path over 107 characters are
+# refused). `down` signals only the daemons this script started for DIR: the process a pid file
+# names is signalled only while its command is that daemon's and names DIR (a stale pid file, whose
+# pid a reboot gave to another process, is left alone with a note).
+#
 # Needs root (the daemons run as root and so do the jobs) and Debian's packages slurmctld, slurmd,
-# slurm-client and munge; missing packages are installed with apt-get. Nothing outside DIR is
+# slurm-client and munge; missing packages are installed with apt-get, which waits up to 10 minutes
+# for another package manager's lock (DPkg::Lock::Timeout). Nothing outside DIR is
 # written or read besides that: its own munge key and socket, free TCP ports, and no accounting
 # database (the executor reads job states from squeue, so MinJobAge keeps finished jobs for an hour;
 # the job completion log DIR/jobcomp.log records every job). The node is this machine, with the CPUs
@@ -16,6 +24,8 @@
 set -euo pipefail
 
 started=""  # the folder of a cluster being started: a failure stops what already runs there
+USAGE="usage: $0 up [DIR] | down DIR"
+APT=(apt-get -o DPkg::Lock::Timeout=600)
 
 die() {
     echo "cluster.sh: error: $*" >&2
@@ -33,9 +43,9 @@ need_packages() {
         || die "missing ${missing[*]} and no apt-get to install Debian's slurmctld slurmd slurm-client munge"
     local log
     log=$(mktemp)
-    if ! { DEBIAN_FRONTEND=noninteractive apt-get install -y -q slurmctld slurmd slurm-client munge > "$log" 2>&1 \
-           || { apt-get update -q > "$log" 2>&1 \
-                && DEBIAN_FRONTEND=noninteractive apt-get install -y -q slurmctld slurmd slurm-client munge > "$log" 2>&1; }; }; then
+    if ! { DEBIAN_FRONTEND=noninteractive "${APT[@]}" install -y -q slurmctld slurmd slurm-client munge > "$log" 2>&1 \
+           || { "${APT[@]}" update -q > "$log" 2>&1 \
+                && DEBIAN_FRONTEND=noninteractive "${APT[@]}" install -y -q slurmctld slurmd slurm-client munge > "$log" 2>&1; }; }; then
         local last
         last=$(grep -E '^(E|W):' "$log" | tail -n 1 || true)
         rm -f "$log"
@@ -62,12 +72,28 @@ wait_pid_file() {  # FILE NAME LOG: the daemon wrote its pid and is alive
     die "$2 did not start: $(last_log "$3")"
 }
 
+check_new_dir() {  # DIR: a folder up can make or use, checked before anything is installed or started
+    local dir=$1 abs parent
+    case $dir in *[[:space:]]*) die "DIR '$dir' contains white space, which slurm.conf cannot hold; choose another folder" ;; esac
+    if [ -e "$dir" ] && [ ! -d "$dir" ]; then
+        die "DIR '$dir' exists and is not a folder; give a new or an empty folder"
+    fi
+    [ ! -e "$dir/slurm.conf" ] || die "$dir already holds a cluster (run: $0 down $dir)"
+    parent=$dir
+    while [ ! -e "$parent" ]; do parent=$(dirname -- "$parent"); done
+    [ -d "$parent" ] || die "DIR '$dir' cannot be made: '$parent' is not a folder"
+    [ -w "$parent" ] || die "DIR '$dir' cannot be made: '$parent' is not writable"
+    abs=$(realpath -m -- "$dir")
+    [ ${#abs} -le 94 ] || die "DIR '$abs' is ${#abs} characters long; at most 94 (munge's socket DIR/munge.socket must fit a 107-character socket path)"
+}
+
 up() {
+    local dir=${1:-}
+    if [ -n "$dir" ]; then check_new_dir "$dir"; fi
     [ "$(id -u)" -eq 0 ] || die "needs root to run munged, slurmctld and slurmd (running as uid $(id -u))"
     need_packages
-    local dir=${1:-}
     if [ -z "$dir" ]; then dir=$(mktemp -d "${TMPDIR:-/tmp}/slurm-cluster.XXXXXX"); fi
-    mkdir -p "$dir"
+    mkdir -p "$dir" 2> /dev/null || die "DIR '$dir' could not be made"
     dir=$(cd "$dir" && pwd)
     [ ! -e "$dir/slurm.conf" ] || die "$dir already holds a cluster (run: $0 down $dir)"
     chmod 755 "$dir"  # munged wants its socket's folders searchable by all
@@ -147,35 +173,59 @@ EOF
     echo "export SLURM_CONF=$SLURM_CONF PATH=$dir/bin:\$PATH"
 }
 
-stop_pid_file() {  # FILE: SIGTERM, then SIGKILL after 10 s
+owned_pid() {  # FILE NAME DIR: prints the pid FILE names if that process is NAME started for DIR
+    [ -s "$1" ] || return 1
+    local pid cmd
+    pid=$(head -c 32 "$1" | tr -d '[:space:]')
+    [[ $pid =~ ^[1-9][0-9]*$ ]] || return 1
+    [ -r "/proc/$pid/cmdline" ] || return 1
+    cmd=$(tr '\0' '\n' < "/proc/$pid/cmdline" 2> /dev/null) || return 1
+    [ "$(basename -- "${cmd%%$'\n'*}")" = "$2" ] || return 1  # the program
+    grep -qF -- "$3/" <<< "$cmd" || return 1  # started for DIR: its files are in DIR
+    echo "$pid"
+}
+
+stop_pid_file() {  # FILE NAME DIR: SIGTERM, then SIGKILL after 10 s, to NAME of DIR only
     [ -s "$1" ] || return 0
     local pid
-    pid=$(cat "$1")
+    if ! pid=$(owned_pid "$1" "$2" "$3"); then
+        echo "cluster.sh: note: $1 names pid $(head -c 32 "$1" | tr -d '[:space:]'), not $2 of $3; left alone" >&2
+        return 0
+    fi
     kill "$pid" 2> /dev/null || return 0
     for _ in $(seq 1 100); do
         kill -0 "$pid" 2> /dev/null || return 0
         sleep 0.1
     done
-    kill -9 "$pid" 2> /dev/null || true
+    [ "$(owned_pid "$1" "$2" "$3")" = "$pid" ] && kill -9 "$pid" 2> /dev/null || true
+}
+
+cluster_dir() {  # DIR: the folder as up wrote it into slurm.conf (the daemons' command lines name it)
+    local recorded=""
+    [ -f "$1/slurm.conf" ] && recorded=$(sed -n 's|^StateSaveLocation=\(.*\)/state$|\1|p' "$1/slurm.conf" | head -n 1)
+    if [ -n "$recorded" ]; then echo "$recorded"; else (cd "$1" && pwd); fi
 }
 
 stop_daemons() {  # DIR: its jobs cancelled, its daemons stopped (those that were started)
-    if [ -f "$1/slurm.conf" ] && [ -s "$1/slurmctld.pid" ]; then
+    local dir
+    dir=$(cluster_dir "$1")
+    if [ -f "$1/slurm.conf" ] && owned_pid "$1/slurmctld.pid" slurmctld "$dir" > /dev/null; then
         SLURM_CONF="$1/slurm.conf" scancel --full --quiet --user=root 2> /dev/null || true
     fi
-    stop_pid_file "$1/slurmd.pid"
-    stop_pid_file "$1/slurmctld.pid"
-    stop_pid_file "$1/munged.pid"
+    stop_pid_file "$1/slurmd.pid" slurmd "$dir"
+    stop_pid_file "$1/slurmctld.pid" slurmctld "$dir"
+    stop_pid_file "$1/munged.pid" munged "$dir"
 }
 
 down() {
-    local dir=${1:?usage: $0 down DIR}
+    local dir=$1
+    [ -d "$dir" ] || die "$dir is not a folder (give the DIR that up printed)"
     [ -f "$dir/munge.key" ] || die "$dir holds no cluster (no munge.key)"
     stop_daemons "$dir"
 }
 
 case "${1:-}" in
-    up) up "${2:-}" ;;
-    down) down "${2:-}" ;;
-    *) die "usage: $0 up [DIR] | down DIR" ;;
+    up) [ $# -le 2 ] || die "$USAGE"; up "${2:-}" ;;
+    down) [ $# -eq 2 ] && [ -n "$2" ] || die "$USAGE"; down "$2" ;;
+    *) die "$USAGE" ;;
 esac
