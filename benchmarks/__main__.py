@@ -17,7 +17,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__)
     ap.add_argument("--quick", action="store_true", help="reduced sizes (< 60 s)")
     ap.add_argument("--out", default="results/benchmarks.json", help="JSON output file")
-    ap.add_argument("--only", default="", help="comma-separated sections: springs,scaling,cantilever,dynamics,scenes,stepping,gpu (gpu: by default only when JAX sees a GPU)")
+    ap.add_argument("--only", default="", help="comma-separated sections: springs,scaling,cantilever,dynamics,scenes,stepping,reference,gpu (gpu: by default only when JAX sees a GPU)")
     args = ap.parse_args(argv)
 
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")
@@ -40,7 +40,8 @@ def main(argv=None):
     print(f"threads: BLAS/OpenMP pools pinned to 1 ({pools}); numba threads {numba.get_num_threads()}; "
           f"cpu count {os.cpu_count()}; load average {os.getloadavg()[0]:.1f}", flush=True)
     res = Results()
-    sections = [s for s in args.only.split(",") if s] or ["springs", "cantilever", "dynamics", "scaling", "scenes", "stepping"]
+    sections = [s for s in args.only.split(",") if s] or ["springs", "cantilever", "dynamics", "scaling", "scenes", "stepping",
+                                                           "reference"]
     if not args.only:  # the GPU figures of the JAX backend, when JAX sees a GPU
         try:
             from msslib.explicit.jax_backend import has_gpu
@@ -49,13 +50,13 @@ def main(argv=None):
                 sections.append("gpu")
         except Exception as exc:  # noqa: BLE001 - a broken JAX install: say so, run the CPU sections
             print(f"no GPU figures: {type(exc).__name__}: {exc}", flush=True)
-    from . import dynamics, gpu, scenes, springs, statics, stepping
+    from . import dynamics, fem_solvers, gpu, scenes, springs, statics, stepping
 
     t0 = time.perf_counter()
     for sec in sections:
         {"springs": springs.run, "scaling": statics.run_scaling, "cantilever": statics.run_cantilever,
          "dynamics": dynamics.run, "scenes": scenes.run,
-         "stepping": stepping.run, "gpu": gpu.run}[sec](res, args.quick)
+         "stepping": stepping.run, "reference": fem_solvers.run_reference, "gpu": gpu.run}[sec](res, args.quick)
     try:
         import pyamg
         amg = pyamg.__version__
