@@ -51,8 +51,8 @@ def _probe(ref_mesh, ref_u, points):
     """Shape-function values of the reference at ``points``: (values, inside mask).
 
     Points on a reference node (a nested refinement, or the same nodes) take that node's value,
-    which is what the interpolating shape functions give there; the others are located element by
-    element in blocks (:data:`PROBE_BLOCK` points at a time: scikit-fem's element finder holds
+    which is what the interpolating shape functions give there; points farther from every node
+    than :func:`element_size` lie in no cell; the others are located element by element in blocks (:data:`PROBE_BLOCK` points at a time: scikit-fem's element finder holds
     arrays of points x candidate elements)."""
     from scipy.spatial import cKDTree
     from skfem import Basis
@@ -66,7 +66,11 @@ def _probe(ref_mesh, ref_u, points):
     distance, nearest = cKDTree(nodes).query(points)
     on_node = distance <= tol
     out[on_node] = ref_u[nearest[on_node]]
-    rest = np.flatnonzero(~on_node)
+    # farther from every node than the largest cell is wide: in no cell (not located one by one)
+    beyond = distance > (1.0 + 1e-9) * element_size(ref_mesh)
+    inside[beyond] = False
+    out[beyond] = ref_u[nearest[beyond]]
+    rest = np.flatnonzero(~on_node & ~beyond)
     if not len(rest):
         return out, inside
     skmesh, elem = to_skfem(ref_mesh)
@@ -123,9 +127,12 @@ def _triangle_distance(p, a, b, c):
     return np.where(inside, np.abs(h) * np.sqrt(np.where(ok, nn, 0.0)), edges)
 
 
-def _distance_to_mesh(mesh, points, candidates: int = 16):
-    """Distance [m] of ``points`` (outside ``mesh``) to the boundary of ``mesh``: exact, over the
-    boundary facets nearest to each point (all of them where those cannot be shown closest)."""
+def _distance_to_mesh(mesh, points, candidates: int = 16, tol: float | None = None):
+    """Distance [m] of ``points`` (outside ``mesh``) to the boundary of ``mesh``, over the boundary
+    facets nearest to each point: exact where those are shown to hold the closest, else over all
+    facets.  With ``tol``, that search over all facets is made only where it decides whether the
+    distance exceeds ``tol`` (elsewhere the value may be an upper bound at most ``tol``, or
+    a value above a lower bound that already exceeds ``tol``)."""
     from scipy.spatial import cKDTree
 
     from msslib.mesh import boundary_facets
@@ -153,13 +160,18 @@ def _distance_to_mesh(mesh, points, candidates: int = 16):
     dc, near = dc.reshape(len(points), k), near.reshape(len(points), k)
     out = dist(points[:, None, :], corners[near]).min(axis=1)
     if k < len(corners):  # a facet beyond the k nearest centres could be closer: check against all
-        for i in np.flatnonzero(out > dc[:, -1] - radius):
+        lower = dc[:, -1] - radius
+        unsure = out > lower
+        if tol is not None:
+            unsure &= (out > tol) & (lower <= tol)
+        for i in np.flatnonzero(unsure):
             out[i] = dist(points[i][None, None, :], corners[None]).min()
     return out
 
 
-def _interpolate(ref_mesh, ref_u, points):
-    """(values, inside mask, distance of each point to the reference mesh [m], 0 inside)."""
+def _interpolate(ref_mesh, ref_u, points, tol: float | None = None):
+    """(values, inside mask, distance of each point to the reference mesh [m], 0 inside; with
+    ``tol`` as :func:`_distance_to_mesh` gives it)."""
     from scipy.spatial import cKDTree
 
     ref_u = np.asarray(ref_u, dtype=float)
@@ -167,7 +179,7 @@ def _interpolate(ref_mesh, ref_u, points):
     out, inside = _probe(ref_mesh, ref_u, points)
     distance = np.zeros(len(points))
     if not inside.all():
-        distance[~inside] = _distance_to_mesh(ref_mesh, points[~inside])
+        distance[~inside] = _distance_to_mesh(ref_mesh, points[~inside], tol=tol)
         out[~inside] = ref_u[cKDTree(ref_mesh.points).query(points[~inside])[1]]
     return out, inside, distance
 
@@ -226,10 +238,11 @@ def reference_at(ref_mesh, ref_u, at, *, result_name: str = "result", reference_
         unit = _unit_hint(X, Xr, result_name, reference_name)
         if unit:
             refuse(unit)
-    values, inside, distance = _interpolate(ref_mesh, ref_u, X)
+    values, inside, distance = _interpolate(ref_mesh, ref_u, X, tol=tol)
     far = float(distance.max(initial=0.0))
     if far > tol:
         worst = int(np.argmax(distance))
+        far = float(_distance_to_mesh(ref_mesh, X[worst][None, :])[0])  # exact, for the message
         refuse(f"node {worst} of {result_name} at {_fmt_point(X[worst])} lies {far:.3g} m outside the reference "
                f"mesh (allowed: {OUTSIDE_TOLERANCE:g} of the element size {h:.3g} m, {tol:.3g} m)")
     if mesh is not None and len(X):
@@ -242,9 +255,10 @@ def reference_at(ref_mesh, ref_u, at, *, result_name: str = "result", reference_
             _, located = _probe(mesh, np.zeros((len(X), 1)), Xr[check])
             check = check[~located]
         if len(check):
-            d = _distance_to_mesh(mesh, Xr[check])
+            d = _distance_to_mesh(mesh, Xr[check], tol=tol)
             if d.max() > tol:
                 worst = int(np.argmax(d))
+                d[worst] = _distance_to_mesh(mesh, Xr[check[worst]][None, :])[0]  # exact, for the message
                 refuse(f"the reference extends beyond the result: node {int(check[worst])} of {reference_name} at "
                        f"{_fmt_point(Xr[check[worst]])} lies {float(d[worst]):.3g} m outside the mesh of {result_name} "
                        f"(allowed: {OUTSIDE_TOLERANCE:g} of the element size {h:.3g} m, {tol:.3g} m)")
