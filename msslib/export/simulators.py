@@ -2,7 +2,8 @@
 
 Both carry the springs, node masses, fixed and prescribed dofs, loads and gravity of an
 :class:`msslib.export.model.MssExport` (see :mod:`msslib.export.model` for the mapping of each); neither can
-carry a volume term, and both files say so in a comment when the model has one.
+carry a volume term, and both files say so in a comment when the model has one.  The MJCF sizes
+MuJoCo's arena from the model (``<size memory>``, :func:`mjcf_memory`).
 """
 
 from __future__ import annotations
@@ -17,8 +18,8 @@ import numpy as np
 from msslib.errors import MsslibWarning
 from msslib.export.model import AXES, MssExport, _pad3, _safe_name, _version, not_carried
 
-__all__ = ["SOFA_COMPONENTS", "SOFA_TARGET", "MJCF_SAFETY", "MjcfStep", "time_step", "stability_limit",
-           "mjcf_time_step", "mjcf_text", "sofa_text"]
+__all__ = ["SOFA_COMPONENTS", "SOFA_TARGET", "MJCF_SAFETY", "MJCF_ARENA_BYTES_PER_ELEMENT", "MJCF_ARENA_MIN",
+           "MjcfStep", "time_step", "stability_limit", "mjcf_time_step", "mjcf_memory", "mjcf_text", "sofa_text"]
 
 #: SOFA components and the attributes the scene uses, for SOFA v24.06 and later: for each component
 #: class the plugin that registers it, its Data names (the XML attributes, as declared by
