@@ -194,13 +194,13 @@ def test_materials_of_a_name_that_is_only_a_facet_group_are_refused(tmp_path):
 STIFF_T = np.array([0.0, 0.0, -40.0])  # Pa on the end face x = LX (1 m^2)
 
 
-def _overlapping(path: Path, version: float = 4.1, binary: bool = False) -> Path:
+def _overlapping(path: Path, version: float = 4.1, binary: bool = False, shared_volume: bool = True) -> Path:
     """The box [0, LX] x [0, LY] x [0, LZ] as two volumes x < 1 and x > 1; every physical group
     shares its elements with another, in every dimension, and the later group is the one meshio
     drops: the volume "stiff" (x > 1) inside the volume "body" (both); the surface "stiff" (the end
     face x = LX, 1 m^2) inside the surface "tip" (that face and the top faces, 3 m^2); the surface
     "base" (x = 0); the curves "edge" and "rim" (the end face's top edge); the points "corner" and
-    "pin" (the corner (LX, LY, LZ))."""
+    "pin" (the corner (LX, LY, LZ)).  Without ``shared_volume``, no volume "stiff"."""
     _start("overlap")
     try:
         occ = gmsh.model.occ
@@ -213,7 +213,8 @@ def _overlapping(path: Path, version: float = 4.1, binary: bool = False) -> Path
         corner = [t for _, t in gmsh.model.getEntities(0) if np.allclose(gmsh.model.getValue(0, t, []), [LX, LY, LZ])]
         assert len(right) == 1 and len(end) == 1 and len(top) == 2 and len(edge) == 1 and len(corner) == 1
         gmsh.model.addPhysicalGroup(3, volumes, name="body")
-        gmsh.model.addPhysicalGroup(3, right, name="stiff")
+        if shared_volume:
+            gmsh.model.addPhysicalGroup(3, right, name="stiff")
         gmsh.model.addPhysicalGroup(2, end + top, name="tip")
         gmsh.model.addPhysicalGroup(2, end, name="stiff")
         gmsh.model.addPhysicalGroup(2, _entities_at(2, 0, 0.0), name="base")
@@ -276,6 +277,17 @@ def test_a_traction_on_a_surface_that_shares_its_triangles_loads_that_surface(tm
     x = ds["rest_position"].transpose("node", "axis").values[:, 0]
     reaction = ds["reaction_force"].transpose("node", "axis").values
     np.testing.assert_allclose(reaction[np.abs(x) < 1e-12].sum(axis=0), -STIFF_T * LY * LZ, rtol=1e-6, atol=1e-6)
+
+
+def test_a_gmsh_2_file_keeps_shared_facets_curves_and_points(tmp_path):
+    """gmsh 2 writes an element once for each of its groups: the lower dimensions keep them all."""
+    mesh = M.read(_overlapping(tmp_path / "overlap.msh", 2.2, shared_volume=False))
+    assert set(mesh.cell_groups) == {"body"} and set(mesh.facet_groups) == {"tip", "stiff", "base"}
+    assert M.facet_areas(mesh, mesh.facet_groups["stiff"]).sum() == pytest.approx(LY * LZ, rel=1e-12)
+    assert M.facet_areas(mesh, mesh.facet_groups["tip"]).sum() == pytest.approx(LY * LZ + LX * LY, rel=1e-12)
+    np.testing.assert_array_equal(mesh.node_groups["edge"], mesh.node_groups["rim"])
+    np.testing.assert_array_equal(mesh.node_groups["corner"], mesh.node_groups["pin"])
+    assert len(mesh.node_groups["corner"]) == 1
 
 
 def test_a_gmsh_2_file_with_shared_cells_is_refused(tmp_path):
