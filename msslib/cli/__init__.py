@@ -338,6 +338,10 @@ def _add_plan(subparsers) -> None:
                                                "only lengthen the measurement)")
     p.add_argument("--budget", type=float,
                    help="wall-time budget per run (s); slower runs are recorded as failed (default 30)")
+    p.add_argument("--time-limit", type=float,
+                   help="without --levels: measure the levels of 1,2,3 whose estimated time in all (dofs, memory and "
+                        "time of every level and of the reference, estimated before anything runs) is within this "
+                        "many seconds (default 150)")
     p.set_defaults(func=_cmd_plan)
 
 
@@ -390,8 +394,8 @@ def _cmd_plan(args) -> int:
     max_error = _positive_number("--max-error", args.max_error, "a fraction of the largest reference displacement")
     planning.check_arguments(max_error=max_error)  # above 1: "did you mean 5 %?"
     if args.front is not None:
-        given = [o for o, v in (("--levels", args.levels), ("--repeats", args.repeats), ("--budget", args.budget))
-                 if v is not None]
+        given = [o for o, v in (("--levels", args.levels), ("--repeats", args.repeats), ("--budget", args.budget),
+                                ("--time-limit", args.time_limit)) if v is not None]
         if given:
             raise CommandError(f"{given[0]} applies to a measurement; with --front nothing is measured")
     levels = _parse_levels("1,2,3" if args.levels is None else args.levels)
@@ -399,6 +403,10 @@ def _cmd_plan(args) -> int:
     if not 1 <= repeats <= planning.MAX_REPEATS:
         raise CommandError(f"--repeats must be an integer from 1 to {planning.MAX_REPEATS}, got {repeats}")
     budget = 30.0 if args.budget is None else _positive_number("--budget", args.budget, "seconds per run")
+    if args.time_limit is not None:
+        _positive_number("--time-limit", args.time_limit, "seconds for the whole measurement")
+        if args.levels is not None:
+            raise CommandError("--time-limit chooses the levels; with --levels they are given")
     input_file(scene, "scene file")
     front_path = Path(args.front) if args.front is not None else None
     save = Path(args.save) if args.save is not None else None
@@ -408,8 +416,14 @@ def _cmd_plan(args) -> int:
     if front_path is not None:
         front = _read_front(front_path, scene)
     else:
-        front = planning.measure_front(args.scene, levels=levels, repeats=repeats, budget=budget,
-                                       progress=lambda s: print(s, file=sys.stderr))
+        progress = lambda s: print(s, file=sys.stderr)  # noqa: E731
+        if args.levels is None:  # the default levels within the time limit, estimated before anything runs
+            limit = planning.DEFAULT_TIME_LIMIT if args.time_limit is None else args.time_limit
+            levels, estimate, lines = planning.levels_within(args.scene, limit, levels=levels, repeats=repeats)
+            for line in lines:
+                print(line, flush=True)
+            progress = planning.with_eta(progress, estimate["total_s"])
+        front = planning.measure_front(args.scene, levels=levels, repeats=repeats, budget=budget, progress=progress)
     if save is not None:
         write_result(save, front)
     for line in planning.report(front, max_error):  # the reference's own error beside the choice

@@ -259,6 +259,76 @@ def check_scene(scene, *, levels=(1, 2, 3), models=None):
     return raw, base_dir, cell_type, models, ref_model
 
 
+#: the default of ``plan --time-limit`` (s): the estimated time of the whole measurement
+DEFAULT_TIME_LIMIT = 150.0
+#: the levels ``plan`` measures by default, within the time limit
+DEFAULT_LEVELS = (1, 2, 3)
+
+
+def check_time_limit(value):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real) or not (
+            math.isfinite(value) and value > 0):
+        raise ValueError(f"time_limit must be a finite number of seconds > 0, got {value!r}")
+    return float(value)
+
+
+def levels_within(scene, time_limit=DEFAULT_TIME_LIMIT, *, levels=DEFAULT_LEVELS, repeats=3, models=None,
+                  calibrate=True):
+    """The levels of ``levels`` that a plan measures within ``time_limit`` seconds: the finest
+    ones are dropped (never the first) while the estimate of the whole measurement
+    (:func:`msslib.planning.reference.estimate`, calibrated by a small reference solve on this
+    machine unless ``calibrate`` is false) exceeds the limit.  Returns ``(levels, estimate,
+    lines)``: the estimate of the levels kept and the lines that say so (the limit, each
+    level's dofs, the reference's dofs, memory and time, the total)."""
+    from msslib import models as registry
+    from msslib.planning import reference as ref
+    from msslib.planning.front import at_level
+    from msslib.scene import load_scene, prepare
+
+    time_limit = check_time_limit(time_limit)
+    levels = check_arguments(levels=levels, models=models, repeats=repeats)
+    raw, base_dir, cell_type, models, ref_model = check_scene(scene, levels=levels, models=models)
+    setup = prepare(load_scene(at_level(raw, 1, ref_model), base_dir=base_dir))
+    rate = ref.calibrate(setup, registry.get(ref_model).law) if calibrate else None
+    kept = sorted(levels)
+    est = ref.estimate(setup, kept, repeats=repeats, n_models=len(models), calibration=rate)
+    while len(kept) > 1 and est["total_s"] > time_limit:
+        kept = kept[:-1]
+        est = ref.estimate(setup, kept, repeats=repeats, n_models=len(models), calibration=rate)
+    lines = [f"time limit {time_limit:g} s (--time-limit): measuring levels {','.join(map(str, kept))}, estimated "
+             f"{est['total_s']:.0f} s in all" + ("" if kept == sorted(levels) else
+                                                 _dropped(levels, kept))]
+    for lv in sorted(est["levels"]):
+        e = est["levels"][lv]
+        lines.append(f"  level {lv}: models {e['dofs']} dofs; reference {e['reference_dofs']} dofs, about "
+                     f"{e['memory_bytes'] / 1e9:.2g} GB, about {e['reference_s']:.2g} s")
+    return tuple(kept), est, lines
+
+
+def _dropped(levels, kept):
+    gone = [str(v) for v in sorted(levels) if v not in kept]
+    return f" (level{'s' if len(gone) > 1 else ''} {','.join(gone)} would exceed it)"
+
+
+def with_eta(progress, total_s, clock=None):
+    """``progress`` with each line followed by the time elapsed and an estimate of the time left
+    (the estimated total less the time elapsed; "overrunning" once the estimate is passed)."""
+    import time
+
+    clock = clock or time.perf_counter
+    t0 = clock()
+
+    def say(line):
+        if progress is None:
+            return
+        elapsed = clock() - t0
+        left = total_s - elapsed
+        eta = f"about {left:.0f} s left" if left >= 0.5 else "past the estimate"
+        progress(f"{line}  [{elapsed:.0f} s elapsed, {eta}]")
+
+    return say
+
+
 from msslib.planning.front import measure_front as measure_front  # noqa: E402 - the engine (public), after what it uses
 
 FRONT_VARIABLES = ("wall_time", "error_max", "error_mean", "n_dofs", "status")

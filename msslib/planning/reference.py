@@ -137,3 +137,71 @@ def reference(prepare_level, top: int, law: str | None, progress=None, lowest: i
     return {"result": results[top], "scale": scale, "error_estimate": estimate, "step_change": step,
             "observed_order": p, "levels": used, "n_dofs": results[top].stats["n_dofs"], "wall_time": wall,
             "locking": nu, "formulation": what}
+
+
+# --------------------------------------------------------------------------------------------
+# what a plan will cost, before it runs
+# --------------------------------------------------------------------------------------------
+
+#: the reference's time grows like (dofs)^TIME_EXPONENT: measured on the 10 x 2 x 2 cm bar of
+#: tetrahedra (neo-Hookean, large deflection): 13,491 dofs 8.2 s, 95,619 dofs 76 s (2 cores)
+TIME_EXPONENT = 1.2
+#: seconds per dofs^TIME_EXPONENT of that measurement: the least the estimate assumes (a machine
+#: or a scene that solves faster is measured by the calibration solve instead)
+TIME_RATE = 8.0e-5
+#: the runs of every model at a level, one repeat, as a share of the reference's time there
+#: (the same bar: 13.7 s for the five tetrahedron models at level 3 against 76 s)
+MODEL_SHARE = 0.25
+#: memory of the reference per dof: its tangent (about 80 entries a row, values and indices) and
+#: a direct factorisation with about ten times the fill
+BYTES_PER_DOF = 12e3
+
+
+def level_sizes(mesh, levels):
+    """``{level: n_nodes}`` of the mesh refined ``level - 1`` times, for every level in ``levels``
+    and the one above each (whose nodes are the quadratic dofs of the level below): counted on
+    refined meshes up to about 10^6 nodes, beyond that scaled by ``2^dim`` per level."""
+    from msslib.mesh.refine import uniform
+
+    top = max(levels) + 1
+    sizes, m = {1: mesh.n_nodes}, mesh
+    for lv in range(2, top + 1):
+        if m is not None and m.n_nodes * 2**mesh.dim <= 1_000_000:
+            m = uniform(m, 1)
+            sizes[lv] = m.n_nodes
+        else:
+            m = None
+            sizes[lv] = sizes[lv - 1] * 2**mesh.dim
+    return sizes
+
+
+def estimate(setup, levels, *, repeats: int = 1, n_models: int = 5, calibration: float | None = None):
+    """Estimated cost of a plan on ``levels`` of a prepared level-1 scene ``setup``: a dict per
+    level (``dofs`` of the models, ``reference_dofs``, ``reference_s``, ``models_s``,
+    ``memory_bytes`` of the reference) and ``total_s``: the reference on the top level and up to
+    two below it, every model on every level ``repeats`` times (plus a warm-up).
+    ``calibration``: seconds per dofs^TIME_EXPONENT measured on this machine and scene (a small
+    reference solve); the larger of it and :data:`TIME_RATE` is used."""
+    d = setup.mesh.dim
+    sizes = level_sizes(setup.mesh, levels)
+    rate = max(TIME_RATE, calibration or 0.0)
+    out = {}
+    for lv in sorted(set(levels) | {lv for top in levels for lv in range(max(1, top - 2), top + 1)}):
+        ref_dofs = d * sizes[lv + 1]
+        t_ref = rate * ref_dofs**TIME_EXPONENT
+        out[lv] = {"dofs": d * sizes[lv], "reference_dofs": ref_dofs, "reference_s": t_ref,
+                   "models_s": MODEL_SHARE * t_ref * n_models / 5.0, "memory_bytes": BYTES_PER_DOF * ref_dofs}
+    top = max(levels)
+    ref_levels = [lv for lv in (top - 2, top - 1, top) if lv >= 1]
+    total = sum(out[lv]["reference_s"] for lv in ref_levels)
+    total += (int(repeats) + 1) * sum(out[lv]["models_s"] for lv in levels)
+    return {"levels": out, "total_s": total, "rate": rate}
+
+
+def calibrate(setup, law) -> float:
+    """Seconds per dofs^TIME_EXPONENT of the quadratic reference of the prepared level-1 scene on
+    this machine: its solve timed once after a first (compiling) solve."""
+    solve_setup(setup, order=2, law=law)
+    t0 = time.perf_counter()
+    res = solve_setup(setup, order=2, law=law)
+    return (time.perf_counter() - t0) / max(res.stats["n_dofs"], 1) ** TIME_EXPONENT
