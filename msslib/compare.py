@@ -267,7 +267,8 @@ def reference_at(ref_mesh, ref_u, at, *, result_name: str = "result", reference_
 
 def interpolate(ref_mesh, ref_u, points):
     """Reference displacement ``ref_u`` (one row per node of ``ref_mesh``) at ``points`` (or at the
-    nodes of a mesh), with the reference mesh's shape functions: :func:`reference_at`'s values.
+    nodes of a mesh: then the reference is checked against it both ways), with the reference mesh's
+    shape functions: :func:`reference_at`'s values.
     Points outside the reference mesh, within its tolerance, take the displacement of the nearest
     reference node; farther ones (and, given a mesh, a reference beyond it) are a ValueError."""
     return reference_at(ref_mesh, ref_u, points)[0]
