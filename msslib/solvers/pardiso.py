@@ -24,9 +24,13 @@ def available() -> bool:
     global _SOLVER
     if _SOLVER is None:
         try:
+            import os
+
             import pypardiso
 
-            pypardiso.PyPardisoSolver(mtype=-2)  # finds libmkl_rt
+            found = pypardiso.PyPardisoSolver(mtype=-2)  # finds libmkl_rt (a directory search: seconds)
+            # every later solver loads the library found, without searching again
+            os.environ.setdefault("PYPARDISO_MKL_RT", found.libmkl._name)
             _SOLVER = pypardiso
         except Exception:  # noqa: BLE001 - no wheel, no MKL library: SuperLU instead
             _SOLVER = False
