@@ -97,6 +97,28 @@ _ETA_MAX = 0.1  # loosest relative tolerance of the iterative linear solves (fir
 _ETA_GAMMA = 0.9
 
 
+#: the diagonal shift of a singular tangent's Newton steps, relative to its largest diagonal entry
+_SHIFT = 1e-9
+
+
+def _shifted(K, rel):
+    """``K + mu I`` with ``mu = rel * max |diag K|`` (a copy, in ``K``'s format): the Newton step of a
+    tangent with zero-stiffness modes (a lattice that is a mechanism at rest, such as Baudet's cube
+    one cube thick) then stays out of those modes instead of taking the round-off of the
+    factorisation in them; the residual decides convergence as before, so the equilibrium found is
+    the same."""
+    mu = rel * float(np.abs(K.diagonal()).max())
+    out = K.copy()
+    if out.format == "bsr":
+        bs = out.blocksize[0]
+        rows = np.repeat(np.arange(out.shape[0] // bs), np.diff(out.indptr))
+        out.data[out.indices == rows] += mu * np.eye(bs)
+    else:
+        out = out.tocsr()
+        out.setdiag(out.diagonal() + mu)
+    return out
+
+
 def _forcing_term(rnorm, rnorm_prev, eta_prev, threshold):
     """Relative tolerance of the iterative linear solve of a Newton step (inexact Newton,
     Eisenstat & Walker's second choice): ``eta = 0.9 (|r_k| / |r_k-1|)^2``, kept above
@@ -216,7 +238,8 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         try:
             rtol = _forcing_term(rnorm, rnorm_prev, eta_prev, target())
             eta_prev, rnorm_prev = rtol, rnorm
-            dx = solve_linear_system(K, r, linear_solver, symmetric, messages, context, rtol,
+            K_step = _shifted(K, context["shift"]) if context.get("shift") else K
+            dx = solve_linear_system(K_step, r, linear_solver, symmetric, messages, context, rtol,
                                truncate=bool(line_search and use_energy))
         except NewtonFailure as exc:
             raise fail(str(exc)) from None
@@ -226,7 +249,8 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         if line_search:
             try:
                 resolve = None if not monotone else (  # the same tangent, for the natural monotonicity test
-                    lambda b, K=K, rtol=rtol: solve_linear_system(K, b, linear_solver, symmetric, messages, context, rtol))
+                    lambda b, K=K_step, rtol=rtol: solve_linear_system(K, b, linear_solver, symmetric, messages, context,
+                                                                        rtol))
                 rnorm_before = rnorm
                 x, r, rnorm, e, alpha = _line_search(problem, x, dx, free, load, r, rnorm, e, use_energy, resolve)
                 armijo = rnorm**2 <= (1.0 - 2.0 * _ARMIJO_C * alpha) * rnorm_before**2
@@ -330,6 +354,7 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
     nominal = 1.0 / load_steps
     # AMG hierarchy and matrix kept across iterations, load steps and solves of this problem
     solver_context = _static_context(problem, x, free, linear_solver)
+    solver_context.pop("shift", None)  # judged afresh by each solve
     try:
         lam = 0.0
         dlam = nominal
@@ -346,6 +371,13 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
                                           linear_solver, symmetric, use_energy, messages, progress, step_index,
                                           solver_context, scales)
             except NewtonFailure as exc:
+                if "shift" not in solver_context and cuts_this_step == 0 and not callable(linear_solver):
+                    # before halving: the same step again with a shifted tangent (zero-stiffness modes)
+                    solver_context["shift"] = _SHIFT
+                    messages.append(f"load step {step_index} to load {target:.6g} failed at iteration "
+                                    f"{exc.iteration} ({exc}); again with the tangent shifted by {_SHIFT:g} of its "
+                                    "largest diagonal entry (zero-stiffness modes)")
+                    continue
                 dlam = 0.5 * (target - lam)
                 if cuts_this_step >= max_cuts or dlam < nominal * 0.5**max_cuts * (1.0 - 1e-12):
                     k = int(np.floor(lam / nominal + 1e-9)) + 1  # the nominal step it belongs to
