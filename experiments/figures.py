@@ -137,7 +137,11 @@ def draw_curves(spec):
 
     path = Path(spec["result"])
     if not path.is_file():
-        raise FileNotFoundError(f"{path}: the study result the figure reads is missing; build it first")
+        # results/<paper>/studies/<name>.nc is written by experiments/<paper>/studies/<name>.py
+        study = Path(__file__).resolve().parent.joinpath(*path.parts[1:-1], f"{path.stem}.py")
+        build = (f"`python -m experiments.{'.'.join(path.parts[1:-1])}.{path.stem} --out {shlex.quote(str(path))}`"
+                 if study.is_file() and path.parts[0] == "results" else "its study")
+        raise FileNotFoundError(f"{path}: the study result the figure reads is missing; build it first: run {build}")
     with xr.open_dataset(path) as ds:
         ds = ds.load()
     for key in (spec["variable"], spec["x"]):

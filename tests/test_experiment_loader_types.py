@@ -162,3 +162,28 @@ def test_a_bad_curves_file_fails_in_one_line_on_the_command_line(tmp_path):
                         str(tmp_path / "x")], cwd=ROOT, capture_output=True, text=True, timeout=120)
     lines = r.stderr.strip().splitlines()
     assert r.returncode != 0 and len(lines) == 1 and "invalid YAML" in lines[0], r.stderr
+
+
+def test_the_missing_study_hint_works_as_printed(tmp_path):
+    """A curves figure whose study result is missing: the one-line error names the study's command;
+    run as printed (in the same folder), it writes the result and the figure is then drawn."""
+    import os
+
+    curves = yaml.safe_load((ROOT / "experiments" / "baudet" / "figures" / "curves.yaml").read_text())
+    (tmp_path / "curves.yaml").write_text(yaml.safe_dump({"figures": {"bulk_modulus": curves["figures"]["bulk_modulus"]}}))
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    draw = [sys.executable, "-m", "experiments.figures", "curves.yaml", "bulk_modulus", "--out", "fig"]
+    r = subprocess.run(draw, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    lines = r.stderr.strip().splitlines()
+    assert r.returncode != 0 and len(lines) == 1, r.stderr
+    hint = re.search(r"run `([^`]+)`$", lines[0])
+    assert hint, lines[0]
+    argv = shlex.split(hint.group(1))
+    assert argv[:2] == ["python", "-m"]
+    done = subprocess.run([sys.executable, *argv[1:]], cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "results" / "baudet" / "studies" / "bulk.nc").is_file()
+    r = subprocess.run(draw, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "fig.png").is_file()
