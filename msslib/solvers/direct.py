@@ -143,20 +143,19 @@ def _banded_cholesky_solve(A, b, context):
     return x if np.all(np.isfinite(x)) else None
 
 
-def _direct_solve(A, b, symmetric, context=None):
-    """The factorisation :func:`msslib.solvers.policy.choose_factorisation` takes.  Symmetric:
+def _direct_solve(A, b, symmetric, context=None, factorisation="superlu"):
+    """``factorisation``: the one :func:`msslib.solvers.policy.choose_factorisation` takes
+    (``"pardiso"`` or ``"superlu"``), after a banded Cholesky where one is cheap.  Symmetric:
     banded Cholesky in a bandwidth-reducing ordering when it is cheap and the matrix is positive
     definite; above ``PARDISO_MIN_DOFS`` MKL Pardiso (symmetric indefinite, its analysis kept in
     ``context`` for the later matrices of the pattern; :mod:`msslib.solvers.pardiso`) where it
     is installed; otherwise SuperLU with the minimum-degree ordering of A^T + A (less fill than
     the default COLAMD on lattice stiffnesses).  Non-symmetric: SuperLU with COLAMD."""
-    from .policy import choose_factorisation
-
     if symmetric:
         x = _banded_cholesky_solve(A, b, context)
         if x is not None:
             return x
-    if choose_factorisation(A.shape[0], symmetric) == "pardiso":
+    if factorisation == "pardiso":
         from .pardiso import PardisoFactor
 
         state = context if context is not None else {}

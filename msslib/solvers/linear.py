@@ -86,7 +86,7 @@ def solve_linear_system(A, b, method, symmetric, messages, context=None, rtol=1e
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            x = _direct_solve(A, b, symmetric, context)
+            x = _direct_solve(A, b, symmetric, context, choose_factorisation(n, symmetric))
     except RuntimeError as exc:  # "Factor is exactly singular"
         raise NewtonFailure(f"singular stiffness matrix ({exc})") from None
     if not np.all(np.isfinite(x)):
