@@ -54,7 +54,7 @@ def test_up_checks_dir_before_it_installs_anything(tmp_path):
     held.mkdir()
     (held / "slurm.conf").write_text("ClusterName=other\n")
     deep = tmp_path / ("x" * 100)
-    for dir_, says in [(plain, f"DIR '{plain}' exists and is not a folder; give a new or an empty folder"),
+    for dir_, says in [(plain, f"DIR '{plain}' exists and is not a folder; give a folder to make or one without a cluster"),
                        (plain / "sub", f"DIR '{plain / 'sub'}' cannot be made: '{plain}' is not a folder"),
                        (held, f"{held} already holds a cluster (run: {CLUSTER} down {held})"),
                        (tmp_path / "two words", "contains white space, which slurm.conf cannot hold"),

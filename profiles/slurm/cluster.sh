@@ -8,9 +8,9 @@
 #   profiles/slurm/cluster.sh down DIR    cancel its jobs and stop its daemons (DIR and its logs stay)
 #
 # Any other use prints `cluster.sh: error: usage: profiles/slurm/cluster.sh up [DIR] | down DIR`.
-# `up` checks DIR before it installs or starts anything: a new or empty folder (an existing file,
-# a folder that already holds a cluster, white space, or a munge socket path over 107 characters are
-# refused). `down` signals only the daemons this script started for DIR: the process a pid file
+# `up` checks DIR before it installs or starts anything: a folder to make or one without a cluster
+# (an existing file, a folder that already holds a cluster, white space, or a munge socket path over
+# 107 characters are refused). `down` signals only the daemons this script started for DIR: the process a pid file
 # names is signalled only while its command is that daemon's and names DIR (a stale pid file, whose
 # pid a reboot gave to another process, is left alone with a note).
 #
@@ -76,7 +76,7 @@ check_new_dir() {  # DIR: a folder up can make or use, checked before anything i
     local dir=$1 abs parent
     case $dir in *[[:space:]]*) die "DIR '$dir' contains white space, which slurm.conf cannot hold; choose another folder" ;; esac
     if [ -e "$dir" ] && [ ! -d "$dir" ]; then
-        die "DIR '$dir' exists and is not a folder; give a new or an empty folder"
+        die "DIR '$dir' exists and is not a folder; give a folder to make or one without a cluster"
     fi
     [ ! -e "$dir/slurm.conf" ] || die "$dir already holds a cluster (run: $0 down $dir)"
     parent=$dir
