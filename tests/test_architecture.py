@@ -155,3 +155,12 @@ def test_no_module_is_named_like_a_sibling_package():
         clashes += [f"{folder.relative_to(ROOT)}/{m}.py beside {m[:-1]}/" for m in modules
                     if m.endswith("s") and m[:-1] in packages]
     assert not clashes, clashes
+
+
+def test_the_simulator_does_not_import_the_scene_layer():
+    """Node selection lives with the mesh (``msslib.mesh.selection``): the stepping code imports
+    nothing of ``msslib.scene`` (the scene builds on the simulator, not the other way)."""
+    mods = _modules()
+    bad = [(m, d) for m, p in mods.items() if m.startswith(("msslib.simulator", "msslib.explicit"))
+           for d in _imports(m, p, mods) if d.startswith("msslib.scene")]
+    assert not bad, bad

@@ -45,7 +45,7 @@ def nearly_incompressible(setup) -> float | None:
 
 def _loads(setup):
     """``(nodal_forces, tractions, body_force)`` of the scene's loads."""
-    from msslib.scene.selection import loaded_facets, select_nodes
+    from msslib.mesh.selection import loaded_facets, select_nodes
 
     mesh, dim = setup.mesh, setup.mesh.dim
     size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if mesh.n_nodes else 1.0

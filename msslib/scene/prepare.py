@@ -13,7 +13,8 @@ import numpy as np
 from msslib import mesh as _mesh
 from msslib import models as _models
 from msslib.scene.schema import Scene
-from msslib.scene.selection import _build_mesh, _check_dim, loaded_facets, select_nodes
+from msslib.mesh.selection import loaded_facets, select_nodes
+from msslib.scene.selection import _build_mesh, _check_dim
 from msslib.scene.validate import AXES, _fail
 
 
