@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numbers
 import time
 
 import numpy as np
@@ -14,6 +15,40 @@ from msslib.explicit.network import network_terms
 from .network import NetworkStepper
 
 ENGINES = ("auto", "network", "generic", "jax")
+METHODS = ("symplectic_euler", "velocity_verlet", "implicit_euler")
+# steps of one fused kernel call: the monitor rows it fills are held at most this many at a time
+_CHUNK = 256
+
+
+def _count(value, name: str) -> int:
+    """``value`` as a positive whole number of steps, else a one-line refusal."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Integral, np.integer)) or value < 1:
+        raise ValueError(f"{name} must be a positive whole number, got {value!r}")
+    return int(value)
+
+
+def _finite(value, name: str, allowed: str) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = float("nan")
+    if isinstance(value, (bool, np.bool_)) or not np.isfinite(x):
+        raise ValueError(f"{name} must be {allowed}, got {value!r}")
+    return x
+
+
+def _checked_damping(damping):
+    if damping is None:
+        return None
+    vals = np.atleast_1d(np.asarray(damping, dtype=object)).ravel()
+    ok = vals.size in (1, 2)
+    try:
+        f = [float(v) for v in vals] if ok else []
+    except (TypeError, ValueError):
+        ok = False
+    if not ok or not all(np.isfinite(v) and v >= 0 for v in f):
+        raise ValueError(f"damping must be None, alpha or (alpha, beta), finite and >= 0, got {damping!r}")
+    return damping
 
 
 class Simulator:
@@ -61,6 +96,18 @@ class Simulator:
             raise ValueError("Simulator needs a mass-spring model (a FEM reference has no time stepping)")
         if engine not in ENGINES:
             raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        dt = _finite(dt, "dt", "a finite time step > 0 (s)")
+        if dt <= 0:
+            raise ValueError(f"dt must be a finite time step > 0 (s), got {dt!r}")
+        blowup = _finite(blowup, "blowup", "a finite number > 0")
+        if blowup <= 0:
+            raise ValueError(f"blowup must be a finite number > 0, got {blowup!r}")
+        damping = _checked_damping(damping)
+        if engine == "jax" and method != "symplectic_euler":
+            raise ValueError(f"engine='jax' runs symplectic_euler only, got method={method!r} "
+                             "(the other schemes run on engine='generic')")
         self.model = model
         self.dim = int(model.dim)
         self.n_nodes = int(model.n_nodes)
@@ -69,6 +116,7 @@ class Simulator:
         self._implicit = dict(newton_tol=newton_tol, newton_max_iter=newton_max_iter, linear_solver=linear_solver)
         self._engine_request = engine
         self._load, self._load_varies = time_function(load, "load")
+        self._value(self._load, 0.0, "load", ())
         self._forces: dict[int, tuple] = {}
         self._paths: dict[int, tuple] = {}
         self._next = 0
@@ -152,49 +200,110 @@ class Simulator:
             fixed = np.flatnonzero(~model.free)
             x2[fixed // self.dim, fixed % self.dim] = model.x0[fixed] + lam * prescribed[fixed]
         for dofs, fn, _ in self._paths.values():
-            u = np.asarray(fn(t), dtype=float)
-            x2[dofs // self.dim, dofs % self.dim] = model.x0[dofs] + np.resize(u, dofs.size)
+            u = fn(t)
+            x2[dofs // self.dim, dofs % self.dim] = model.x0[dofs] + np.repeat(u[None, :], dofs.size // u.size, 0).ravel()
         if st is None:
             return
         if self._forces:
             extra = np.zeros(model.n_dof)
             for dofs, fn, share, _ in self._forces.values():
-                f = np.asarray(fn(t), dtype=float) * share
-                np.add.at(extra, dofs, np.resize(f, dofs.size))
+                f = fn(t) * share
+                np.add.at(extra, dofs, np.tile(f, dofs.size // f.size))
             st.extra = extra
         else:
             st.extra = None
+
+    @staticmethod
+    def _value(fn, t, name, shape):
+        """``fn(t)`` as a float array of ``shape``, finite, else a one-line refusal."""
+        raw = fn(t)
+        try:
+            a = np.asarray(raw, dtype=float)
+        except (TypeError, ValueError):
+            a = None
+        if a is None or a.shape != shape or not np.all(np.isfinite(a)):
+            want = "a finite number" if shape == () else f"{shape[0]} finite numbers"
+            raise ValueError(f"{name} at t = {float(t):.6g} s must be {want}, got {raw!r}")
+        return a
+
+    def _checked(self, fn, name, shape):
+        """``fn`` wrapped so that every value it returns is checked like a constant."""
+        return lambda t, _f=fn: self._value(_f, t, name, shape)
 
     def _rebuild(self):
         st = self._stepper
         self._build(st.x.copy(), st.v.copy(), st.t, st.n_taken)
 
+    def _transaction(self, change):
+        """Apply ``change()`` (which edits the load tables) and rebuild; on any error restore the
+        tables and the stepper as they were, so a refused call changes nothing."""
+        saved = (self._load, self._load_varies, dict(self._forces), dict(self._paths), self._next,
+                 self._stepper, self.engine)
+        try:
+            out = change()
+            self._rebuild()
+        except BaseException:
+            (self._load, self._load_varies, self._forces, self._paths, self._next,
+             self._stepper, self.engine) = saved
+            raise
+        return out
+
     def _nodes(self, selection) -> np.ndarray:
         mesh = getattr(self.model, "mesh", None)
         if isinstance(selection, dict):  # the scene's selection syntax (group, plane, box)
-            from msslib.scene.selection import select_nodes
+            from msslib.mesh.selection import select_nodes
 
             size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if mesh.n_nodes else 1.0
             nodes = np.asarray(select_nodes("selection", mesh, selection, max(1e-8 * size, 1e-15)))
         else:
-            a = np.asarray(selection)
-            nodes = np.flatnonzero(a) if a.dtype == bool else a.astype(np.int64).reshape(-1)
+            try:
+                a = np.asarray(selection)
+            except Exception:
+                a = np.asarray([object()])
+            if a.dtype == bool:
+                if a.shape != (self.n_nodes,):
+                    raise ValueError(f"nodes: a boolean mask must hold {self.n_nodes} entries (one per node), "
+                                     f"got shape {a.shape}")
+                nodes = np.flatnonzero(a)
+            elif a.dtype.kind in "iu":
+                nodes = a.astype(np.int64).reshape(-1)
+            elif a.dtype.kind == "f" and np.all(np.isfinite(a)) and np.all(a == np.round(a)):
+                nodes = a.astype(np.int64).reshape(-1)
+            else:
+                raise ValueError(f"nodes must be whole node ids in 0..{self.n_nodes - 1}, a boolean mask of "
+                                 f"{self.n_nodes} entries or a selection dict, got {selection!r}")
         if nodes.size == 0:
-            raise ValueError(f"the selection {selection!r} holds no node")
+            raise ValueError(f"nodes: the selection {selection!r} holds no node")
         if nodes.min() < 0 or nodes.max() >= self.n_nodes:
-            raise ValueError(f"node ids must lie in 0..{self.n_nodes - 1}")
+            bad = int(nodes[(nodes < 0) | (nodes >= self.n_nodes)][0])
+            raise ValueError(f"nodes: node ids must lie in 0..{self.n_nodes - 1}, got {bad}")
         return np.unique(nodes)
 
-    def _dofs(self, nodes, axes=None):
-        axes = range(self.dim) if axes is None else [int(a) for a in np.atleast_1d(axes)]
-        return (self.dim * nodes[:, None] + np.asarray(list(axes))[None, :]).ravel()
+    def _axes(self, axes):
+        if axes is None:
+            return np.arange(self.dim)
+        a = np.atleast_1d(np.asarray(axes, dtype=object)).ravel()
+        ok = a.size >= 1 and all(isinstance(v, (numbers.Integral, np.integer)) and not isinstance(v, (bool, np.bool_))
+                                 and 0 <= v < self.dim for v in a)
+        if not ok or len(set(int(v) for v in a)) != a.size:
+            raise ValueError(f"axes must be distinct whole numbers in 0..{self.dim - 1}, got {axes!r}")
+        return np.array([int(v) for v in a], dtype=np.int64)
+
+    def _dofs(self, nodes, axes):
+        return (self.dim * nodes[:, None] + axes[None, :]).ravel()
 
     # ---- loads ---------------------------------------------------------------------------
 
     def set_load(self, load) -> None:
         """The load factor of the model's own loads: a number, a callable of time or a table."""
-        self._load, self._load_varies = time_function(load, "load")
-        self._rebuild()
+        fn, varies = time_function(load, "load")
+        fn = self._checked(fn, "load", ())
+        fn(self.t)
+
+        def change():
+            self._load, self._load_varies = fn, varies
+
+        self._transaction(change)
 
     def apply_force(self, nodes, force, *, total: bool = False) -> int:
         """Add the force ``force`` (N, a vector, a callable of time or a table ``[[t, fx, fy, fz],
@@ -203,8 +312,10 @@ class Simulator:
         Returns a handle for :meth:`remove`."""
         nodes = self._nodes(nodes)
         fn, varies = time_function(force, "force", self.dim)
+        fn = self._checked(fn, "force", (self.dim,))
+        fn(self.t)  # a callable that fails or returns a wrong value is refused here
         share = 1.0 / len(nodes) if total else 1.0
-        return self._add(self._forces, (self._dofs(nodes), fn, share, varies))
+        return self._add(self._forces, (self._dofs(nodes, np.arange(self.dim)), fn, share, varies))
 
     def prescribe(self, nodes, displacement, *, axes=None) -> int:
         """Move the nodes ``nodes`` by ``displacement`` (m; a vector, a callable of time or a table
@@ -212,54 +323,83 @@ class Simulator:
         tool.  Their dofs stop being free; :attr:`reaction` holds the force the tool applies.
         Returns a handle for :meth:`remove`."""
         nodes = self._nodes(nodes)
+        ax = self._axes(axes)
         fn, varies = time_function(displacement, "displacement", self.dim)
-        dofs = self._dofs(nodes, axes)
-        if axes is not None:
-            ax = np.atleast_1d(axes)
-            whole = fn
-            fn = (lambda t, _f=whole, _a=ax: np.asarray(_f(t), dtype=float)[_a])
-        return self._add(self._paths, (dofs, fn, varies))
+        whole = self._checked(fn, "displacement", (self.dim,))
+        fn = (lambda t, _f=whole, _a=ax: _f(t)[_a])
+        fn(self.t)
+        return self._add(self._paths, (self._dofs(nodes, ax), fn, varies))
 
     def _add(self, table, entry):
-        handle = self._next
-        self._next += 1
-        table[handle] = entry
-        self._rebuild()
-        return handle
+        def change():
+            handle = self._next
+            self._next += 1
+            table[handle] = entry
+            return handle
+
+        return self._transaction(change)
 
     def remove(self, handle: int) -> None:
         """Remove a force or a prescribed path (its nodes move freely again)."""
         for table in (self._forces, self._paths):
-            if handle in table:
-                del table[handle]
-                self._rebuild()
+            if isinstance(handle, (numbers.Integral, np.integer)) and not isinstance(handle, bool) and handle in table:
+                self._transaction(lambda: table.pop(handle))
                 return
-        raise KeyError(f"no force or path with handle {handle}")
+        raise KeyError(f"handle: no force or path with handle {handle!r} (handles: "
+                       f"{sorted([*self._forces, *self._paths])})")
 
     # ---- stepping ------------------------------------------------------------------------
 
     def step(self, n: int = 1, *, h: float | None = None, t_new: float | None = None) -> Simulator:
-        """Advance ``n`` steps of ``h`` (default ``dt``; a shorter step ends a run at a given
-        time, ``t_new`` the time after the last step)."""
+        """Advance ``n`` steps (a positive whole number) of ``h`` (default ``dt``; a shorter step
+        ends a run at a given time, ``t_new`` the time after the last step, later than ``t``).
+        A wrong argument is refused before anything moves."""
+        n = _count(n, "n")
+        dt = self._options["dt"]
+        if h is not None:
+            hv = _finite(h, "h", f"a step in (0, dt = {dt:.6g} s]")
+            if not (0 < hv <= dt * (1 + 1e-12)):
+                raise ValueError(f"h must be a step in (0, dt = {dt:.6g} s], got {h!r}")
+            h = hv
+        if t_new is not None:
+            tn = _finite(t_new, "t_new", f"a finite time later than t = {self.t:.6g} s")
+            if not tn > self.t:
+                raise ValueError(f"t_new must be a finite time later than t = {self.t:.6g} s (time never runs "
+                                 f"backwards), got {t_new!r}")
+            t_new = tn
         t0 = time.perf_counter()
         st = self._stepper
-        if h is not None and not (0 < h <= self._options["dt"] * (1 + 1e-12)):
-            raise ValueError(f"h must lie in (0, dt = {self._options['dt']:.6g} s], got {h!r}")
-        if self.engine in ("network", "jax"):
-            st.steps(n, h, t_new)
-        else:
-            for i in range(int(n)):
-                st.step(h, t_new if i + 1 == n else None)
-        self._wall += time.perf_counter() - t0
+        saved = (st.x.copy(), st.v.copy(), st.t, st.n_taken) if self._varies() else None
+        try:
+            if self.engine in ("network", "jax"):
+                st.steps(n, h, t_new)
+            else:
+                for i in range(n):
+                    st.step(h, t_new if i + 1 == n else None)
+        except Exception as exc:
+            from msslib.errors import DivergenceError
+
+            if saved is not None and not isinstance(exc, DivergenceError):
+                # a load or path callable failed in the middle of the call: back to the state before it
+                self._build(*saved)
+            raise
+        finally:
+            self._wall += time.perf_counter() - t0
         return self
 
     def run(self, t_end: float, callback=None, every: int = 1) -> Simulator:
-        """Step until ``t >= t_end`` (the last step is not shortened); ``callback(self)`` after
-        every ``every`` steps."""
+        """Step until ``t >= t_end`` (a finite time; the last step is not shortened);
+        ``callback(self)`` after every ``every`` steps (a positive whole number)."""
+        t_end = _finite(t_end, "t_end", "a finite time (s)")
+        every = _count(every, "every")
+        if callback is not None and not callable(callback):
+            raise ValueError(f"callback must be callable or None, got {callback!r}")
         dt = self._options["dt"]
         n = int(np.ceil((t_end - self.t) / dt - 1e-9))
+        if n < 1:
+            return self
         if callback is None:
-            return self.step(max(n, 0))
+            return self.step(n)
         while n > 0:
             k = min(every, n)
             self.step(k)

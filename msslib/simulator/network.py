@@ -97,15 +97,27 @@ class NetworkStepper(Integrator):
         self._ckpt = (self.x.copy(), self.v.copy(), self.t, self.n_taken, self.j_min, self.flips)
         self._since = []  # (n, h, end) of the calls since the checkpoint
 
+    # steps of one fused kernel call: the monitor rows are held for at most this many steps, so
+    # that the memory of a call does not grow with its number of steps
+    _CHUNK = 256
+
     def steps(self, n: int, h=None, t_new=None):
         """``n`` steps of ``h`` (default ``dt``); ``t_new`` the time after the last one.  Runs them
-        in one kernel call when nothing changes in between (no ``drive``, no other terms)."""
+        in fused kernel calls of at most ``_CHUNK`` steps when nothing changes in between (no
+        ``drive``, no other terms)."""
         n = int(n)
         if n < 1:
             return
         h = self.dt if h is None else float(h)
-        self._set_step(h)
         end = self.t + n * h if t_new is None else float(t_new)
+        done = 0
+        while done < n:
+            k = min(self._CHUNK, n - done)
+            done += k
+            self._steps(k, h, end if done == n else self.t + k * h)
+
+    def _steps(self, n, h, end):
+        self._set_step(h)
         if getattr(self, "_ckpt", None) is None or self.n_taken - self._ckpt[3] >= self._CHECKPOINT_EVERY:
             self._checkpoint()
         self._since.append((n, h, end))

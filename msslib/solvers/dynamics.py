@@ -488,7 +488,7 @@ def _check_state(problem, x, v, x_ref, bound, step, t, dt, method, x_prev, v_pre
     else:
         what = f"{quantity} of dof {dof} = {value}"
     with np.errstate(all="ignore"):
-        umax = float(np.nanmax(np.abs(x_prev - x_ref))) if x_prev.size else 0.0
+        umax = float(np.nanmax(np.abs(np.ravel(x_prev) - x_ref))) if x_prev is not None and np.size(x_prev) else 0.0
     raise DivergenceError(
         f"{method} diverged: {what} at step {step}, t = {t:.6g} s{_limit_hint(dt, limit)}",
         step=step, time=t, quantity=quantity, dof=dof, value=float(value), x_last=x_prev, v_last=v_prev,
