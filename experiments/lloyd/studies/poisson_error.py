@@ -21,7 +21,7 @@ import xarray as xr
 
 from experiments import script
 from msslib.results import write_result
-from msslib.metrics import displacement_error
+from msslib.compare import compare_results
 from msslib.scene import run_scene
 
 E, HEIGHT, RINGS, THICKNESS = 14630.0, 0.017, 4, 0.01
@@ -53,11 +53,11 @@ def main(argv=None):
         warnings.simplefilter("ignore")  # eq. 8 off nu = 1/3: expected, that is the point
         for i, case in enumerate(cases):
             for j, nu in enumerate(nus):
-                u = run_scene(scene("lloyd_triangle", nu, LOADS[case]), progress=False)["displacement"].values
-                ur = run_scene(scene("fem_linear", nu, LOADS[case]), progress=False)["displacement"].values
-                e = displacement_error(u, ur)
-                err_max[i, j], err_mean[i, j] = e.max, e.mean
-                ref_max[i, j] = np.linalg.norm(ur, axis=1).max()
+                mss = run_scene(scene("lloyd_triangle", nu, LOADS[case]), progress=False)
+                fem = run_scene(scene("fem_linear", nu, LOADS[case]), progress=False)
+                c = compare_results(mss, fem, result_name="lloyd_triangle", reference_name="fem_linear")
+                err_max[i, j], err_mean[i, j] = c.error.max, c.error.mean
+                ref_max[i, j] = c.reference_max
     best = nus[np.argmin(err_mean, axis=1)]
     third, zero = np.argmin(np.abs(nus - 1 / 3)), np.argmin(np.abs(nus))
     ds = xr.Dataset(
