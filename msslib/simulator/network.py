@@ -71,6 +71,11 @@ class NetworkStepper(Integrator):
     def _flat_x(self):
         return self.x.reshape(-1)
 
+    def _fixed_positions(self):
+        if self.drive is None or not self._fixed.size:
+            return None
+        return self.x[self._fixed // 3, self._fixed % 3]
+
     def evaluate(self):
         """The force, reactions and monitor at the current state (no step): after a change of the
         loads or of the driven dofs' positions made outside :meth:`step`."""
@@ -94,7 +99,7 @@ class NetworkStepper(Integrator):
     _CHECKPOINT_EVERY = 64
 
     def _checkpoint(self):
-        self._ckpt = (self.x.copy(), self.v.copy(), self.t, self.n_taken, self.j_min, self.flips)
+        self._ckpt = (self.x.copy(), self.v.copy(), self.t, self.n_taken, self.j_min, self.flips, self.a_in)
         self._since = []  # (n, h, end) of the calls since the checkpoint
 
     # steps of one fused kernel call: the monitor rows are held for at most this many steps, so
@@ -153,7 +158,9 @@ class NetworkStepper(Integrator):
         """One step without the detector: advance, move the driven dofs, evaluate."""
         fused_advance(self.R, self.v, self.F, self.w, self.damp, h)
         if self.drive is not None:
+            before = (self._fixed_positions(), self.load, self.extra)
             self.drive(t_step, self.x)
+            self.note_input(before[0], self._fixed_positions(), before[1], before[2])
         self.evaluate()
         self.n_taken += 1
         self.t = t_step
@@ -165,10 +172,10 @@ class NetworkStepper(Integrator):
     def _replay(self):
         """Rerun the steps since the checkpoint one by one, keeping the state before each, until
         the detector raises again (with that state)."""
-        x, v, t, n_taken, j_min, flips = self._ckpt
+        x, v, t, n_taken, j_min, flips, a_in = self._ckpt
         self.x[:] = x
         self.v[:] = v
-        self.t, self.n_taken, self.j_min, self.flips = t, n_taken, j_min, flips
+        self.t, self.n_taken, self.j_min, self.flips, self.a_in = t, n_taken, j_min, flips, a_in
         if self.drive is not None:
             self.drive(t, self.x)
         self.evaluate()

@@ -273,6 +273,13 @@ class Integrator:
         self.j_floor = (omega**4 * float(self.mf.sum()) * (_FLOOR_SIZE * _bbox_size(problem, self.x_ref)) ** 2
                         if self.explicit and np.isfinite(omega) else 0.0)
         self.j_min = None
+        # the amplitude sqrt(J) the loads and paths put in since the start (see note_input)
+        self.a_in = 0.0
+        self._omega2 = omega**2 if self.explicit and np.isfinite(omega) else 0.0
+        self._fixed = np.flatnonzero(~free)
+        m_mean = float(self.mf.mean()) if self.mf.size else 1.0
+        self._m_fixed = np.maximum(mass[self._fixed], m_mean)
+        self._load_norm = None
         self.growth = _growth_threshold(stats["dt_over_limit"]) if self.explicit else None
         self.flips = 0  # steps in a row whose force flipped sign
         self._zeros = np.zeros(int(free.sum()))
@@ -282,6 +289,34 @@ class Integrator:
             if self.explicit and not np.any(v[free]):  # from rest: J_0 = a.M a
                 j = float(np.sum(self.f * self.f * self.inv_m))
                 self.j_min = j if np.isfinite(j) else None
+
+    def note_input(self, x_fixed_before, x_fixed_after, load_before, extra_before):
+        """Add to ``a_in`` the amplitude ``sqrt(J)`` that one step's change of the inputs can put
+        into the motion: a move ``du`` of the dofs that do not move freely (paths, prescribed
+        displacements) changes the force on the free dofs by ``K du``, at most
+        ``omega_max^2 |du|_M`` in the ``M^-1`` norm of J; a change of the load factor or of the
+        extra nodal forces by its ``M^-1`` norm.  The detector measures growth against this scale
+        too, so that a body at rest driven by a tool or a ramped load (J ~ 0 at the start) is not
+        taken for an instability."""
+        a = 0.0
+        if self._fixed.size and x_fixed_before is not None:
+            du = np.asarray(x_fixed_after, dtype=float) - np.asarray(x_fixed_before, dtype=float)
+            a += self._omega2 * float(np.sqrt(np.sum(self._m_fixed * du * du)))
+        if self.load != load_before:
+            if self._load_norm is None:
+                f_load = protocol._load_vector(self.problem, self.x_ref)[self.free]
+                self._load_norm = float(np.sqrt(np.sum(f_load * f_load * self.inv_m)))
+            a += abs(float(self.load) - float(load_before)) * self._load_norm
+        if self.extra is not extra_before:
+            new = self.extra[self.free] if self.extra is not None else 0.0
+            old = extra_before[self.free] if extra_before is not None else 0.0
+            d = np.broadcast_to(np.asarray(new - old, dtype=float), self.mf.shape)
+            a += float(np.sqrt(np.sum(d * d * self.inv_m)))
+        if np.isfinite(a):
+            self.a_in += a
+
+    def _fixed_positions(self):
+        return self.x[self._fixed] if self.drive is not None and self._fixed.size else None
 
     def force(self, xx):
         """The force on the free dofs at ``xx`` (with ``load`` and ``extra``)."""
@@ -322,6 +357,7 @@ class Integrator:
         free, alpha, beta, inv_m = self.free, self.alpha, self.beta, self.inv_m
         x, v, f = self.x, self.v, self.f
         x_prev, v_prev = x, v  # not modified below (x and v are replaced by new arrays)
+        inputs = (self._fixed_positions(), self.load, self.extra) if self.drive is not None else None
         with np.errstate(all="ignore"):
             vf = v[free]
             jterms = None  # (velocity u, f_late, f_early, f for a.M a, step h): K u = -(f_late - f_early) / h
@@ -354,6 +390,8 @@ class Integrator:
             v = np.zeros(v.size)
             v[free] = vf
             self.x, self.v, self.f = x, v, f
+            if inputs is not None:
+                self.note_input(inputs[0], self._fixed_positions(), inputs[1], inputs[2])
             self.t = t_new
             self.n_taken = step
             self.stats["n_steps"] = max(self.stats["n_steps"], step)
@@ -372,7 +410,7 @@ class Integrator:
             J = r - ku / h
             J = J if J == J else float("inf")
             self.j_min = J if self.j_min is None else min(self.j_min, J)
-            j_ref = max(self.j_min, self.j_floor, TINY)
+            j_ref = max(self.j_min, self.j_floor, self.a_in * self.a_in, TINY)
             if (J > self.growth * j_ref and self.flips >= 1) or J > _GROWTH_ANY * j_ref:
                 _raise_growth(self._flat_x(), self.x_ref, step, t, self.dt, self.method, x_prev, v_prev, self.limit,
                               J / j_ref, self.flips)
