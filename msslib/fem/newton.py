@@ -74,11 +74,13 @@ def _problem_class():
 
 
 def newton_solve(internal, f_ext, constrained, prescribed, points, *, steps: int, tol: float, max_iter: int,
-                 max_halvings: int, progress: Callable[[int, int], None] | None = None, linear_solver="auto"):
+                 max_halvings: int, progress: Callable[[int, int], None] | None = None, linear_solver="auto",
+                 initial=None):
     """Solve ``f_int(u) = f_ext`` from ``u = 0`` by :func:`msslib.solvers.static_solve` (Newton
     without line search, ``steps`` load increments each halved at most ``max_halvings`` times in a
     row, the convergence test of the mass-spring models) with the linear solver chosen by the
     policy of :mod:`msslib.solvers`. ``internal(u, tangent)`` -> ``(f_int, K, energy, f_abs)``.
+    ``initial``: the first iterate (all dofs, flat; default zero).
     Returns ``(u, stats)`` as :func:`msslib.solvers.displacement.solve_displacement`."""
     from msslib.solvers import static_solve
 
@@ -90,7 +92,8 @@ def newton_solve(internal, f_ext, constrained, prescribed, points, *, steps: int
             progress(reported[0], steps)
             reported[0] += 1
 
-    res = static_solve(problem, np.zeros(problem.n_dof), load_steps=steps, tol=tol, max_iter=max_iter, line_search=False,
+    x0 = np.zeros(problem.n_dof) if initial is None else np.asarray(initial, dtype=float).ravel()
+    res = static_solve(problem, x0, load_steps=steps, tol=tol, max_iter=max_iter, line_search=False,
                        linear_solver=linear_solver, max_cuts=max_halvings, on_load_step=on_load_step)
     stats = {"iterations": list(res.iterations), "residuals": [[r / res.force_scale for r in h] for h in res.residuals],
              "load_factors": list(res.loads), "n_halvings": res.n_cuts, "force_scale": res.force_scale,

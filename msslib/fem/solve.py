@@ -277,6 +277,7 @@ def solve_nonlinear(
     tractions=(),
     linear_solver="auto",
     volumetric: str = "full",
+    initial=None,
 ) -> FemResult:
     """Geometrically non-linear (total Lagrangian) reference solution with dead loads.
 
@@ -297,6 +298,9 @@ def solve_nonlinear(
     inverted element) is halved, at most ``max_halvings`` times in a row and never below
     ``1 / (steps * 2**max_halvings)``; then :class:`msslib.errors.ConvergenceError` (a
     RuntimeError) names the step and the residual.
+    ``initial``: None, or a displacement ``(n_nodes, dim)`` at the mesh's nodes (a guess of the
+    solution, e.g. a coarser mesh's at these nodes) from whose linear interpolant at every dof
+    Newton starts, with ``steps = 1`` only (ValueError otherwise).
     2D: ``plane="stress"`` (default, as in :func:`solve_linear`; exact plane stress of the 3D law, see
     the module docstring) or ``"strain"`` (``F33 = 1``). ``progress(step, n_steps)`` is called after every converged nominal step.
 
@@ -324,6 +328,16 @@ def solve_nonlinear(
     lam_c, mu_c = lame(E_c, nu_c)  # 3D constants; plane stress handled inside the law
     geo = _Geometry(mesh, order)
     w = thickness if d == 2 else 1.0
+    x0 = None
+    if initial is not None:
+        guess = np.asarray(initial, dtype=float)
+        if guess.shape != (mesh.n_nodes, d) or not np.all(np.isfinite(guess)):
+            raise ValueError(f"initial must be None or finite displacements of shape ({mesh.n_nodes}, {d}) (one per "
+                             f"node), got shape {guess.shape}" + ("" if guess.shape != (mesh.n_nodes, d) else
+                                                                    " with non-finite values"))
+        if steps != 1:
+            raise ValueError(f"initial is a guess of the solution: it needs steps=1, got steps={steps!r}")
+        x0 = np.asarray(geo.interp @ guess).ravel()
     cons, presc, f_ext = _boundary(mesh, fixed, prescribed, nodal_forces, body_force, geo, thickness, tractions)
     free = ~cons
     pl = plane if d == 2 else None
@@ -359,7 +373,8 @@ def solve_nonlinear(
         return fint, K, energy, (fabs if tangent else None)
 
     u, newton = newton_solve(internal, f_ext, cons, presc, geo.points, steps=steps, tol=tol, max_iter=max_iter,
-                             max_halvings=max_halvings, progress=progress, linear_solver=linear_solver)
+                             max_halvings=max_halvings, progress=progress, linear_solver=linear_solver,
+                             initial=x0)
     fint, _, energy, _ = internal(u, tangent=False)
     r = fint - f_ext
     reaction = np.where(cons, r, 0.0)

@@ -65,11 +65,12 @@ def _loads(setup):
 
 
 def solve_setup(setup, *, order: int = 2, law: str | None = None, volumetric: str = "full", steps: int = 1,
-                tol: float = 1e-10, max_iter: int = 30, linear_solver="auto"):
+                tol: float = 1e-10, max_iter: int = 30, linear_solver="auto", initial=None):
     """The FEM solution of a prepared scene with elements of ``order`` (a
     :class:`msslib.fem.FemResult`; ``dof_points`` / ``dof_displacement`` hold every dof).
     ``law``: None (linear elasticity) or a law of :func:`msslib.fem.solve_nonlinear`, solved in
-    ``steps`` load steps to a relative residual ``tol``."""
+    ``steps`` load steps to a relative residual ``tol``; ``initial``: a guess of the non-linear
+    solution at the mesh's nodes (:func:`msslib.fem.solve_nonlinear`)."""
     from msslib import fem
 
     scene, mesh = setup.scene, setup.mesh
@@ -82,7 +83,7 @@ def solve_setup(setup, *, order: int = 2, law: str | None = None, volumetric: st
         kw.update(thickness=setup.thickness, plane=scene.model_options.get("plane", "stress"))
     if law is None:
         return fem.solve_linear(mesh, E, nu, **kw)
-    return fem.solve_nonlinear(mesh, E, nu, law=law, steps=steps, tol=tol, max_iter=max_iter, **kw)
+    return fem.solve_nonlinear(mesh, E, nu, law=law, steps=steps, tol=tol, max_iter=max_iter, initial=initial, **kw)
 
 
 def at_points(result, points, rtol: float = 1e-9):
@@ -113,7 +114,15 @@ def reference(prepare_level, top: int, law: str | None, progress=None, lowest: i
     results, wall = {}, 0.0
     for lv in used:
         t0 = time.perf_counter()
-        results[lv] = solve_setup(setups[lv], order=2, law=law, volumetric=volumetric, linear_solver=solver)
+        # Newton starts on each finer level from the coarser level's solution at its nodes (they are
+        # that level's quadratic dofs): a few iterations where a start from rest takes many.  Not
+        # under prescribed displacements, whose convergence scale is the force of the motion from
+        # the start
+        guess = None
+        if law is not None and lv - 1 in results and not np.any(setups[lv].prescribed):
+            guess = at_points(results[lv - 1], setups[lv].mesh.points)
+        results[lv] = solve_setup(setups[lv], order=2, law=law, volumetric=volumetric, linear_solver=solver,
+                                  initial=guess)
         wall += time.perf_counter() - t0
         if progress:
             progress(f"reference (quadratic elements, {law or 'linear'}) level {lv}: "
