@@ -153,7 +153,9 @@ def reference(prepare_level, top: int, law: str | None, progress=None, lowest: i
 # --------------------------------------------------------------------------------------------
 
 #: the reference's time grows like (dofs)^TIME_EXPONENT: measured on the 10 x 2 x 2 cm bar of
-#: tetrahedra (neo-Hookean, large deflection): 13,491 dofs 8.2 s, 95,619 dofs 76 s (2 cores)
+#: tetrahedra (neo-Hookean, large deflection), each level from rest: 13,491 dofs 8.2 s, 95,619
+#: dofs 76 s (2 cores); started from the coarser level's solution, as the reference now is, the
+#: finest took 51 s: the estimate errs on the long side
 TIME_EXPONENT = 1.2
 #: seconds per dofs^TIME_EXPONENT of that measurement: the least the estimate assumes (a machine
 #: or a scene that solves faster is measured by the calibration solve instead)
