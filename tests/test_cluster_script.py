@@ -37,6 +37,7 @@ def _cluster(*args, path=None, timeout=60):
 
 
 @pytest.mark.parametrize("args", [[], ["down"], ["down", ""], ["down", "a", "b"], ["up", "a", "b"], ["start"],
+                                  ["up", "--help"], ["up", "-x"], ["down", "-h"],
                                   ["--help"]])
 def test_every_wrong_call_prints_the_usage_line(args):
     r = _cluster(*args)

@@ -7,7 +7,8 @@
 #                                         points sbatch, squeue, srun (and snakemake) at it
 #   profiles/slurm/cluster.sh down DIR    cancel its jobs and stop its daemons (DIR and its logs stay)
 #
-# Any other use prints `cluster.sh: error: usage: profiles/slurm/cluster.sh up [DIR] | down DIR`.
+# Any other use (an option such as --help where DIR goes, too: a folder named -x is ./-x) prints
+# `cluster.sh: error: usage: profiles/slurm/cluster.sh up [DIR] | down DIR`.
 # `up` checks DIR before it installs or starts anything: a folder to make or one without a cluster
 # (an existing file, a folder that already holds a cluster, white space, or a munge socket path over
 # 107 characters are refused). `down` signals only the daemons this script started for DIR: the process a pid file
@@ -93,8 +94,8 @@ up() {
     [ "$(id -u)" -eq 0 ] || die "needs root to run munged, slurmctld and slurmd (running as uid $(id -u))"
     need_packages
     if [ -z "$dir" ]; then dir=$(mktemp -d "${TMPDIR:-/tmp}/slurm-cluster.XXXXXX"); fi
-    mkdir -p "$dir" 2> /dev/null || die "DIR '$dir' could not be made"
-    dir=$(cd "$dir" && pwd)
+    mkdir -p -- "$dir" 2> /dev/null || die "DIR '$dir' could not be made"
+    dir=$(cd -- "$dir" && pwd)
     [ ! -e "$dir/slurm.conf" ] || die "$dir already holds a cluster (run: $0 down $dir)"
     chmod 755 "$dir"  # munged wants its socket's folders searchable by all
     mkdir -p "$dir/state" "$dir/spool"
@@ -224,6 +225,7 @@ down() {
     stop_daemons "$dir"
 }
 
+case "${2:-}" in -*) die "$USAGE" ;; esac  # an option where DIR goes (--help); a folder named -x is ./-x
 case "${1:-}" in
     up) [ $# -le 2 ] || die "$USAGE"; up "${2:-}" ;;
     down) [ $# -eq 2 ] && [ -n "$2" ] || die "$USAGE"; down "$2" ;;
