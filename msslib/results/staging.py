@@ -23,7 +23,8 @@ import weakref
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["TEMP_TAG", "StagedOutputs", "Terminated", "terminate_raises", "remove_stale_temporaries"]
+__all__ = ["TEMP_TAG", "StagedOutputs", "Terminated", "abandon_staged", "terminate_raises",
+           "remove_stale_temporaries"]
 
 
 def _to_text(text: str):
@@ -77,11 +78,20 @@ def _interrupts_held():
     """Within the block, SIGINT and SIGTERM are held and take effect when it ends (the previous
     handlers are restored and the signals sent again): a file created in the block and registered
     for removal in the same block cannot be left behind by an interrupt landing in between.  The
-    blocks are short (a file created, renamed or removed).  Outside the main thread (which
-    receives no signals in Python) it does nothing."""
-    if not _in_main_thread():
-        yield
-        return
+    blocks are short (a file created, renamed or removed).  In every thread the block holds
+    :data:`_CRITICAL`, so that :func:`abandon_staged` (called on a signal by another thread) runs
+    before or after it, never in the middle.  Outside the main thread (which receives no signals
+    in Python) no handler is changed."""
+    with _CRITICAL:
+        if not _in_main_thread():
+            yield
+            return
+        with _held_in_main_thread():
+            yield
+
+
+@contextmanager
+def _held_in_main_thread():
     held: list[int] = []
 
     def hold(signum, frame):
@@ -296,6 +306,33 @@ def _rename_error(exc: BaseException, tmp: Path, dest: Path, what: str, disk_ful
     return new
 
 
+#: held by every step that creates, renames or removes a staged file (:func:`_interrupts_held`)
+_CRITICAL = threading.RLock()
+#: every :class:`StagedOutputs` alive, for :func:`abandon_staged`
+_LIVE: "weakref.WeakSet[StagedOutputs]" = weakref.WeakSet()
+
+
+def abandon_staged(timeout: float = 2.0) -> None:
+    """Remove the temporary files of every :class:`StagedOutputs` alive (and the temporaries their
+    writers made beside them); no destination is touched.  For a process about to end at once
+    (``os._exit``) on a signal, from a thread other than the one writing: it waits up to
+    ``timeout`` seconds for a create, rename or remove under way to end, so that a commit is
+    either whole or not begun.  The caller must not let the writing thread go on afterwards."""
+    got = _CRITICAL.acquire(timeout=timeout)
+    try:
+        for outputs in list(_LIVE):
+            for _, tmp in list(outputs._staged):
+                _unlink(tmp)
+                try:  # a writer's own temporary beside the path it was given
+                    for extra in tmp.parent.glob(f".{tmp.name}.*"):
+                        _unlink(extra)
+                except OSError:
+                    pass
+    finally:
+        if got:
+            _CRITICAL.release()
+
+
 class StagedOutputs:
     """Several output files written as one: every file is replaced, or none is.
 
@@ -334,6 +371,7 @@ class StagedOutputs:
         self._stale: dict[str, dict[str, list[str]]] = {}  # directory -> target -> temporaries of dead runs
         self._installed = False
         self._previous = None
+        _LIVE.add(self)
 
     # -- staging
 
