@@ -90,6 +90,23 @@ def test_a_bar_one_cube_thick_is_a_mechanism_at_rest():
     assert np.linalg.eigvalsh(K2)[0] > 1e-9 * np.abs(K2).max()  # two cubes thick: no mechanism
 
 
+@pytest.mark.parametrize("amplitude", [0.0, 1e-4])
+def test_the_default_readings_tangent_is_the_derivative_of_its_forces(amplitude):
+    """The stall was not a wrong tangent: at rest and at a perturbed state (1e-4 of a cube per dof),
+    K = -dF/dx to 1e-7 by central differences, correction included (10 Pa tip traction)."""
+    mesh, fixed = _bar((4, 1, 1))
+    model = _model(mesh, [(E0, 0.3)], "boundary", fixed, [0.0, 0.0, -TIP], _face(mesh, "x", A0 * 4))
+    x = model.x0 + amplitude * A0 * np.random.default_rng(0).standard_normal(model.n_dof)
+    K = model.stiffness(x).toarray()
+    h = 1e-7 * A0
+    fd = np.empty_like(K)
+    for j in range(model.n_dof):
+        e = np.zeros(model.n_dof)
+        e[j] = h
+        fd[:, j] = -(model.force(x + e) - model.force(x - e)) / (2 * h)
+    assert np.abs(K - fd).max() <= 1e-7 * np.abs(K).max()
+
+
 def test_issue_cantilever_of_ten_cubes_under_a_10_pa_tip_traction():
     """Through the scene runner, the default reading: one load step, no halving; the deflection is
     the minimum-norm solution of the linearisation at rest to 1e-6 plus the rotation, and
