@@ -72,9 +72,9 @@ class Simulator:
     * :meth:`prescribe`: a displacement of a selection along a path (a tool); its dofs stop
       being free and their reactions are what the tool must push with.
 
-    State, read without copies: :attr:`x` and :attr:`v` (``(n_nodes, dim)`` read-only views),
-    :attr:`reaction` (``-f`` on every dof that does not move, 0 elsewhere: a view on the
-    ``network`` engine), :attr:`t`, :attr:`n_steps`; :attr:`real_time_factor` is the simulated
+    State, read as snapshots (read-only copies taken when read, on every engine; they do not
+    follow later steps): :attr:`x` and :attr:`v` (``(n_nodes, dim)``), :attr:`reaction` (``-f``
+    on every dof that does not move, 0 elsewhere), :attr:`t`, :attr:`n_steps`; :attr:`real_time_factor` is the simulated
     time over the wall time spent in :meth:`step`.  :meth:`reset` returns to the start.
 
     ``engine``: ``"network"`` runs symplectic Euler on 3D spring models with the fused kernel of
@@ -118,6 +118,7 @@ class Simulator:
         self._load, self._load_varies = time_function(load, "load")
         self._value(self._load, 0.0, "load", ())
         self._forces: dict[int, tuple] = {}
+        self._shift_cache: dict = {}
         self._paths: dict[int, tuple] = {}
         self._next = 0
         self._omega = None
@@ -415,22 +416,25 @@ class Simulator:
     # ---- state ---------------------------------------------------------------------------
 
     def _view(self, a):
-        out = a.reshape(-1, self.dim).view()
+        """A snapshot of ``a`` as ``(n_nodes, dim)``: a read-only copy taken when read (it does
+        not follow later steps, on any engine)."""
+        out = np.array(a, dtype=float).reshape(-1, self.dim)
         out.flags.writeable = False
         return out
 
     @property
     def x(self) -> np.ndarray:
-        """Positions ``(n_nodes, dim)`` (a read-only view)."""
+        """Positions ``(n_nodes, dim)``: a read-only snapshot (a copy taken when read)."""
         return self._view(self._stepper.x)
 
     @property
     def v(self) -> np.ndarray:
-        """Velocities ``(n_nodes, dim)`` (a read-only view)."""
+        """Velocities ``(n_nodes, dim)``: a read-only snapshot (a copy taken when read)."""
         return self._view(self._stepper.v)
 
     @property
     def displacement(self) -> np.ndarray:
+        """``x - x0`` ``(n_nodes, dim)`` (m), a snapshot."""
         return np.asarray(self._stepper.x).reshape(-1, self.dim) - self.model.x0.reshape(-1, self.dim)
 
     @property
@@ -441,7 +445,7 @@ class Simulator:
         if self.engine == "network":
             return self._view(st.react)
         f = st.full_force() if st.explicit else np.asarray(self.model.force(np.ravel(st.x), st.load), dtype=float)
-        return np.where(st.free, 0.0, -f).reshape(-1, self.dim)
+        return self._view(np.where(st.free, 0.0, -f))
 
     @property
     def t(self) -> float:
@@ -475,14 +479,24 @@ class Simulator:
         return self._stepper.kinetic_energy()
 
     def potential_energy(self) -> float | None:
-        """Internal energy minus the work of the loads at the current load factor (J); None for a
-        model with a non-conservative term."""
+        """Internal energy minus the work of the loads on the displacement from the rest
+        positions, at the current load factor (J): it does not depend on where the mesh sits
+        (:func:`msslib.solvers.dynamics.relative_potential_energy`); None for a model with a
+        non-conservative term."""
         st = self._stepper
         if not st.conservative:
             return None
-        from msslib.solvers import protocol
+        from msslib.solvers.dynamics import relative_potential_energy
 
-        return protocol._energy_or_none(self.model, np.ravel(st.x), st.load)
+        x = np.ravel(np.asarray(st.x))
+        if self._forces:  # the extra nodal forces do work on the displacement too
+            extra = np.zeros(self.model.n_dof)
+            for dofs, fn, share, _ in self._forces.values():
+                np.add.at(extra, dofs, np.tile(fn(self.t) * share, dofs.size // self.dim))
+            work = float(extra @ (x - self.model.x0))
+        else:
+            work = 0.0
+        return relative_potential_energy(self.model, x, st.load, self._shift_cache) - work
 
     @property
     def real_time_factor(self) -> float:

@@ -62,6 +62,27 @@ _GROWTH_ANY = 1e10
 _FLOOR_SIZE = 1e-8
 
 
+def relative_potential_energy(problem, x, load, cache: dict | None = None):
+    """The potential energy at ``x`` measured from the reference positions ``x0`` of ``problem``:
+    ``E(x, load) - E(x0, load) + E(x0, 0)``, the internal energy minus the work of the loads on the
+    displacement ``x - x0`` (for a constant load ``f``: ``E_int(x) - load f.(x - x0)``), so that it
+    does not change when the whole mesh is moved.  None for a model with a non-conservative term.
+    ``cache`` (a dict) keeps ``E(x0, load) - E(x0, 0)`` per load factor."""
+    e = protocol._energy_or_none(problem, x, load)
+    if e is None:
+        return None
+    x0 = getattr(problem, "x0", None)
+    if not isinstance(x0, np.ndarray) or x0.size != np.size(x):  # no reference positions: E as it is
+        return e
+    key = float(load)
+    shift = None if cache is None else cache.get(key)
+    if shift is None:
+        shift = protocol._energy_or_none(problem, x0, load) - protocol._energy_or_none(problem, x0, 0.0)
+        if cache is not None:
+            cache[key] = shift
+    return float(e - shift)
+
+
 def _growth_threshold(ratio):
     """G of the detector for ``dt = ratio x`` the stability limit (see the comment above)."""
     if not ratio < 1.0:
@@ -155,6 +176,7 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
     n_steps = int(np.ceil(t_end / dt - 1e-9)) if t_end > 0 else 0
     stepper.stats["n_steps"] = n_steps
     ts, xs, vs, kes, pes = [], [], [], [], []
+    shift_cache: dict = {}
 
     def save(step, t):
         ts.append(t)
@@ -162,7 +184,7 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
         vs.append(stepper.v.copy())
         kes.append(stepper.kinetic_energy())
         if stepper.conservative:
-            pes.append(protocol._energy_or_none(problem, stepper.x, load))
+            pes.append(relative_potential_energy(problem, stepper.x, load, shift_cache))
         if progress is not None:
             progress({"step": step, "t": t, "n_steps": n_steps})
 
