@@ -241,8 +241,10 @@ def test_the_entities_groups_in_every_gmsh_4_encoding(tmp_path):
     assert entity_groups(_overlapping(tmp_path / "o2.msh", 2.2)) is None
 
 
-@pytest.mark.parametrize("version, binary", [(4.1, False), (4.1, True)])
+@pytest.mark.parametrize("version, binary", [(4.1, False), (4.1, True), (2.2, False)])
 def test_groups_that_share_elements_are_all_kept(tmp_path, version, binary):
+    """gmsh 4 lists the groups of each entity; gmsh 2 writes an element once for each of its groups
+    (the tetrahedra of "stiff" twice): both read as one cell in every group."""
     mesh = M.read(_overlapping(tmp_path / "overlap.msh", version, binary))
     assert set(mesh.cell_groups) == {"body", "stiff"}
     assert set(mesh.facet_groups) == {"tip", "stiff", "base"} and set(mesh.node_groups) == {"edge", "rim", "corner",
@@ -290,11 +292,37 @@ def test_a_gmsh_2_file_keeps_shared_facets_curves_and_points(tmp_path):
     assert len(mesh.node_groups["corner"]) == 1
 
 
-def test_a_gmsh_2_file_with_shared_cells_is_refused(tmp_path):
-    """gmsh 2 writes an element once per group: the shared tetrahedra are refused as duplicates."""
-    with pytest.raises(ValueError, match="have the same nodes .*gmsh 2 file repeats an element for every physical "
-                                         "group"):
-        M.read(_overlapping(tmp_path / "overlap.msh", 2.2))
+def test_a_gmsh_2_file_keeps_the_volumes_of_shared_cells_as_one_mesh(tmp_path):
+    """The gmsh 2 file of two volume groups sharing tetrahedra reads as the gmsh 4 file does: the
+    same cells once each, the same groups."""
+    two = M.read(_overlapping(tmp_path / "o2.msh", 2.2))
+    four = M.read(_overlapping(tmp_path / "o4.msh", 4.1))
+    text = (tmp_path / "o2.msh").read_text()
+    n_file = int(text.split("$Elements\n", 1)[1].split("\n", 1)[0])
+    assert two.n_cells == four.n_cells and n_file > two.n_cells  # the file repeats the "stiff" tetrahedra
+    np.testing.assert_array_equal(two.points, four.points)
+    np.testing.assert_array_equal(two.cells, four.cells)
+    for name in ("body", "stiff"):
+        np.testing.assert_array_equal(two.cell_groups[name], four.cell_groups[name])
+
+
+def test_a_gmsh_2_file_with_a_cell_repeated_in_another_node_order_is_refused(tmp_path):
+    """Copies of an element are one cell only when they are the same element: a repeated
+    tetrahedron with two nodes swapped (an inverted copy) is refused naming both cells."""
+    path = _overlapping(tmp_path / "overlap.msh", 2.2)
+    head, rest = path.read_text().split("$Elements\n", 1)
+    lines = rest.split("\n")
+    n = int(lines[0])
+    rows = [line.split() for line in lines[1:n + 1]]
+    tets = [r for r in rows if r[1] == "4"]
+    tail = tets[-1]  # the last copy of a shared tetrahedron (its group "stiff" comes after "body")
+    assert sum(r[-4:] == tail[-4:] for r in tets) == 2
+    tail[-4:] = [tail[-3], tail[-4], tail[-2], tail[-1]]
+    lines[1:n + 1] = [" ".join(r) for r in rows]
+    path.write_text(head + "$Elements\n" + "\n".join(lines))
+    with pytest.raises(ValueError, match=r"overlap.msh: tetra cells \d+ and \d+ have the same nodes \(1 duplicate "
+                                         r"cell\(s\)\); allowed: each cell once \(copies of one gmsh 2 element"):
+        M.read(path)
 
 
 @pytest.mark.parametrize("version", [4.1, 2.2])

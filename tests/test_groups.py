@@ -208,11 +208,16 @@ def test_node_set_on_a_node_no_cell_uses_is_dropped_with_a_warning(meshes, tmp_p
     assert set(read.node_groups) == {"base"}
 
 
-def test_gmsh2_file_repeating_elements_is_refused(tmp_path):
-    """Format 2 writes an element once per physical group: the volumes in "block" too."""
-    path = _two_boxes(tmp_path / "two_v2.msh", version=2.2)
-    with pytest.raises(ValueError, match=r"two_v2\.msh: tetra cells \d+ and \d+ have the same nodes \(\d+ duplicate"):
-        M.read(path)
+def test_gmsh2_file_repeating_elements_reads_as_gmsh_4(tmp_path):
+    """Format 2 writes an element once per physical group (the volumes in "block" too): each is one
+    cell, in all its groups, as in format 4."""
+    two = M.read(_two_boxes(tmp_path / "two_v2.msh", version=2.2))
+    four = M.read(_two_boxes(tmp_path / "two_v4.msh", version=4.1))
+    assert two.n_cells == four.n_cells and set(two.cell_groups) == {"soft", "stiff", "block"}
+    np.testing.assert_array_equal(two.cells, four.cells)
+    for name in ("soft", "stiff", "block"):
+        np.testing.assert_array_equal(two.cell_groups[name], four.cell_groups[name])
+    np.testing.assert_array_equal(two.cell_groups["block"], np.arange(two.n_cells))
 
 
 def test_gmsh_file_with_elements_outside_every_group_is_one_line(tmp_path):

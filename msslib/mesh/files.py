@@ -127,7 +127,8 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
     dropped.  ``cell_data[material_key]`` (one integer per cell), when present, becomes
     ``material``; otherwise every cell has material 0, also when the file has groups (the scenes
     assign materials by group, :func:`materials_from_groups`).  Two cells on the same nodes are
-    an error (a gmsh 2 file repeats an element for every physical group it belongs to).
+    an error, except the copies a gmsh 2 file writes of an element for each of its physical groups
+    (same nodes in the same order, same material): they are one cell in all those groups.
 
     Groups (:class:`Mesh`): the gmsh physical groups (named by the file's ``$PhysicalNames`` with
     their dimension, since meshio's ``field_data`` ``{name: [tag, dim]}`` keeps one group of each
@@ -242,10 +243,17 @@ def _mesh_from_meshio(path: Path, m, material_key: str):
             raise ValueError(f"{path}: cell data {material_key!r} of cell {int(bad[0])} is {values[bad[0]].item()!r}; "
                              f"allowed: integer material indices")
         material = np.rint(values).astype(np.int64)
-    _check_duplicate_cells(path, cells, cell_type)
+    names_in_file, entities = physical_names(path), entity_groups(path)
+    # a gmsh 2 file (no $Entities) writes an element once for each physical group it is in
+    gmsh2 = names_in_file is not None and entities is None and "gmsh:physical" in (m.cell_data or {})
+    repeats = _check_duplicate_cells(path, cells, cell_type, material if gmsh2 else False)
     used = np.unique(cells)  # file numbers of the nodes the cells use, ascending
-    groups, notes = _file_groups(m, cell_type, blocks, used, physical_names(path), entity_groups(path),
-                                 source=str(path))
+    groups, notes = _file_groups(m, cell_type, blocks, used, names_in_file, entities, source=str(path))
+    if repeats is not None:  # one cell for each repeated element, in every group of its copies
+        kept, new_index = repeats
+        cells = cells[kept]
+        material = None if material is None else material[kept]
+        groups["cell_groups"] = {name: np.unique(new_index[idx]) for name, idx in groups["cell_groups"].items()}
     points = points[used]
     cells = np.searchsorted(used, cells)
     bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
@@ -298,20 +306,36 @@ def _one_cell_type(path: Path, blocks) -> str:
                      f"elements carry groups)")
 
 
-def _check_duplicate_cells(path: Path, cells: np.ndarray, cell_type: str) -> None:
-    """Two cells on the same nodes (in any order) are a ValueError naming both."""
+def _check_duplicate_cells(path: Path, cells: np.ndarray, cell_type: str, repeats=False):
+    """Two cells on the same nodes (in any order) are a ValueError naming both, except, with
+    ``repeats`` not False (a gmsh 2 file, which writes an element once for each of its physical
+    groups; ``repeats`` is then its materials or None), copies with the same nodes in the same order
+    and the same material: then ``(kept, new_index)``, the first copy of each cell (ascending) and
+    the index among those of every cell, for the groups of the copies to become the groups of the
+    one cell.  None when no cell is repeated."""
     if len(cells) < 2:
-        return
+        return None
     keys = np.sort(cells, axis=1)
     _, first, inverse, counts = np.unique(keys, axis=0, return_index=True, return_inverse=True, return_counts=True)
     inverse = inverse.ravel()
     dup = np.flatnonzero(counts[inverse] > 1)
     dup = dup[dup != first[inverse[dup]]]
     if len(dup):
+        original = first[inverse]  # the first copy of every cell
+        if repeats is not False:
+            same = (cells[dup] == cells[original[dup]]).all(axis=1)
+            if repeats is not None:
+                same &= repeats[dup] == repeats[original[dup]]
+            if same.all():
+                kept = np.flatnonzero(original == np.arange(len(cells)))
+                return kept, np.searchsorted(kept, original)
+            dup = dup[~same]
         c = int(dup[0])
+        hint = ("copies of one gmsh 2 element in several physical groups, nodes in the same order and of one "
+                "material, are one cell" if repeats is not False else
+                "a gmsh 2 file repeats an element for every physical group it belongs to: it is read as one cell")
         raise ValueError(f"{path}: {cell_type} cells {int(first[inverse[c]])} and {c} have the same nodes ({len(dup)} "
-                         f"duplicate cell(s)); allowed: each cell once (a gmsh 2 file repeats an element for every "
-                         f"physical group it belongs to: save it in gmsh format 4 or put each element in one group)")
+                         f"duplicate cell(s)); allowed: each cell once ({hint})")
 
 
 #: topological dimension of meshio cell types that may carry groups (others are looked up in meshio)
