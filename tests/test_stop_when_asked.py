@@ -69,3 +69,22 @@ def test_signal_stops_a_long_factorisation_within_5_s(tmp_path, sig, code, said)
     assert rc == code, (rc, err)
     assert said in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]  # no output, no temporary file
+
+
+def test_a_command_that_ends_leaves_no_watching_thread_and_no_error(tmp_path):
+    """The watching thread ends with the command (it reads the end of its pipe), without an error."""
+    import threading
+
+    from msslib.cli import main
+
+    errors, previous = [], threading.excepthook
+    threading.excepthook = lambda args: errors.append(args.exc_value)
+    try:
+        assert main(["validate", str(tmp_path / "missing.yaml")]) == 1
+        for t in threading.enumerate():
+            if t.name == "msslib-stop":
+                t.join(5)
+    finally:
+        threading.excepthook = previous
+    assert not [t for t in threading.enumerate() if t.name == "msslib-stop"]
+    assert errors == []

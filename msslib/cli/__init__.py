@@ -586,15 +586,15 @@ class _StopWhenAsked:
             return
         finally:
             os.close(fd)
-            abandon_staged()
-            term = int(signal.SIGTERM) in signums
-            try:
-                sys.stderr.write("msslib: terminated\n" if term else "msslib: interrupted\n")
-                sys.stderr.flush()
-                sys.stdout.flush()
-            except Exception:
-                pass
-            os._exit(143 if term else 130)
+        abandon_staged()
+        term = int(signal.SIGTERM) in signums
+        try:
+            sys.stderr.write("msslib: terminated\n" if term else "msslib: interrupted\n")
+            sys.stderr.flush()
+            sys.stdout.flush()
+        except Exception:
+            pass
+        os._exit(143 if term else 130)
 
     def __exit__(self, *exc):
         import signal
