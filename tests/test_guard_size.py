@@ -157,3 +157,59 @@ def test_file_mesh_checked_after_reading(tmp_path):
 def test_runs_that_cannot_end_are_refused(solver, message):
     with pytest.raises(ValueError, match=message):
         load_scene(_scene(solver=solver, output={"history": False}))
+
+
+def _refine_must_not_run(monkeypatch):
+    import msslib.mesh.refine
+
+    def refused(*args, **kwargs):
+        raise AssertionError("the mesh was refined before its size was checked")
+
+    monkeypatch.setattr(msslib.mesh.refine, "uniform", refused)
+
+
+def test_refined_mesh_size_counts_the_children():
+    """Cells exactly (2^dim children each), nodes exactly for a grid of cubes."""
+    from msslib.mesh.refine import uniform
+
+    m = mesh.hex_grid(1.0, 0.5, 0.5, 4, 2, 2)
+    fine = uniform(m, 2)
+    nodes, cells = resources.refined_mesh_size(m.n_nodes, m.n_cells, 3, 2)
+    assert cells == fine.n_cells == 16 * 64
+    assert fine.n_nodes == 17 * 9 * 9 and nodes >= fine.n_nodes  # about, never below
+
+
+def test_refined_mesh_file_over_the_limit_refused_before_refining(tmp_path, monkeypatch):
+    """``refine:`` on a mesh file: the refined size is estimated from the file before refining."""
+    from msslib.scene import prepare
+
+    mesh.write_vtu(tmp_path / "m.vtu", mesh.hex_grid(1.0, 0.1, 0.1, 4, 1, 1))
+    d = _scene(checks={"max_memory_gb": 1.0})
+    d["geometry"] = {"file": "m.vtu", "refine": 6}
+    scene = load_scene(d, base_dir=tmp_path)
+    _refine_must_not_run(monkeypatch)
+    # 20 nodes x 8^6 = 5.24e+06 nodes x 32 kB (MSS, 3D) + 0.7 GB = 168 GB
+    with pytest.raises(ResourceError, match=r"scene\.geometry\.file \(m\.vtu\) refined 6 times \(refine: 6\): "
+                                            r"5\.24e\+06 nodes would need about 168 GB, over the limit of 1 GB"):
+        prepare(scene)
+
+
+def test_plan_refuses_levels_of_a_mesh_file_over_the_limit_in_one_line(tmp_path, capsys, monkeypatch):
+    import yaml
+
+    mesh.write_vtu(tmp_path / "m.vtu", mesh.tet_grid(1.0, 0.2, 0.2, 5, 1, 1))
+    d = _scene()
+    d["geometry"] = {"file": "m.vtu"}
+    d["model"] = "fem_linear"
+    d["loads"] = [{"type": "gravity", "g": [0.0, 0.0, -9.81]}]
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(d))
+    _refine_must_not_run(monkeypatch)
+    code = main(["plan", str(tmp_path / "s.yaml"), "--max-error", "0.2", "--levels", "1,9", "--repeats", "1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1, err
+    assert len(err) == 1, err
+    # 24 nodes, 30 cells refined 8 times: 24 x 8^8 = 4.03e+08 nodes, 30 x 8^8 = 5.03e+08 cells
+    assert err[0].startswith("msslib: error: --levels 9: the mesh file m.vtu (24 nodes, 30 cells) refined 8 times, "
+                             "about 4.03e+08 nodes and 5.03e+08 cells for the fem_neohookean reference would need "
+                             "about 4.03e+04 GB"), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.vtu", "s.yaml"]

@@ -176,9 +176,38 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
 
 
 def check_scene_levels(raw, base_dir, levels, models, ref_model):
-    """Every (level, model) scene loads (:func:`msslib.scene.load_scene`: its keys and values)."""
+    """Every (level, model) scene loads (:func:`msslib.scene.load_scene`: its keys and values),
+    and the finest level fits in memory, a mesh file's too (its size read from the file, the
+    refinement estimated before anything is refined): :class:`msslib.errors.ResourceError`
+    naming ``--levels``, the level and the size in GB otherwise."""
+    from msslib.errors import ResourceError
     from msslib.scene import load_scene
 
-    for level in levels:
+    for level in sorted(levels):
         for model in dict.fromkeys([*models, ref_model]):
-            load_scene(copy.deepcopy(at_level(raw, level, model)), base_dir=base_dir)
+            try:
+                scene = load_scene(copy.deepcopy(at_level(raw, level, model)), base_dir=base_dir)
+            except ResourceError as exc:
+                raise ResourceError(f"--levels {level}: {exc}") from None
+    if "file" in scene.geometry:
+        _check_file_levels(scene, max(levels), ref_model)
+
+
+def _check_file_levels(scene, level, ref_model):
+    """Refuse a level whose refinement of the scene's mesh file would not fit in memory."""
+    from msslib import mesh as _mesh
+    from msslib import models as registry
+    from msslib.scene import resources
+
+    geo = scene.geometry
+    refine = int(geo.get("refine", 0) or 0)
+    if not refine:
+        return
+    m = _mesh.read(geo["file"], coincident_nodes=scene.checks.get("coincident_nodes", "merge"))
+    n_nodes, n_cells = resources.refined_mesh_size(m.n_nodes, m.n_cells, m.dim, refine)
+    fem = registry.get(ref_model).kind == "fem"
+    estimate = resources.run_memory(n_nodes, m.dim, fem=fem)
+    what = (f"--levels {level}: the mesh file {geo['file'].name} ({m.n_nodes} nodes, {m.n_cells} cells) refined "
+            f"{refine} times, about {n_nodes:.3g} nodes and {n_cells:.3g} cells for the {ref_model} reference")
+    resources.check_memory(estimate, what, "use lower --levels (or set checks.max_memory_gb)",
+                           scene.checks["max_memory_gb"])

@@ -24,7 +24,8 @@ import os
 
 from msslib.errors import ResourceError
 
-__all__ = ["available_memory", "generated_mesh_size", "run_memory", "check_memory", "history_memory"]
+__all__ = ["available_memory", "generated_mesh_size", "refined_mesh_size", "run_memory", "check_memory",
+           "history_memory"]
 
 #: resident memory of a process that has imported msslib, numpy, scipy, numba and scikit-fem and
 #: compiled its kernels (B): compiling with a cold numba cache adds about 170 MB to a warm run, and
@@ -105,6 +106,17 @@ def generated_mesh_size(generator: str, args: dict) -> tuple[float, float, int]:
         return 0.3 * n + 50, 1.1 * n + 50, 3
     except (KeyError, TypeError, ValueError, ZeroDivisionError, OverflowError):
         return nan, nan, 3
+
+
+def refined_mesh_size(n_nodes: float, n_cells: float, dim: int, times: int) -> tuple[float, float]:
+    """``(nodes, cells)`` of a mesh of ``n_nodes`` nodes and ``n_cells`` cells after ``times``
+    uniform refinements (:func:`msslib.mesh.refine.uniform`), known before refining: the cells
+    exactly (each has ``2**dim`` children), the nodes about (each refinement multiplies them by
+    about ``2**dim``: exact for a fine grid of squares or cubes, an upper bound for simplices,
+    whose new nodes are their edges' midpoints)."""
+    times = int(times)
+    factor = float(2 ** dim) ** times
+    return float(n_nodes) * factor, float(n_cells) * factor
 
 
 def history_memory(n_saved: float, n_dof: float) -> float:

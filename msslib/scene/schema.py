@@ -429,7 +429,9 @@ def _check_size(root, geometry, model, solver, output, checks, n_nodes=None, dim
         n_nodes, _n_cells, dim = resources.generated_mesh_size(geometry["generator"], geometry["args"])
         if not math.isfinite(n_nodes):
             return
-        n_nodes *= (2**dim) ** geometry.get("refine", 0)  # about: a refinement multiplies the nodes by 2^dim
+    refine = int(geometry.get("refine", 0) or 0)
+    if refine:  # estimated before refining (a mesh file's too): about 2^dim times the nodes per refinement
+        n_nodes, _ = resources.refined_mesh_size(n_nodes, 0, dim, refine)
     n_saved = _saved_states(solver, output)
     estimate = resources.run_memory(n_nodes, dim, fem=model in _models.names("fem"), n_saved=n_saved)
     history = resources.history_memory(n_saved, n_nodes * dim)
@@ -445,8 +447,10 @@ def _check_size(root, geometry, model, solver, output, checks, n_nodes=None, dim
             what += " (the in-memory mesh)"
         else:
             what += f".file ({geometry['file'].name})"
+        if refine:
+            what += f" refined {refine} times (refine: {refine})"
         what += f": {n_nodes:.3g} nodes"
-        hint = "use fewer elements"
+        hint = "use a smaller refine or fewer elements" if refine else "use fewer elements"
     resources.check_memory(estimate, what, hint + " (or set checks.max_memory_gb)", checks["max_memory_gb"])
 
 
