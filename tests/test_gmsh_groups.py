@@ -265,11 +265,12 @@ def test_groups_that_share_elements_are_all_kept(tmp_path, version, binary):
         np.testing.assert_allclose(mesh.points[mesh.node_groups[name]], [[LX, LY, LZ]], atol=1e-12)
 
 
-def test_a_traction_on_a_surface_that_shares_its_triangles_loads_that_surface(tmp_path):
+@pytest.mark.parametrize("version", [4.1, 2.2])
+def test_a_traction_on_a_surface_that_shares_its_triangles_loads_that_surface(tmp_path, version):
     """The reaction at the clamped base balances 40 Pa on the 1 m^2 of the surface "stiff" (40 N),
     not on the 5 m^2 outline of the volume "stiff" (meshio's single tag keeps the triangles in
     "tip" alone, and the selection then took the volume's faces)."""
-    _overlapping(tmp_path / "overlap.msh")
+    _overlapping(tmp_path / "overlap.msh", version)
     data = {"geometry": {"file": "overlap.msh"}, "materials": {"body": MAT}, "model": "fem_linear",
             "boundary": [{"select": {"group": "base"}, "fix": "all"}],
             "loads": [{"type": "traction", "select": {"group": "stiff"}, "traction": STIFF_T.tolist()}]}
