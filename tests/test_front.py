@@ -170,3 +170,54 @@ def test_crossover_is_the_most_accurate_mss_point_when_fem_wins_below_it():
     assert (c["crossover_error"], c["mss_window_upper"], c["crossover_kind"]) == (0.1, 0.3, "mss window")
     f = _front({"mss": [(0.01, 0.2), (1.0, 0.01)], "fem_x": [(0.1, 0.1)]})
     assert front.crossover(f)["crossover_kind"] == "interleaved"
+
+
+def _ranged(points, spans, runs=7):
+    """``_front`` with the time ranges ``spans`` ({model: [(min, max), ...]}) and ``runs`` runs each."""
+    f = _front(points)
+    lo, hi = np.full(f.wall_time.shape, np.nan), np.full(f.wall_time.shape, np.nan)
+    for i, m in enumerate(f.model.values):
+        for j, (a, b) in enumerate(spans[str(m)]):
+            lo[i, j], hi[i, j] = a, b
+    f["time_min"], f["time_max"] = (("model", "level"), lo), (("model", "level"), hi)
+    f["time_median"] = f.wall_time
+    f["runs"] = (("model", "level"), np.full(lo.shape, runs))
+    return f
+
+
+def test_crossover_resolved_only_where_the_time_ranges_do_not_overlap():
+    pts = {"mss": [(0.01, 0.20), (0.05, 0.10)], "fem_x": [(0.08, 0.05), (2.0, 0.01)]}
+    # the MSS point at 0.05 s (0.04-0.06) and the FEM point at 0.08 s (0.07-0.09): apart
+    apart = _ranged(pts, {"mss": [(0.009, 0.011), (0.04, 0.06)], "fem_x": [(0.07, 0.09), (1.9, 2.1)]})
+    c = front.crossover(apart)
+    assert (c["crossover_error"], c["crossover_kind"], c["crossover_resolved"]) == (0.10, "single crossover", 1)
+    # the same medians, the ranges overlapping (0.04-0.075 and 0.07-0.09): unresolved
+    overlap = _ranged(pts, {"mss": [(0.009, 0.011), (0.04, 0.075)], "fem_x": [(0.07, 0.09), (1.9, 2.1)]})
+    assert front.crossover(overlap)["crossover_resolved"] == 0
+    # ranges apart but each from one run: unresolved; no ranges at all (an older front): unresolved
+    assert front.crossover(_ranged(pts, {"mss": [(0.01, 0.01), (0.05, 0.05)], "fem_x": [(0.08, 0.08), (2.0, 2.0)]},
+                                   runs=1))["crossover_resolved"] == 0
+    assert front.crossover(_front(pts))["crossover_resolved"] == 0
+    # no change of family along the front: nothing to resolve
+    assert front.crossover(_front({"mss": [(1.0, 0.2)], "fem_x": [(0.1, 0.1)]}))["crossover_resolved"] == 1
+
+
+def test_plan_says_when_its_choice_ties_within_the_timing_spread():
+    from msslib.planning import report
+    from msslib.planning.front import ties
+
+    pts = {"baudet_cube": [(0.009, 0.10), (0.05, 0.05)], "fem_linear": [(0.010, 0.08), (0.06, 0.02)]}
+    f = _ranged(pts, {"baudet_cube": [(0.0087, 0.0112), (0.045, 0.055)],
+                      "fem_linear": [(0.0089, 0.0110), (0.058, 0.062)]})
+    f.attrs.update(reference_error=math.nan)
+    lines = report(f, 0.2)
+    assert lines[-2].startswith("choice: baudet_cube at resolution level 0")
+    assert lines[-1] == ("tie: within the timing spread (0.0087-0.0112 s over 7 runs) of fem_linear level 0 "
+                         "(0.0089-0.011 s); another run may choose any of them")
+    # a budget that only the finer points meet: fem_linear level 1 (0.058-0.062 s) is apart from the choice
+    assert ties(f, ("baudet_cube", 1), 0.05) == []
+    assert not report(f, 0.05)[-1].startswith("tie")
+    # apart ranges: no tie line
+    g = _ranged(pts, {"baudet_cube": [(0.0087, 0.0095), (0.045, 0.055)], "fem_linear": [(0.0096, 0.011), (0.058, 0.062)]})
+    g.attrs.update(reference_error=math.nan)
+    assert report(g, 0.2)[-1].startswith("choice: baudet_cube")

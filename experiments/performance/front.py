@@ -12,11 +12,13 @@ with the observed order). Every variant is compared with it at its own nodes: no
 
 Variants: each MSS model of the cell type solved non-linearly (load-stepped Newton) and
 linearly (one solve with its Hessian at rest, ``solver.linear``), linear FEM and the non-linear
-FEM law, all on the same solvers (:mod:`msslib.solvers`). Timing: the CPU time of the
+FEM law. Timing: the CPU time of the
 single-threaded run (mesh, model set-up and solve; its wall time on an idle machine, and unlike
 the wall time not inflated by other load on a shared machine), after a warm-up run of the variant
-on the coarsest level, best of ``repeats`` runs (one run when a run takes longer than ``LONG``
-seconds); the best wall time is kept too (``elapsed``). A run still going after ``BUDGET``
+on the coarsest level, best of ``REPEATS`` runs (one run when a run takes longer than ``LONG``
+seconds), with the median and range of the runs (``time_median``, ``time_min``, ``time_max``);
+the best wall time is kept too (``elapsed``). A crossover is resolved (``crossover_resolved``)
+only where the points on either side of it have time ranges that do not overlap. A run still going after ``BUDGET``
 seconds of CPU time is stopped and recorded as such in ``status``.
 """
 
@@ -35,6 +37,7 @@ from experiments import script
 
 HERE = Path(__file__).resolve().parent
 LONG = 2.0  # s: runs longer than this are timed once
+REPEATS = 7  # timed runs of every (variant, level) shorter than LONG
 BUDGET = 75.0  # s of CPU time after which a run is stopped (and recorded as such)
 
 LAW = {"triangle": "fem_svk", "quad": "fem_svk", "tetra": "fem_neohookean", "hexahedron": "fem_neohookean"}
@@ -141,14 +144,32 @@ def crossover(front):
         kind = ("single crossover" if contiguous and fem_below and first == 0 else
                 "mss window" if contiguous and fem_below else "mss most accurate" if contiguous else "interleaved")
     return {"crossover_error": cross, "mss_window_upper": upper, "crossover_kind": kind,
-            "winners": "; ".join(intervals)}
+            "winners": "; ".join(intervals), "crossover_resolved": _resolved(front, pts, families)}
+
+
+def _resolved(front, pts, families):
+    """1 when at every change of family along the front (an MSS point next to an FEM point) the
+    two points' time ranges (``time_min`` to ``time_max`` of their timed runs) do not overlap, each
+    measured more than once: the timing tells them apart.  0 otherwise ("unresolved"), and where
+    the front carries no ranges; 1 with no change of family (nothing to resolve)."""
+    changes = [k for k in range(1, len(pts)) if families[k] != families[k - 1]]
+    if not changes:
+        return 1
+    if "time_min" not in front or "time_max" not in front:
+        return 0
+    for k in changes:
+        (m0, l0, *_), (m1, l1, *_) = pts[k - 1], pts[k]  # pts[k - 1] the faster
+        a, b = front.sel(model=m0, level=l0), front.sel(model=m1, level=l1)
+        if int(a.runs) < 2 or int(b.runs) < 2 or not float(a.time_max) < float(b.time_min):
+            return 0
+    return 1
 
 
 def main(scene: str, levels, quick_levels=(0, 1), below=1):
     from msslib.results import write_result
 
     a = script.args(f"speed against error for {scene}")
-    front = measure(HERE / "scenes" / scene, quick_levels if a.quick else levels, repeats=1 if a.quick else 3,
+    front = measure(HERE / "scenes" / scene, quick_levels if a.quick else levels, repeats=1 if a.quick else REPEATS,
                     progress=lambda s: print(s, flush=True), below=below)
     front.attrs["scene_file"] = f"experiments/performance/scenes/{scene}"
     front.attrs["threads"] = os.environ.get("OMP_NUM_THREADS", "default")

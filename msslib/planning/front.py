@@ -16,8 +16,9 @@ Timing (``cpu=False``, the default of ``plan``): the median wall time of ``repea
 seconds; ``cpu=True`` (the paper): the best CPU time of up to ``repeats`` runs after a warm-up run
 on the coarsest level, stopped after ``budget`` seconds of CPU time (single-threaded, it is the
 wall time on an idle machine and not inflated by other load).  Runs longer than ``long_run``
-seconds are timed once.  FEM and MSS runs use the same linear solvers and Newton iteration
-(:mod:`msslib.solvers`), so the times compare the methods.
+seconds are timed once.  The dataset keeps the median, smallest and largest time of the timed
+runs (``time_median``, ``time_min``, ``time_max``): two points whose ranges overlap are not told
+apart by the timing (:func:`ties`; ``plan`` says so when its choice ties with other candidates).
 """
 
 from __future__ import annotations
@@ -58,9 +59,10 @@ def variants(models, linear_variants=False):
     return out
 
 
-def _timed(raw, base_dir, repeats, budget, cpu, long_run):
+def _timed(raw, base_dir, repeats, budget, cpu, long_run, spread=None):
     """``(time, best wall time, runs, dataset)``: the median wall time of ``repeats`` runs, or
-    (``cpu``) the best CPU time; a run longer than ``long_run`` s ends the repeats."""
+    (``cpu``) the best CPU time; a run longer than ``long_run`` s ends the repeats.  ``spread``
+    (a list) receives ``(median, min, max)`` of the times measured."""
     from msslib.planning import run_with_budget
     from msslib.scene import load_scene
 
@@ -77,6 +79,8 @@ def _timed(raw, base_dir, repeats, budget, cpu, long_run):
         if long_run is not None and times[-1] > long_run:
             break
     t = min(times) if cpu else float(np.median(times))
+    if spread is not None:
+        spread[:] = [float(np.median(times)), float(min(times)), float(max(times))]
     return t, min(walls), len(times), ds
 
 
@@ -128,6 +132,7 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
     shape = (len(names), len(levels))
     wall, elapsed = np.full(shape, np.nan), np.full(shape, np.nan)
     err_max, err_mean = np.full(shape, np.nan), np.full(shape, np.nan)
+    t_median, t_min, t_max = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
     dofs, runs = np.zeros(shape, dtype=np.int64), np.zeros(shape, dtype=np.int64)
     status = np.full(shape, "ok", dtype=object)
     for i, (name, model, linear) in enumerate(names):
@@ -138,7 +143,9 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
                 say(f"{name}: the warm-up run failed")
         for j, lv in enumerate(levels):
             try:
-                t, tw, n_runs, ds = _timed(at_level(raw, lv, model, linear), base_dir, repeats, budget, cpu, long_run)
+                spread = []
+                t, tw, n_runs, ds = _timed(at_level(raw, lv, model, linear), base_dir, repeats, budget, cpu, long_run,
+                                           spread)
             except (Exception, RunTimeout) as exc:  # noqa: BLE001 - a model that fails on a scene is a result too
                 status[i, j] = f"{type(exc).__name__}: {' '.join(str(exc).split())[:200]}"
                 say(f"{name} level {lv}: failed ({status[i, j]})")
@@ -148,11 +155,13 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
             e = displacement_error(u, at_points(ref["result"], X), relative_to=scale)
             wall[i, j], elapsed[i, j], err_max[i, j], err_mean[i, j] = t, tw, e.rel_max, e.rel_mean
             dofs[i, j], runs[i, j] = u.size, n_runs
+            t_median[i, j], t_min[i, j], t_max[i, j] = spread
             if int(ds.attrs.get("inverted_cells", 0)):
                 status[i, j] = f"ok, {int(ds.attrs['inverted_cells'])} inverted cells"
             say(f"{name} level {lv}: {u.size} dofs, {t:.3g} s, max error {100 * e.rel_max:.3g} %")
     what = (f"best CPU time of up to {repeats} runs (set-up and solve)" if cpu
             else f"median wall time of {repeats} runs (set-up and solve)")
+    kind = "CPU time" if cpu else "wall time"
     nan_or = (lambda v: float(v) if v is not None else math.nan)
     return xr.Dataset(
         {
@@ -160,6 +169,9 @@ def measure_front(scene, *, levels=(1, 2, 3), models=None, repeats=3, budget=30.
             "elapsed": (("model", "level"), elapsed, {"units": "s", "long_name": "best wall time"}),
             "error_max": (("model", "level"), err_max, {"units": "1", "long_name": "max node error / max reference displacement"}),
             "error_mean": (("model", "level"), err_mean, {"units": "1", "long_name": "mean node error / max reference displacement"}),
+            "time_median": (("model", "level"), t_median, {"units": "s", "long_name": f"median {kind} of the timed runs"}),
+            "time_min": (("model", "level"), t_min, {"units": "s", "long_name": f"smallest {kind} of the timed runs"}),
+            "time_max": (("model", "level"), t_max, {"units": "s", "long_name": f"largest {kind} of the timed runs"}),
             "n_dofs": (("model", "level"), dofs, {"units": "1", "long_name": "degrees of freedom"}),
             "runs": (("model", "level"), runs, {"units": "1", "long_name": "timed runs"}),
             "status": (("model", "level"), status.astype(str), {"units": "1", "long_name": "ok or the error raised"}),
@@ -211,3 +223,30 @@ def _check_file_levels(scene, level, ref_model):
             f"{refine} times, about {n_nodes:.3g} nodes and {n_cells:.3g} cells for the {ref_model} reference")
     resources.check_memory(estimate, what, "use lower --levels (or set checks.max_memory_gb)",
                            scene.checks["max_memory_gb"])
+
+
+def ties(front, choice, max_error):
+    """The other points within ``max_error`` whose time range (``time_min`` to ``time_max`` of
+    their timed runs) overlaps the range of ``choice`` (``(model, level, ...)``): the timing does
+    not tell them from the choice.  ``[(model, level, time_min, time_max), ...]``, fastest first;
+    empty when the front carries no ranges (an older file) or the choice ran once only."""
+    if "time_min" not in front or "time_max" not in front:
+        return []
+
+    def span(m, lv):
+        r = front.sel(model=m, level=lv)
+        return float(r.time_min), float(r.time_max), int(r.runs)
+
+    lo, hi, n = span(choice[0], choice[1])
+    if not (np.isfinite(lo) and np.isfinite(hi)) or n < 2:
+        return []
+    out = []
+    for m in front.model.values:
+        for lv in front.level.values:
+            if (str(m), int(lv)) == (str(choice[0]), int(choice[1])):
+                continue
+            e = float(front.error_max.sel(model=m, level=lv))
+            a, b, _ = span(m, lv)
+            if np.isfinite(e) and e <= max_error and np.isfinite(a) and np.isfinite(b) and a <= hi and lo <= b:
+                out.append((str(m), int(lv), a, b))
+    return sorted(out, key=lambda x: x[2])
