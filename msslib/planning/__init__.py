@@ -403,6 +403,14 @@ def report(front, max_error: float) -> list[str]:
     timing = "best CPU time" if front.attrs.get("timing") == "cpu" else "median wall time"
     lines.append(f"choice: {m} at resolution level {lv}: max error {100 * e:.3g} % <= {100 * max_error:.3g} %"
                  f"{note}, {timing} {t:.3g} s")
+    from msslib.planning.front import ties
+
+    tied = ties(front, best, max_error)
+    if tied:
+        r = front.sel(model=m, level=lv)
+        lines.append(f"tie: within the timing spread ({float(r.time_min):.3g}-{float(r.time_max):.3g} s over "
+                     f"{int(r.runs)} runs) of " + ", ".join(f"{tm} level {tl} ({a:.3g}-{b:.3g} s)" for tm, tl, a, b in tied)
+                     + "; another run may choose any of them")
     return lines
 
 
