@@ -9,7 +9,8 @@ Placeholders (in ``paper/*.md.in`` and the files they include):
     the figure ``figures/NAME.png`` (made by the workflow) with its caption;
 ``{{value FILE VAR [DIM=LABEL ...] [scale=S] [fmt=F]}}``
     a number read from the NetCDF result ``FILE`` (relative to the project root): variable or
-    attribute ``VAR``, selected by labels, multiplied by ``S``, formatted with ``F`` (default .3g);
+    attribute ``VAR``, selected by labels, multiplied by ``S``, formatted with ``F`` (default .3g;
+    ``fmt=text``: a text attribute as it is, e.g. a status word the results computed);
 ``{{notebooks}}``
     links to the executed notebook page of every derivation module (from the derivation registry);
 ``{{expr EXPRESSION [| FMT]}}``
@@ -143,6 +144,8 @@ def _value(root: Path, spec: str) -> str:
                 val = float((ds[var].sel(sel) if sel else ds[var]).values)
             except KeyError:  # a label the reduced quick build does not run (e.g. fewer ratios)
                 val = None
+        elif var in ds.attrs and fmt == "text":  # a word the results computed (e.g. "resolved")
+            return str(ds.attrs[var])
         elif var in ds.attrs:
             val = float(ds.attrs[var])
         else:

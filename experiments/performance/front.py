@@ -144,7 +144,8 @@ def crossover(front):
         kind = ("single crossover" if contiguous and fem_below and first == 0 else
                 "mss window" if contiguous and fem_below else "mss most accurate" if contiguous else "interleaved")
     return {"crossover_error": cross, "mss_window_upper": upper, "crossover_kind": kind,
-            "winners": "; ".join(intervals), "crossover_resolved": _resolved(front, pts, families)}
+            "winners": "; ".join(intervals), "crossover_resolved": (resolved := _resolved(front, pts, families)),
+            "crossover_status": "resolved" if resolved else "unresolved"}
 
 
 def _resolved(front, pts, families):
