@@ -123,8 +123,13 @@ def load_experiment(path) -> Experiment:
     for key in ("scene", "models"):
         if key not in raw:
             _fail(f"experiment.{key}", "missing")
+    for key in ("paper", "cases", "quick", "published", "figures"):  # `or` below must not swallow [], 0 or ''
+        if (key in raw and raw[key] is not None and not raw[key]
+                and not isinstance(raw[key], str if key == "paper" else dict)):
+            _fail(f"experiment.{key}", f"{raw[key]!r}: expected " + ("a paper name" if key == "paper" else "a mapping")
+                  + " (leave the key out for none)")
     paper = raw.get("paper") or ""
-    if paper and paper not in PAPERS:
+    if paper and (not isinstance(paper, str) or paper not in PAPERS):
         _fail("experiment.paper", f"{paper!r} is not one of {PAPERS} (leave it out for an experiment of your own)")
     cases = raw.get("cases") or {"default": {}}
     models = raw["models"]
@@ -229,6 +234,9 @@ def _column(where, col, cases, models, reference):
         if col.get(key) is None:
             _fail(f"{where}.{key}", "missing" + (" (the experiment has no reference)" if key == "reference" else ""))
         _one_of(f"{where}.{key}", col[key], sorted(names), f"{what} of the experiment")
+    if col["variant"] == col["reference"]:
+        _fail(f"{where}.variant", f"{col['variant']!r} is the column's reference (its errors would all be 0); "
+                                  f"expected another model of {sorted(set(models) - {col['reference']})}")
     _text(f"{where}.title", col.get("title"), "the column's title")
     return {k: col[k] for k in COLUMN_KEYS}
 

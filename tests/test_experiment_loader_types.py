@@ -47,6 +47,11 @@ BAD_FIGURES = [
     ({"magnify": 0.0}, "experiment.figures.column.magnify", "0.0 is out of range"),
     ({"plane": ["xz"]}, "experiment.figures.column.plane", "expected a str"),
     ({"title": 5}, "experiment.figures.column.title", "expected a str, got 5"),
+    # a column drawn against itself would show zero error everywhere
+    ({"columns": [{"title": "a", "case": "pull", "variant": "fem"}]}, "experiment.figures.column.columns[0].variant",
+     "'fem' is the column's reference (its errors would all be 0); expected another model of ['mss']"),
+    ({"columns": [{"title": "a", "case": "pull", "variant": "mss", "reference": "mss"}]},
+     "experiment.figures.column.columns[0].variant", "'mss' is the column's reference"),
 ]
 
 BAD_TOP = [
@@ -63,6 +68,15 @@ BAD_TOP = [
      "expected [value, unit]"),
     ({"models": {"mss": {"model": "baudet_cube"}, 3: {"model": "fem_linear"}}, "reference": "mss"},
      "experiment.models", "name 3: a case or model name is a non-empty string"),
+    # an empty value of the wrong type is not "none": `cases: []` was read as one default case
+    ({"cases": []}, "experiment.cases", "[]: expected a mapping (leave the key out for none)"),
+    ({"figures": []}, "experiment.figures", "[]: expected a mapping"),
+    ({"figures": ""}, "experiment.figures", "'': expected a mapping"),
+    ({"cases": ""}, "experiment.cases", "'': expected a mapping"),
+    ({"quick": 0}, "experiment.quick", "0: expected a mapping"),
+    ({"published": False}, "experiment.published", "False: expected a mapping"),
+    ({"paper": []}, "experiment.paper", "[]: expected a paper name"),
+    ({"paper": 5}, "experiment.paper", "5 is not one of"),
 ]
 
 
