@@ -59,3 +59,16 @@ def test_a_step_over_the_limit_under_a_tool_is_still_stopped_within_a_few_steps(
     # stopped by the growth detector within a few steps (19 at 1.05 x the limit, 5 at 1.5 x), the
     # motion still within 10 x the tool's depth, not by the displacement bound of the last resort
     assert err.quantity == "growth" and err.step <= 25 and err.max_displacement < 2e-2
+
+
+@pytest.mark.parametrize("engine", ["network", "generic"])
+def test_a_constant_force_on_a_body_without_load_is_no_false_alarm(engine):
+    """The reference of the detector is taken with the forces the simulator applies (it was taken
+    before them: J ~ 0 at rest, and the first steps 'grew' 1e8-fold)."""
+    mesh = M.cylinder_mesh(0.02, 0.08, 0.01)
+    model = msslib.build_model("lloyd_tetrahedron", mesh, msslib.Material(1e4, 0.25, density=1000.0),
+                               fixed={"plane": ["z", 0.0]}, loads={"type": "gravity", "g": [0, 0, -9.81]}).model
+    sim = Simulator(model, dt=0.5 * explicit_stability_limit(model, model.x0), engine=engine, damping=0.0, load=0.0)
+    sim.apply_force([2], [0.0, 0.0, 0.0832])
+    sim.step(100)
+    assert np.all(np.isfinite(sim.x))

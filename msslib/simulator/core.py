@@ -187,6 +187,8 @@ class Simulator:
             stepper.evaluate()
         else:
             stepper.f = stepper.force(stepper.x) if stepper.explicit else None
+        if hasattr(stepper, "restart_detector"):
+            stepper.restart_detector()  # its reference from the force with this call's loads
 
     def _apply(self, t, x, st):
         """Loads at time ``t`` onto the stepper ``st`` (None: not built yet) and the driven

@@ -89,6 +89,9 @@ class NetworkStepper(Integrator):
     def full_force(self):
         return self.F
 
+    def _free_force(self):
+        return self.F[self.free]
+
     def step(self, h=None, t_new=None):
         self.steps(1, h, t_new)
 

@@ -312,6 +312,22 @@ class Integrator:
                 j = float(np.sum(self.f * self.f * self.inv_m))
                 self.j_min = j if np.isfinite(j) else None
 
+    def restart_detector(self):
+        """Set the detector's reference from the current force and velocity (after the caller set
+        ``extra`` or ``load`` and re-evaluated the force): from rest, ``J_0 = a.M a``."""
+        if not self.explicit:
+            return
+        self.j_min = None
+        self.flips = 0
+        if not np.any(np.asarray(self.v).reshape(-1)[self.free]):
+            f = self._free_force()
+            with np.errstate(all="ignore"):
+                j = float(np.sum(f * f * self.inv_m))
+            self.j_min = j if np.isfinite(j) else None
+
+    def _free_force(self):
+        return self.f
+
     def note_input(self, x_fixed_before, x_fixed_after, load_before, extra_before):
         """Add to ``a_in`` the amplitude ``sqrt(J)`` that one step's change of the inputs can put
         into the motion: a move ``du`` of the dofs that do not move freely (paths, prescribed
