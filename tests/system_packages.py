@@ -24,13 +24,22 @@ DPKG_LOCK_TIMEOUT = 600
 
 @contextlib.contextmanager
 def install_lock(path=None):
-    """Hold the installing tests' lock (exclusive; blocks until no other test process holds it)."""
-    with open(path or LOCK, "a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
+    """Hold the installing tests' lock (exclusive; blocks until no other test process holds it).  The
+    file is opened read-only when it exists (flock needs no more), so a lock file made by another user
+    in a sticky temporary folder (where O_CREAT on another's file is refused) still serves."""
+    path = os.fspath(path or LOCK)
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except FileNotFoundError:
+        fd = os.open(path, os.O_RDONLY | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
         try:
             yield
         finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
+            fcntl.flock(fd, fcntl.LOCK_UN)
+    finally:
+        os.close(fd)
 
 
 def apt_get(*args) -> list[str]:

@@ -10,6 +10,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import system_packages
 
 HERE = Path(__file__).resolve().parent
@@ -84,3 +86,50 @@ def test_installing_tests_go_through_the_lock():
                                                   for item in node.items)
                and "'up'" in ast.unparse(node)
                for node in ast.walk(ast.parse(slurm.read_text(encoding="utf-8"))))
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="needs root to run a process as another user")
+def test_another_users_lock_file_serves(tmp_path):
+    """The lock file made by root (0644): a test process of another user (nobody) takes the lock
+    instead of failing with PermissionError."""
+    import pwd
+    import shutil
+    import tempfile
+
+    folder = Path(tempfile.mkdtemp(prefix="msslib-lock-"))
+    try:
+        folder.chmod(0o755)
+        lock = folder / "apt.lock"
+        lock.write_text("")
+        lock.chmod(0o644)
+        nobody = pwd.getpwnam("nobody")
+        child = (f"import sys; sys.path.insert(0, {str(HERE)!r}); import system_packages\n"
+                 f"with system_packages.install_lock({str(lock)!r}): print('held')")
+        python = shutil.which("python3", path="/usr/bin:/bin")  # one that another user may run
+        if python is None:
+            pytest.skip("no system python3 in /usr/bin or /bin")
+        r = subprocess.run([python, "-c", child], capture_output=True, text=True, timeout=60, cwd="/",
+                           user=nobody.pw_uid, group=nobody.pw_gid, extra_groups=[],
+                           env={**os.environ, "HOME": "/", "PYTHONDONTWRITEBYTECODE": "1"})
+        assert r.returncode == 0 and r.stdout == "held\n", r.stderr[-500:]
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def test_a_lock_file_that_is_not_writable_still_locks(tmp_path):
+    """A lock file left read-only (made by another user) is opened read-only: flock still holds."""
+    import fcntl
+
+    lock = tmp_path / "apt.lock"
+    lock.write_text("")
+    lock.chmod(0o444)
+    with system_packages.install_lock(lock):
+        with open(lock) as other:  # a second open file description: flock excludes it
+            try:
+                fcntl.flock(other, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                taken = True
+            except BlockingIOError:
+                taken = False
+    assert not taken
+    with open(lock) as other:  # released afterwards
+        fcntl.flock(other, fcntl.LOCK_EX | fcntl.LOCK_NB)
