@@ -12,6 +12,7 @@
 #include "msslib_square.h"
 #include "msslib_rectangle.h"
 #include "msslib_tetrahedron.h"
+#include "msslib_kikuuwe_tetrahedron.h"
 #include "msslib_tetrahedron_lsq.h"
 #include "msslib_cube_baudet.h"
 #include "msslib_cube_golec.h"
