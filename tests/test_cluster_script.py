@@ -106,7 +106,8 @@ def test_down_signals_only_the_daemons_it_started(tmp_path):
         (bin_dir / name).symlink_to(sys.executable)
     sleep = "import time; time.sleep(120)"
     reused = _start([sys.executable, "-c", sleep])
-    other = _start([str(bin_dir / "slurmctld"), "-c", sleep, "-f", str(tmp_path / "elsewhere" / "slurm.conf")])
+    # another cluster's slurmctld, in a sub-folder of DIR: its command line names a path under DIR
+    other = _start([str(bin_dir / "slurmctld"), "-c", sleep, "-f", str(folder / "inner" / "slurm.conf")])
     ours = _start([str(bin_dir / "munged"), "-c", sleep, f"--pid-file={folder}/munged.pid"])
     try:
         time.sleep(0.5)

@@ -11,9 +11,10 @@
 # `cluster.sh: error: usage: profiles/slurm/cluster.sh up [DIR] | down DIR`.
 # `up` checks DIR before it installs or starts anything: a folder to make or one without a cluster
 # (an existing file, a folder that already holds a cluster, white space, or a munge socket path over
-# 107 characters are refused). `down` signals only the daemons this script started for DIR: the process a pid file
-# names is signalled only while its command is that daemon's and names DIR (a stale pid file, whose
-# pid a reboot gave to another process, is left alone with a note).
+# 107 characters are refused). `down` signals only the daemons this script started for DIR: the
+# process a pid file names is signalled only while its command is that daemon's with DIR's own file
+# as an argument (DIR/slurm.conf; munged's --pid-file=DIR/munged.pid). A stale pid file, whose pid
+# a reboot gave to another process, is left alone with a note.
 #
 # Needs root (the daemons run as root and so do the jobs) and Debian's packages slurmctld, slurmd,
 # slurm-client and munge; missing packages are installed with apt-get, which waits up to 10 minutes
@@ -182,7 +183,11 @@ owned_pid() {  # FILE NAME DIR: prints the pid FILE names if that process is NAM
     [ -r "/proc/$pid/cmdline" ] || return 1
     cmd=$(tr '\0' '\n' < "/proc/$pid/cmdline" 2> /dev/null) || return 1
     [ "$(basename -- "${cmd%%$'\n'*}")" = "$2" ] || return 1  # the program
-    grep -qF -- "$3/" <<< "$cmd" || return 1  # started for DIR: its files are in DIR
+    # started for DIR: one of its arguments is exactly the one up gave it (not merely a path under DIR,
+    # which a cluster in a sub-folder of DIR also has)
+    local own="$3/slurm.conf"
+    [ "$2" = munged ] && own="--pid-file=$3/munged.pid"
+    grep -qxF -- "$own" <<< "$cmd" || return 1
     echo "$pid"
 }
 
