@@ -74,3 +74,20 @@ def test_after_negative_curvature_the_problem_goes_direct():
     x = solve_linear_system(A, b, "auto", True, messages, ctx)
     assert len(messages) == 1
     assert np.linalg.norm(A @ x - b) <= 1e-9 * np.linalg.norm(b)
+
+
+def test_a_matrix_pardiso_refuses_goes_to_superlu(monkeypatch):
+    """A nearly singular tangent that Pardiso refuses (perturbed pivots) is solved by SuperLU's
+    pivoting, as before Pardiso was used."""
+    monkeypatch.setattr(pardiso, "available", lambda: True)
+
+    class Refusing:
+        inertia = None
+
+        def solve(self, A, b):
+            raise RuntimeError("MKL Pardiso: singular matrix (1 pivots perturbed)")
+
+    A = _indefinite(18**3, 0.5)
+    b = np.ones(A.shape[0])
+    x = solve_linear_system(A, b, "direct", True, [], {"pardiso": Refusing()})
+    assert np.abs(x - spla.splu(A.tocsc()).solve(b)).max() <= 1e-10 * np.abs(x).max()

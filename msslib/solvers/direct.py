@@ -162,10 +162,14 @@ def _direct_solve(A, b, symmetric, context=None, factorisation="superlu"):
         factor = state.get("pardiso")
         if factor is None:
             factor = state["pardiso"] = PardisoFactor()
-        x = factor.solve(A, b)
-        state["direct_solver"] = "pardiso"
-        if factor.inertia is not None and factor.inertia[1] > 0:
-            state["indefinite"] = True  # CG is not tried again on this problem's tangents
-        return x
+        try:
+            x = factor.solve(A, b)
+        except RuntimeError:  # a (nearly) singular tangent: SuperLU's pivoting decides, as before
+            x = None
+        if x is not None:
+            state["direct_solver"] = "pardiso"
+            if factor.inertia is not None and factor.inertia[1] > 0:
+                state["indefinite"] = True  # CG is not tried again on this problem's tangents
+            return x
     spec = "MMD_AT_PLUS_A" if symmetric else "COLAMD"
     return spla.splu(sp.csc_matrix(A), permc_spec=spec).solve(np.asarray(b, dtype=float))
