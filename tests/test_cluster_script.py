@@ -8,6 +8,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -55,18 +56,22 @@ def test_up_checks_dir_before_it_installs_anything(tmp_path):
     held.mkdir()
     (held / "slurm.conf").write_text("ClusterName=other\n")
     deep = tmp_path / ("x" * 100)
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o700)
     for dir_, says in [(plain, f"DIR '{plain}' exists and is not a folder; give a folder to make or one without a cluster"),
                        (plain / "sub", f"DIR '{plain / 'sub'}' cannot be made: '{plain}' is not a folder"),
                        (held, f"{held} already holds a cluster (run: {CLUSTER} down {held})"),
                        (tmp_path / "two words", "contains white space, which slurm.conf cannot hold"),
-                       (deep, "characters long; at most 94")]:
+                       (deep, "characters long; at most 94"),
+                       (locked / "c", f"DIR '{locked / 'c'}' is inside '{locked}', which not every user may enter "
+                                      "(mode 700); munged needs that for its socket")]:
         r = _cluster("up", str(dir_), path=path)
         lines = r.stderr.strip().splitlines()
         assert r.returncode == 1 and len(lines) == 1 and lines[0].startswith("cluster.sh: error: "), r.stderr
         assert says in lines[0], lines[0]
     assert not record.exists()  # apt-get never ran
     assert plain.read_text() == "keep me too" and a_file.read_text() == "keep me"
-    assert not deep.exists() and not (tmp_path / "two words").exists()
+    assert not deep.exists() and not (tmp_path / "two words").exists() and not (locked / "c").exists()
     assert (held / "slurm.conf").read_text() == "ClusterName=other\n"
 
 
@@ -78,15 +83,21 @@ def test_up_installs_with_apt_get_waiting_for_the_dpkg_lock(tmp_path):
     path = f"{bin_dir}{os.pathsep}/usr/bin{os.pathsep}/bin"
     if shutil.which("munged", path=path):
         pytest.skip("munged is on /usr/bin or /bin here")
-    new = tmp_path / "cluster"
-    r = _cluster("up", str(new), path=path)
+    searchable = Path(tempfile.mkdtemp(prefix="msslib-cluster-"))  # (tmp_path's folders are 0700)
+    searchable.chmod(0o755)
+    new = searchable / "cluster"
+    try:
+        r = _cluster("up", str(new), path=path)
+    finally:
+        made = new.exists()
+        shutil.rmtree(searchable)
     lines = r.stderr.strip().splitlines()
     assert r.returncode == 1 and lines == ["cluster.sh: error: apt-get could not install slurmctld slurmd "
                                            "slurm-client munge: E: no network here"], r.stderr
     calls = record.read_text().splitlines()
     assert [c.split()[2] for c in calls] == ["install", "update"]
     assert all(c.startswith("-o DPkg::Lock::Timeout=600 ") for c in calls), calls
-    assert not new.exists()
+    assert not made
 
 
 def _start(argv, **kw):

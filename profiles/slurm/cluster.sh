@@ -10,8 +10,9 @@
 # Any other use (an option such as --help where DIR goes, too: a folder named -x is ./-x) prints
 # `cluster.sh: error: usage: profiles/slurm/cluster.sh up [DIR] | down DIR`.
 # `up` checks DIR before it installs or starts anything: a folder to make or one without a cluster
-# (an existing file, a folder that already holds a cluster, white space, or a munge socket path over
-# 107 characters are refused). `down` signals only the daemons this script started for DIR: the
+# (an existing file, a folder that already holds a cluster, white space, a munge socket path over
+# 107 characters, or a folder above DIR that not every user may enter, as munged requires, are
+# refused). `down` signals only the daemons this script started for DIR: the
 # process a pid file names is signalled only while its command is that daemon's with DIR's own file
 # as an argument (DIR/slurm.conf; munged's --pid-file=DIR/munged.pid). A stale pid file, whose pid
 # a reboot gave to another process, is left alone with a note.
@@ -87,6 +88,13 @@ check_new_dir() {  # DIR: a folder up can make or use, checked before anything i
     [ -w "$parent" ] || die "DIR '$dir' cannot be made: '$parent' is not writable"
     abs=$(realpath -m -- "$dir")
     [ ${#abs} -le 94 ] || die "DIR '$abs' is ${#abs} characters long; at most 94 (munge's socket DIR/munge.socket must fit a 107-character socket path)"
+    local up_dir=$abs  # munged wants every folder above its socket searchable by all
+    while [ "$up_dir" != / ]; do
+        up_dir=$(dirname -- "$up_dir")
+        if [ -d "$up_dir" ] && [ "$(( 0$(stat -c %a -- "$up_dir") & 1 ))" -eq 0 ]; then
+            die "DIR '$dir' is inside '$up_dir', which not every user may enter (mode $(stat -c %a -- "$up_dir")); munged needs that for its socket: choose another folder or chmod o+x '$up_dir'"
+        fi
+    done
 }
 
 up() {
