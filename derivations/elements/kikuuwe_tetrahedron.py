@@ -35,7 +35,7 @@ from derivations import show
 from derivations.elasticity import E, nu
 from derivations.records import Derivation, Element, Formula
 
-ELEMENT = Element("kikuuwe_tetrahedron", cell="tetra", models=(),
+ELEMENT = Element("kikuuwe_tetrahedron", cell="tetra", models=("kikuuwe_tetrahedron",),
                   source="Kikuuwe, Tabuchi and Yamamoto (2009), An edge-based computationally efficient formulation "
                          "of Saint Venant-Kirchhoff tetrahedral finite elements, ACM TOG 28(1)",
                   extends="tetrahedron")

@@ -1,6 +1,6 @@
 # Generated from derivations/elements/kikuuwe_tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-# source-sha256: 801517b987aecd036665cbb583caa71cc97dcbfd66b4dbf615b3bd5285c14a1f
-# body-sha256: 313cbd3b1faa3529971e9a2f1ba9b10ea04e289af9ad6ff7891ed57778c03824
+# source-sha256: ba46e1b1818ee404fc7e9256726ce3f7fd882a12de97af05fe918140e1923343
+# body-sha256: 3e2158a83cb697e0edd4c7483b1f23c9889c143d6a81cca1a27d48b51ea2ebe1
 """Tetrahedron of any shape: the St Venant-Kirchhoff element in edge coordinates (Kikuuwe et al. 2009).
 
 Generated from derivations/elements/kikuuwe_tetrahedron.py by `python -m derivations.codegen`; do not edit.
@@ -10,7 +10,7 @@ from numpy import sqrt  # noqa: F401
 
 
 # the simulator models whose parameters come from this module (its ELEMENT declaration)
-MODELS = ()
+MODELS = ('kikuuwe_tetrahedron',)
 
 
 OUTPUTS = {'kikuuwe_tetrahedron': ('k_01', 'k_02', 'k_03', 'k_12', 'k_13', 'k_23', 'c_01_02', 'c_01_03', 'c_01_12', 'c_01_13', 'c_01_23', 'c_02_03', 'c_02_12', 'c_02_13', 'c_02_23', 'c_03_12', 'c_03_13', 'c_03_23', 'c_12_13', 'c_12_23', 'c_13_23')}

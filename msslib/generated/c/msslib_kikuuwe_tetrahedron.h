@@ -1,5 +1,5 @@
 // Generated from derivations/elements/kikuuwe_tetrahedron.py by `python -m derivations.codegen`. Do not edit.
-// source-sha256: 801517b987aecd036665cbb583caa71cc97dcbfd66b4dbf615b3bd5285c14a1f
+// source-sha256: ba46e1b1818ee404fc7e9256726ce3f7fd882a12de97af05fe918140e1923343
 // body-sha256: b9badacd56c0dfe2fa160a04e88e091a747ebf6a29669249629ea747e927eba3
 /* Tetrahedron of any shape: the St Venant-Kirchhoff element in edge coordinates (Kikuuwe et al. 2009), in C99 (units and linkage: msslib_api.h).
  * Printed from the expressions of msslib/generated/kikuuwe_tetrahedron.py (derivations/elements/kikuuwe_tetrahedron.py). */
