@@ -213,3 +213,17 @@ def test_plan_refuses_levels_of_a_mesh_file_over_the_limit_in_one_line(tmp_path,
                              "about 4.03e+08 nodes and 5.03e+08 cells for the fem_neohookean reference would need "
                              "about 4.03e+04 GB"), err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.vtu", "s.yaml"]
+
+
+def test_plan_names_the_level_of_a_generated_mesh_over_the_limit(tmp_path, capsys):
+    import yaml
+
+    d = _scene(nx=4)
+    d["model"] = "fem_linear"
+    d["loads"] = [{"type": "gravity", "g": [0.0, 0.0, -9.81]}]
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(d))
+    code = main(["plan", str(tmp_path / "s.yaml"), "--max-error", "0.2", "--levels", "1,9", "--repeats", "1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1 and len(err) == 1, err
+    assert err[0].startswith("msslib: error: --levels 9: scene.geometry (hex_grid with ") and "refined 8 times" in err[0], err
+    assert " GB" in err[0]
