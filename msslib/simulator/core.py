@@ -229,9 +229,14 @@ class Simulator:
             raise ValueError(f"{name} at t = {float(t):.6g} s must be {want}, got {raw!r}")
         return a
 
-    def _checked(self, fn, name, shape):
-        """``fn`` wrapped so that every value it returns is checked like a constant."""
-        return lambda t, _f=fn: self._value(_f, t, name, shape)
+    def _checked(self, fn, name, shape, user=False):
+        """``fn`` wrapped so that every value it returns is checked like a constant (``user``: a
+        caller's callable, which may raise in the middle of a step call)."""
+        def checked(t, _f=fn):
+            return self._value(_f, t, name, shape)
+
+        checked.user = user
+        return checked
 
     def _rebuild(self):
         st = self._stepper
@@ -300,7 +305,7 @@ class Simulator:
     def set_load(self, load) -> None:
         """The load factor of the model's own loads: a number, a callable of time or a table."""
         fn, varies = time_function(load, "load")
-        fn = self._checked(fn, "load", ())
+        fn = self._checked(fn, "load", (), callable(load))
         fn(self.t)
 
         def change():
@@ -315,7 +320,7 @@ class Simulator:
         Returns a handle for :meth:`remove`."""
         nodes = self._nodes(nodes)
         fn, varies = time_function(force, "force", self.dim)
-        fn = self._checked(fn, "force", (self.dim,))
+        fn = self._checked(fn, "force", (self.dim,), callable(force))
         fn(self.t)  # a callable that fails or returns a wrong value is refused here
         share = 1.0 / len(nodes) if total else 1.0
         return self._add(self._forces, (self._dofs(nodes, np.arange(self.dim)), fn, share, varies))
@@ -328,8 +333,12 @@ class Simulator:
         nodes = self._nodes(nodes)
         ax = self._axes(axes)
         fn, varies = time_function(displacement, "displacement", self.dim)
-        whole = self._checked(fn, "displacement", (self.dim,))
-        fn = (lambda t, _f=whole, _a=ax: _f(t)[_a])
+        whole = self._checked(fn, "displacement", (self.dim,), callable(displacement))
+
+        def fn(t, _f=whole, _a=ax):
+            return _f(t)[_a]
+
+        fn.user = whole.user
         fn(self.t)
         return self._add(self._paths, (self._dofs(nodes, ax), fn, varies))
 
@@ -372,7 +381,9 @@ class Simulator:
             t_new = tn
         t0 = time.perf_counter()
         st = self._stepper
-        saved = (st.x.copy(), st.v.copy(), st.t, st.n_taken) if self._varies() else None
+        user = (getattr(self._load, "user", False) or any(e[1].user for e in self._forces.values())
+                or any(e[1].user for e in self._paths.values()))
+        saved = (st.x.copy(), st.v.copy(), st.t, st.n_taken) if user else None  # a callable may raise
         try:
             if self.engine in ("network", "jax"):
                 st.steps(n, h, t_new)
