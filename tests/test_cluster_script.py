@@ -69,6 +69,13 @@ def test_up_checks_dir_before_it_installs_anything(tmp_path):
         lines = r.stderr.strip().splitlines()
         assert r.returncode == 1 and len(lines) == 1 and lines[0].startswith("cluster.sh: error: "), r.stderr
         assert says in lines[0], lines[0]
+    env_tmp = {"TMPDIR": str(locked)}  # without DIR: the folder it would make in TMPDIR is checked too
+    r = subprocess.run(["bash", str(CLUSTER), "up"], capture_output=True, text=True, timeout=60,
+                       env={**os.environ, "PATH": path, **env_tmp})
+    assert r.returncode == 1 and r.stderr.splitlines() == [
+        f"cluster.sh: error: DIR '{locked}/slurm-cluster.XXXXXX' is inside '{locked}', which not every user may "
+        f"enter (mode 700); munged needs that for its socket: choose another folder or chmod o+x '{locked}'"], r.stderr
+    assert not any(locked.iterdir())
     assert not record.exists()  # apt-get never ran
     assert plain.read_text() == "keep me too" and a_file.read_text() == "keep me"
     assert not deep.exists() and not (tmp_path / "two words").exists() and not (locked / "c").exists()

@@ -99,7 +99,8 @@ check_new_dir() {  # DIR: a folder up can make or use, checked before anything i
 
 up() {
     local dir=${1:-}
-    if [ -n "$dir" ]; then check_new_dir "$dir"; fi
+    # (without DIR: the folder mktemp will make in TMPDIR, checked the same way)
+    check_new_dir "${dir:-${TMPDIR:-/tmp}/slurm-cluster.XXXXXX}"
     [ "$(id -u)" -eq 0 ] || die "needs root to run munged, slurmctld and slurmd (running as uid $(id -u))"
     need_packages
     if [ -z "$dir" ]; then dir=$(mktemp -d "${TMPDIR:-/tmp}/slurm-cluster.XXXXXX"); fi
