@@ -77,8 +77,9 @@ REFERENCE_TIMEOUT = 240.0  # s per size: a slower case is reported as "> REFEREN
 
 
 def _cube_scene(n, model):
-    """A 10 cm cube of 6 n^3 tetrahedra (E = 1 MPa, nu = 1/4, where Lloyd's tetrahedra are exact), clamped at z = 0, under a body
-    force of 10^4 N/m^3 (strain about 10^-3: a few Newton iterations)."""
+    """A 10 cm cube of 6 n^3 tetrahedra (E = 1 MPa, nu = 1/4, where Lloyd's tetrahedra are exact),
+    clamped at z = 0, under a body force of 10^4 N/m^3 (strain about 10^-3: a few Newton
+    iterations)."""
     return {"name": "cube", "geometry": {"generator": "tet_grid",
                                          "args": {"lx": 0.1, "ly": 0.1, "lz": 0.1, "nx": n, "ny": n, "nz": n}},
             "materials": [{"E": 1.0e6, "nu": 0.25, "density": 1000.0}], "model": model,

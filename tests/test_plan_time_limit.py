@@ -53,7 +53,7 @@ def test_levels_are_dropped_from_the_top_until_the_estimate_fits(tmp_path):
     levels, est, lines = planning.levels_within(str(scene), 1e6, repeats=1, calibrate=False)
     assert levels == (1, 2, 3) and lines[0].startswith("time limit 1e+06 s (--time-limit): measuring levels 1,2,3")
     full = est["total_s"]
-    two = ref.estimate(prepare(load_scene(SCENE)), [1, 2], repeats=1)["total_s"]
+    two = ref.estimate(prepare(load_scene(SCENE)), [1, 2], repeats=1, n_models=len(planning.MODELS["tetra"]))["total_s"]
     levels, est, lines = planning.levels_within(str(scene), (two + full) / 2, repeats=1, calibrate=False)
     assert levels == (1, 2) and est["total_s"] == pytest.approx(two) and "(level 3 would exceed it)" in lines[0]
     levels, _, lines = planning.levels_within(str(scene), 1e-9, repeats=1, calibrate=False)
