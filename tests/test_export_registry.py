@@ -63,6 +63,12 @@ def _expected_columns(term):
                                        "c_01_12": Q[:, 1, 0], "c_12_02": Q[:, 2, 1], "c_01_02": Q[:, 2, 0],
                                        "L2_01": term.L2[:, 0], "L2_12": term.L2[:, 1], "L2_02": term.L2[:, 2]}, \
             term.conn
+    if name == "TetrahedronEdges":
+        Q, names = term.Q, ("01", "02", "03", "12", "13", "23")
+        cols = {f"k_{n}": Q[:, i, i] for i, n in enumerate(names)}
+        cols.update({f"c_{names[i]}_{names[j]}": Q[:, j, i] for i in range(6) for j in range(i + 1, 6)})
+        cols.update({f"L2_{n}": term.L2[:, i] for i, n in enumerate(names)})
+        return "kikuuwe_tetrahedron", cols, term.conn
     raise AssertionError(f"the test knows no term {name}: add its expected columns")
 
 

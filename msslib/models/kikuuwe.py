@@ -27,7 +27,7 @@ from msslib.terms.jit import njit_cached
 
 __all__ = ["kikuuwe_tetrahedron"]
 
-RANK = 11
+RANK = 12
 VALID_NU: dict = {}
 
 EDGES = np.array([(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)])

@@ -102,6 +102,7 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     ``delingette_triangle``      triangle     ``springs``
     ``lsq_triangle``             triangle     ``springs``
     ``lsq_tetrahedron``          tetra        ``springs``
+    ``kikuuwe_tetrahedron``      tetra        ``springs``
     ============================ ============ =========================================
 
     (every MSS model of the registry, a test checks; the documentation's model table, generated
