@@ -91,7 +91,8 @@ def load_curves(path) -> dict:
             raise ValueError(f"{where}: result {result!r} is not a results/....nc file")
         for key in ("variable", "x", "xlabel", "ylabel", "description"):
             if not isinstance(spec.get(key, ""), str) or (key != "description" and not spec[key].strip()):
-                raise ValueError(f"{where}: {key} {spec[key]!r}: expected a non-empty string")
+                raise ValueError(f"{where}: {key} {spec[key]!r}: expected a "
+                                 + ("string (or leave it out)" if key == "description" else "non-empty string"))
         for key, low, high, what in (("xscale", 0.0, None, "a number above 0"), ("yscale", 0.0, None, "a number above 0"),
                                      ("band", 0.0, None, "a number above 0 (%), or leave it out"),
                                      ("height", 0.0, 20.0, "a height in inches above 0 and at most 20, or leave it out")):

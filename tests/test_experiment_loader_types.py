@@ -143,6 +143,7 @@ def _curves_with(tmp_path, edit):
     (lambda f: f.update(result=["results/a.nc"]), "result ['results/a.nc'] is not a results/....nc file"),
     (lambda f: f.update(variable=["E_error"]), "variable ['E_error']: expected a non-empty string"),
     (lambda f: f.update(x=3), "x 3: expected a non-empty string"),
+    (lambda f: f.update(description=None), "description None: expected a string (or leave it out)"),
     (lambda f: f.update(xlabel=""), "xlabel '': expected a non-empty string"),
     (lambda f: f.update(xscale=-1.0), "xscale -1.0: expected a number above 0"),
     (lambda f: f.update(yscale="100"), "yscale '100': expected a number above 0"),
