@@ -86,3 +86,22 @@ def test_linearisation_is_the_linear_fem_stiffness():
     K = model.stiffness(model.x0).toarray()
     K_fem = fem_stiffness(mesh, 2.0, 0.45, 1.0)
     assert np.abs(K - K_fem).max() <= 1e-9 * np.abs(K_fem).max()
+
+
+def test_static_solve_equals_st_venant_kirchhoff_fem():
+    """A 20 % stretch of a tetrahedral bar: the static solve agrees with svk FEM to solver tolerance."""
+    from msslib.scene import load_scene, run_scene
+
+    scene = {
+        "name": "bar", "model": "kikuuwe_tetrahedron",
+        "geometry": {"generator": "tet_grid", "args": {"lx": 0.04, "ly": 0.01, "lz": 0.01, "nx": 4, "ny": 1, "nz": 1}},
+        "materials": [{"E": 1.0e4, "nu": 0.45}],
+        "boundary": [{"select": {"plane": ["x", 0.0]}, "fix": "all"}],
+        "loads": [{"type": "traction", "select": {"plane": ["x", 0.04]}, "traction": [2000.0, 0.0, 0.0]}],
+        "solver": {"type": "static", "load_steps": 4, "tol": 1.0e-10},
+    }
+    mss = run_scene(load_scene(scene), progress=False)
+    ref = run_scene(load_scene({**scene, "model": "fem_svk"}), progress=False)
+    u, u_ref = mss["displacement"].values, ref["displacement"].values
+    assert np.abs(u_ref).max() > 0.1 * 0.04  # a large deformation
+    assert np.abs(u - u_ref).max() <= 1e-6 * np.abs(u_ref).max()
