@@ -227,3 +227,19 @@ def test_backend_option_falls_back_to_numba_with_a_warning(lloyd, golec, monkeyp
         assert isinstance(JB.lattice_engine(golec[0]), LatticeExplicit)
     with pytest.raises(ValueError, match="backend must be one of"):
         JB.network_engine(model, h, backend="cuda")
+
+
+def test_the_cpu_network_holds_a_bounded_monitor_for_many_steps(lloyd, monkeypatch):
+    """Many steps in one call run in kernel calls of at most 256 steps (the monitor used to hold a
+    row per step), bitwise the same as the steps taken one call at a time."""
+    model, h, v0 = lloyd
+    monkeypatch.setattr(JB.device, "available", lambda: (False, "jax cannot be imported (test)"))
+    with pytest.warns(MsslibWarning):
+        a = JB.network_engine(model, h, ALPHA, v0=v0, precision="double")
+    with pytest.warns(MsslibWarning):
+        b = JB.network_engine(model, h, ALPHA, v0=v0, precision="double")
+    a.steps(600)
+    for _ in range(6):
+        b.steps(100)
+    assert a._mon.shape[0] <= 256
+    assert np.array_equal(a.positions(), b.positions()) and np.array_equal(a.velocities(), b.velocities())

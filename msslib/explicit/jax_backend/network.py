@@ -171,9 +171,13 @@ class CpuNetwork(_NetworkBase):
             return self
         R, v, F = self._state[:3]
         saved = (R.copy(), v.copy(), F.copy())
-        if self._mon.shape[0] < n:
-            self._mon = np.zeros((n, N_MONITOR))
-        network_steps(self._state, self.layout, self._mon, n)
+        done = 0
+        while done < n:  # kernel calls of at most 256 steps: the monitor does not grow with n
+            k = min(256, n - done)
+            if self._mon.shape[0] < k:
+                self._mon = np.zeros((k, N_MONITOR))
+            network_steps(self._state, self.layout, self._mon, k)
+            done += k
         if not (np.isfinite(R[:, :3]).all() and np.isfinite(v).all()):
             R[:], v[:], F[:] = saved
             self._diverged(n)
