@@ -39,8 +39,10 @@ def test_element_order_dimension_nodes_and_extensions():
     dims = [(len(fem._REF[decl[n].cell][0]), len(fem._REF[decl[n].cell])) for n in ELEMENTS]
     assert dims == sorted(dims)  # 2D before 3D, fewer nodes first
     for n, d in decl.items():
-        if d.extends:  # right after the element it generalises
-            assert ELEMENTS.index(n) == ELEMENTS.index(d.extends) + 1
+        if d.extends:  # after the element it generalises, with only its other extensions between
+            between = ELEMENTS[ELEMENTS.index(d.extends) + 1:ELEMENTS.index(n)]
+            assert ELEMENTS.index(n) > ELEMENTS.index(d.extends)
+            assert all(decl[m].extends == d.extends for m in between), (n, between)
 
 
 def test_no_list_of_modules_in_codegen_or_registry():
