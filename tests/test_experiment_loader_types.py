@@ -202,3 +202,26 @@ def test_the_missing_study_hint_works_as_printed(tmp_path):
     r = subprocess.run(draw, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     assert (tmp_path / "fig.png").is_file()
+
+
+def test_experiment_compare_missing_run_hint_works_as_printed(tmp_path):
+    """compare before the runs: the one-line error names a run-all command; run exactly as printed
+    (from another folder, with a space in the path), compare then succeeds."""
+    exp = _write(tmp_path, TINY)
+    runs = tmp_path / "my runs"
+    runs.mkdir()
+    compare = [sys.executable, "-m", "msslib", "experiment", "compare", str(exp), "--results", str(runs),
+               "--out", str(tmp_path / "cmp.nc")]
+    r = subprocess.run(compare, cwd=ROOT, capture_output=True, text=True, timeout=300)
+    lines = r.stderr.strip().splitlines()
+    assert r.returncode != 0 and len(lines) == 1 and lines[0].startswith("msslib: error: missing run"), r.stderr
+    hint = re.search(r"run `([^`]+)` first", lines[0])
+    assert hint, lines[0]
+    argv = shlex.split(hint.group(1))
+    assert argv[:3] == ["python", "-m", "msslib"]
+    done = subprocess.run([sys.executable, *argv[1:], "--quiet"], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr
+    r = subprocess.run(compare, cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "cmp.nc").is_file()

@@ -242,7 +242,11 @@ def _cmd_experiment_compare(args) -> int:
     results = {}
     for key, path in paths.items():
         if not path.is_file():
-            raise CommandError(f"missing run {str(path)!r}")
+            import shlex
+
+            run_all = shlex.join(["python", "-m", "msslib", "experiment", "run-all", str(args.experiment),
+                                  "--out-dir", str(results_dir)])
+            raise CommandError(f"missing run {str(path)!r}; run `{run_all}` first")
         results[key] = read_result_file(path, "run")
     ds = experiment.compare(exp, results)
     with StagedOutputs() as staged:  # both files, or neither
