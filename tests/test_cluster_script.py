@@ -45,7 +45,7 @@ def test_every_wrong_call_prints_the_usage_line(args):
     assert r.returncode == 1 and r.stdout == "" and r.stderr.splitlines() == [USAGE], r.stderr
 
 
-def test_up_checks_dir_before_it_installs_anything(tmp_path):
+def test_up_checks_dir_before_it_installs_anything(tmp_path, request):
     bin_dir, record = _fake_apt(tmp_path)
     path = f"{bin_dir}{os.pathsep}/usr/bin{os.pathsep}/bin"
     a_file = tmp_path / "a file.txt"
@@ -56,8 +56,10 @@ def test_up_checks_dir_before_it_installs_anything(tmp_path):
     held.mkdir()
     (held / "slurm.conf").write_text("ClusterName=other\n")
     deep = tmp_path / ("x" * 100)
-    locked = tmp_path / "locked"
-    locked.mkdir(mode=0o700)
+    # a short folder of mode 700 (mkdtemp's): under a long temporary path the length check, which
+    # comes first, would answer instead
+    locked = Path(tempfile.mkdtemp(prefix="lk", dir="/tmp"))
+    request.addfinalizer(lambda: shutil.rmtree(locked, ignore_errors=True))
     for dir_, says in [(plain, f"DIR '{plain}' exists and is not a folder; give a folder to make or one without a cluster"),
                        (plain / "sub", f"DIR '{plain / 'sub'}' cannot be made: '{plain}' is not a folder"),
                        (held, f"{held} already holds a cluster (run: {CLUSTER} down {held})"),

@@ -103,7 +103,10 @@ def test_another_users_lock_file_serves(tmp_path):
         lock.write_text("")
         lock.chmod(0o644)
         nobody = pwd.getpwnam("nobody")
-        child = (f"import sys; sys.path.insert(0, {str(HERE)!r}); import system_packages\n"
+        # the module beside the lock: the tests' folder may lie where nobody may not enter
+        shutil.copy(HERE / "system_packages.py", folder / "system_packages.py")
+        (folder / "system_packages.py").chmod(0o644)
+        child = (f"import sys; sys.path.insert(0, {str(folder)!r}); import system_packages\n"
                  f"with system_packages.install_lock({str(lock)!r}): print('held')")
         python = shutil.which("python3", path="/usr/bin:/bin")  # one that another user may run
         if python is None:
