@@ -243,6 +243,40 @@ def haptic_rate(res, quick):
             f"{s} springs, one step per call, force read every step", target=(">=", 1.0, "value"))
 
 
+def jax_reset(res, quick):
+    """reset() of a JAX Simulator on the 16 k-spring column (JAX's first device; CPU here): the
+    rebuild reuses the compiled step when the shapes and options are unchanged."""
+    try:
+        import jax  # noqa: F401
+    except ImportError:
+        return
+    model = lloyd_network(0.0085)
+    s = len(_springs(model)[0])
+    dt = 0.9 * S.explicit_stability_limit(model, model.x0)
+    from msslib.explicit.jax_backend import network as jax_network
+
+    jax_network._compiled.cache_clear()  # a first build compiles: what every reset() cost before the cache
+    t = time.perf_counter()
+    sim = Simulator(model, dt=dt, damping=0.0, engine="jax")
+    sim.step(1)
+    cold = time.perf_counter() - t
+    walls = []
+    for _ in range(3):
+        t = time.perf_counter()
+        sim.reset()
+        sim.step(1)
+        walls.append(time.perf_counter() - t)
+    t = time.perf_counter()
+    sim.step(STEPS)
+    np.asarray(sim.x)  # waits for the device
+    run = time.perf_counter() - t
+    w = min(walls)
+    res.add("stepping_jax_reset_16k", w, "s", None, None,
+            f"{s} springs: reset() and one step take {w * 1000:.1f} ms (the compiled step reused) against "
+            f"{cold * 1000:.0f} ms for a first build that compiles and {run * 1000:.1f} ms for {STEPS} steps "
+            f"(engine='jax', {sim.stats.get('device', '')})", target=("<=", 0.1, "value"))
+
+
 def run(res, quick: bool):
     cases = [("lloyd_16k", lambda r: lloyd_network(0.0085, r)), ("lloyd_122k", lambda r: lloyd_network(0.0042, r)),
              ("golec_95k", lambda r: golec_network(19, r))]
@@ -254,4 +288,5 @@ def run(res, quick: bool):
         if name in ("lloyd_122k", "lloyd_945k"):
             stability_share(res, name, model, dt)
     api_overhead(res, quick)
+    jax_reset(res, quick)
     haptic_rate(res, quick)

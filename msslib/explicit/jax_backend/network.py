@@ -14,11 +14,15 @@ On JAX: a spring's force ``d k (l - L0) / l`` (``d = x_b - x_a``) is one gather 
 positions per spring; the nodal forces are two ``jax.ops.segment_sum`` (the springs are sorted by
 their first node, so the first sum is over sorted segments); ``n`` steps are one jitted call of a
 ``lax.fori_loop`` whose body runs ``unroll`` steps, so a small network pays one launch per
-``unroll`` steps and not one per step.  The state stays on the device between calls;
+``unroll`` steps and not one per step.  The jitted functions take every array as an argument
+and are shared by all networks of the same node count, precision and unroll, so a rebuild with
+arrays of the same shapes (a reset, a new load, a second network) compiles nothing.  The state stays on the device between calls;
 :meth:`JaxNetwork.positions` and :meth:`JaxNetwork.velocities` copy it to NumPy.
 """
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 import scipy.sparse as sp
@@ -205,6 +209,44 @@ def _spring_force(jnp, segment_sum, x, a, b, k, L0, n_nodes, dtype):
     return F.reshape(-1)
 
 
+@functools.lru_cache(maxsize=32)
+def _compiled(n_nodes: int, dtype, unroll: int):
+    """The jitted force and ``n``-step loop for ``n_nodes`` nodes, force precision ``dtype`` and
+    ``unroll`` steps per loop iteration.  The arrays (springs, loads, weights, state) are
+    arguments, not constants of the trace, so every network with the same options shares these
+    functions and JAX's compilation cache: a rebuild with arrays of the same shapes (a reset, a
+    new load, a second network on the same model) does not trace or compile again."""
+    import jax
+    import jax.numpy as jnp
+    from jax import lax
+
+    segment_sum = jax.ops.segment_sum
+    u = unroll
+
+    def force(x, c):
+        return _spring_force(jnp, segment_sum, x, c["a"], c["b"], c["k"], c["L0"], n_nodes, dtype).astype(x.dtype) \
+            + c["fext"]
+
+    def step(s, c):
+        x, v, F = s
+        v = c["damp"] * v + c["w"] * F
+        x = x + c["hfree"] * v
+        return x, v, force(x, c)
+
+    def run(s, c, n):
+        def chunk(_, s):
+            for _ in range(u):
+                s = step(s, c)
+            return s
+
+        s = lax.fori_loop(0, n // u, chunk, s)
+        s = lax.fori_loop(0, n % u, lambda _, s: step(s, c), s)
+        finite = jnp.isfinite(s[0]).all() & jnp.isfinite(s[1]).all()
+        return s, finite
+
+    return jax.jit(force), jax.jit(run)
+
+
 class JaxNetwork(_NetworkBase):
     """Symplectic Euler steps of a 3D spring network on JAX (GPU when JAX sees one, else CPU).
 
@@ -269,33 +311,7 @@ class JaxNetwork(_NetworkBase):
             self._F = self._force(x, self._consts)
 
     def _compile(self, jax, jnp):
-        from jax import lax
-
-        n_nodes, dt, u = self.n_nodes, self.dtype, self.unroll
-        segment_sum = jax.ops.segment_sum
-
-        def force(x, c):
-            return _spring_force(jnp, segment_sum, x, c["a"], c["b"], c["k"], c["L0"], n_nodes, dt).astype(x.dtype) \
-                + c["fext"]
-
-        def step(s, c):
-            x, v, F = s
-            v = c["damp"] * v + c["w"] * F
-            x = x + c["hfree"] * v
-            return x, v, force(x, c)
-
-        def run(s, c, n):
-            def chunk(_, s):
-                for _ in range(u):
-                    s = step(s, c)
-                return s
-
-            s = lax.fori_loop(0, n // u, chunk, s)
-            s = lax.fori_loop(0, n % u, lambda _, s: step(s, c), s)
-            finite = jnp.isfinite(s[0]).all() & jnp.isfinite(s[1]).all()
-            return s, finite
-
-        return jax.jit(force), jax.jit(run)
+        return _compiled(self.n_nodes, np.dtype(self.dtype), self.unroll)
 
     def steps(self, n: int):
         """Advance ``n`` steps in one device call (the force is current after the call)."""
