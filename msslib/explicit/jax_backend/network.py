@@ -8,7 +8,8 @@ damping on the flat state ``x, v`` (``3 n_nodes``): ``F = f_springs(x) + f_ext``
 dofs, ``w = 0``, ``damp = 1``, ``h_free = 0`` on the fixed ones (they keep their position and
 velocity).  The force ``F`` is kept current: a call of ``steps(n)`` advances from the current
 force, then evaluates the force at the new positions, so the state after ``n`` steps is the same
-for any split of ``n`` into calls.
+for any split of ``n`` into calls to round-off, not bitwise (37 steps in one call and as 20 + 17
+differ in the last bits).
 
 On JAX: a spring's force ``d k (l - L0) / l`` (``d = x_b - x_a``) is one gather of the two end
 positions per spring; the nodal forces are two ``jax.ops.segment_sum`` (the springs are sorted by
