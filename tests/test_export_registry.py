@@ -63,13 +63,11 @@ def _expected_columns(term):
                                        "c_01_12": Q[:, 1, 0], "c_12_02": Q[:, 2, 1], "c_01_02": Q[:, 2, 0],
                                        "L2_01": term.L2[:, 0], "L2_12": term.L2[:, 1], "L2_02": term.L2[:, 2]}, \
             term.conn
-    if name == "TetrahedronEdges":
-        Q, names = term.Q, ("01", "02", "03", "12", "13", "23")
-        cols = {f"k_{n}": Q[:, i, i] for i, n in enumerate(names)}
-        cols.update({f"c_{names[i]}_{names[j]}": Q[:, j, i] for i in range(6) for j in range(i + 1, 6)})
-        cols.update({f"L2_{n}": term.L2[:, i] for i, n in enumerate(names)})
-        return "kikuuwe_tetrahedron", cols, term.conn
-    raise AssertionError(f"the test knows no term {name}: add its expected columns")
+    # any other term: the per-cell constants it declares (variable, attribute, unit, long name) are
+    # columns of its table named by the variable, holding the attribute's values
+    declared = getattr(term, "cell_constants", ())
+    assert declared, f"term {name} declares no cell_constants: declare them (or give this test its columns)"
+    return term.export_name, {var: getattr(term, attr) for var, attr, *_ in declared}, getattr(term, "conn", None)
 
 
 def _build(name, opts):
