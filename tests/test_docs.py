@@ -103,9 +103,9 @@ def test_scene_docstring_names_every_model():
     table = re.search(r"\n( *)=+ =+ =+\n\s*model\s+cells.*?\n *=+ =+ =+\n(.*?)\n *=+ =+ =+\n", doc, re.S)
     assert table, "the scene docstring has its table of mass-spring models"
     rows = [line.strip() for line in table.group(2).splitlines()]
-    assert [re.sub(r"\s+", " ", r) for r in rows] == [_scene_row(n, "{:s} {:s} {:s}") for n in model_names("mss")], \
-        "the scene docstring's model table (msslib/scene/__init__.py) is not the registry; its rows should read:\n" \
-        + "\n".join(table.group(1) + _scene_row(n) for n in model_names("mss"))
+    if [re.sub(r"\s+", " ", r) for r in rows] != [_scene_row(n, "{:s} {:s} {:s}") for n in model_names("mss")]:
+        pytest.fail("the scene docstring's model table (msslib/scene/__init__.py) is not the registry; its rows "
+                    "should read:\n" + "\n".join(table.group(1) + _scene_row(n) for n in model_names("mss")))
     for name in model_names("fem"):
         assert f"``{name}``" in doc
 
