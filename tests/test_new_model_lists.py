@@ -1,7 +1,7 @@
 """A new model needs no edit of the lists the tests keep: a throw-away family (a model module with a
 term of its own) written into a temporary folder is found by the registry, counted by the docs test,
 exported and checked against the constants its term declares by the export registry test, and the
-scene docstring's table check names the exact row to add for it.
+scene docstring's table check names the exact row to add for it; ``plan`` compares it on its cells.
 """
 
 from __future__ import annotations
@@ -66,6 +66,9 @@ def test_the_docs_count_takes_the_new_model_and_the_scene_table_names_its_row(fa
     names = models.names()
     assert names[-1] == "scratch_tetrahedron" and len(names) == 16  # the 15 shipped models and this one
     assert len(names) == sum(len(m.SPECS) for m in models.families())  # the docs test's count
+    from msslib import planning
+
+    assert planning._models_for("tetra")[-3:] == ["scratch_tetrahedron", "fem_linear", "fem_neohookean"]  # `plan`
     with pytest.raises(pytest.fail.Exception) as failed:
         test_docs.test_scene_docstring_names_every_model()
     assert str(failed.value).endswith("\n    ``scratch_tetrahedron``      tetra        ``springs``, ``bulk``")
