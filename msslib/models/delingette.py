@@ -27,7 +27,7 @@ from msslib.models.common import _require, material_arrays
 from msslib.models.spec import Exactness, ModelSpec
 from msslib.terms import Term
 from msslib.terms.base import Table, cell_columns, make_column
-from msslib.terms.assembly import block_pattern
+from msslib.terms.edges import EdgeQuadraticEnergy
 from msslib.terms.jit import njit_cached
 
 __all__ = ["TriangleAngularSprings", "delingette_triangle"]  # the parameters (gathered by msslib.parameters)
@@ -74,7 +74,7 @@ def local_coordinates(points, cells):
     return a, x2, y2
 
 
-class TriangleAngular(Term):
+class TriangleAngular(EdgeQuadraticEnergy):
     """The energy of the module docstring on triangles ``cells`` (m, 3) of a 2D mesh, with the
     constants ``Q`` (m, 3, 3) (``Q_ii = k_i``, ``Q_ij = c_ij``: ``W = 1/4 D^T Q D``) and the rest
     squared lengths ``L2`` (m, 3)."""
@@ -127,49 +127,11 @@ class TriangleAngular(Term):
                             for i, e in enumerate(edges)],
                       ])]
 
-    def __init__(self, cells, Q, L2):
-        self.dim = 2
-        self.conn = np.ascontiguousarray(cells, dtype=np.int64)
-        self.Q = np.ascontiguousarray(Q, dtype=float)
-        self.L2 = np.ascontiguousarray(L2, dtype=float)
-        m = len(self.conn)
-        if self.conn.shape != (m, 3) or self.Q.shape != (m, 3, 3) or self.L2.shape != (m, 3):
-            raise ValueError("TriangleAngular: cells (m, 3), Q (m, 3, 3) and L2 (m, 3) expected")
-        if not np.isfinite(self.Q).all():
-            raise ValueError("TriangleAngular: the constants must be finite")
-        self._pattern = None
+    dim, nodes, n_edges = 2, 3, 3
 
-    def __len__(self):
-        return len(self.conn)
-
-    def max_node(self) -> int:
-        return int(self.conn.max()) if self.conn.size else -1
-
-    def _x(self, x):
-        x = np.ascontiguousarray(x, dtype=float).reshape(-1)
-        if 2 * (self.max_node() + 1) > len(x):
-            raise ValueError(f"TriangleAngular: x has {len(x)} entries, the cells need {2 * (self.max_node() + 1)}")
-        return x
-
-    def energy(self, x) -> float:
-        return float(_angular_energy(self._x(x), self.conn, self.Q, self.L2))
-
-    def gradient(self, x) -> np.ndarray:
-        x = self._x(x)
-        g = np.zeros_like(x)
-        _angular_gradient(x, self.conn, self.Q, self.L2, g)
-        return g
-
-    def hessian_pattern(self):
-        if self._pattern is None:
-            self._pattern = block_pattern(self.conn, 2)
-        return self._pattern
-
-    def hessian_values(self, x) -> np.ndarray:
-        """Element blocks (m, 6, 6), row-major, in the order of :meth:`hessian_pattern`."""
-        out = np.empty(36 * len(self.conn))
-        _angular_hessian(self._x(x), self.conn, self.Q, self.L2, out)
-        return out
+    @property
+    def loops(self):
+        return _angular_energy, _angular_gradient, _angular_hessian
 
 
 # The element loops of TriangleAngular. Per triangle, edge e = (a, b) of EDGES has the vector

@@ -22,7 +22,7 @@ from msslib.models.common import _require, material_arrays
 from msslib.models.spec import Exactness, ModelSpec
 from msslib.terms import Term
 from msslib.terms.base import Table, cell_columns, make_column
-from msslib.terms.assembly import block_pattern
+from msslib.terms.edges import EdgeQuadraticEnergy
 from msslib.terms.jit import njit_cached
 
 __all__ = ["kikuuwe_tetrahedron"]
@@ -62,7 +62,7 @@ def local_coordinates(points, cells):
     return a, x2, y2, np.einsum("ij,ij->i", e3, u), np.einsum("ij,ij->i", e3, v), np.abs(np.einsum("ij,ij->i", e3, w))
 
 
-class TetrahedronEdges(Term):
+class TetrahedronEdges(EdgeQuadraticEnergy):
     """The energy of the module docstring on tetrahedra ``cells`` (m, 4) of a 3D mesh, with the
     constants ``Q`` (m, 6, 6) (``Q_ii = k_i``, ``Q_ij = c_ij``: ``W = 1/4 D^T Q D``) and the rest
     squared lengths ``L2`` (m, 6)."""
@@ -89,56 +89,21 @@ class TetrahedronEdges(Term):
                             for i, n in enumerate(NAMES)],
                       ])]
 
+    dim, nodes, n_edges = 3, 4, 6
+
+    @property
+    def loops(self):
+        return _edges_energy, _edges_gradient, _edges_hessian
+
     def __init__(self, cells, Q, L2):
-        self.dim = 3
-        self.conn = np.ascontiguousarray(cells, dtype=np.int64)
-        self.Q = np.ascontiguousarray(Q, dtype=float)
-        self.L2 = np.ascontiguousarray(L2, dtype=float)
-        m = len(self.conn)
-        if self.conn.shape != (m, 4) or self.Q.shape != (m, 6, 6) or self.L2.shape != (m, 6):
-            raise ValueError("TetrahedronEdges: cells (m, 4), Q (m, 6, 6) and L2 (m, 6) expected")
-        if not np.isfinite(self.Q).all():
-            raise ValueError("TetrahedronEdges: the constants must be finite")
-        self._pattern = None
+        super().__init__(cells, Q, L2)
         for i, n in enumerate(NAMES):
             setattr(self, f"_k_{n}", self.Q[:, i, i])
         for e, f in PAIRS:
             setattr(self, f"_c_{NAMES[e]}_{NAMES[f]}", self.Q[:, e, f])
 
-    def __len__(self):
-        return len(self.conn)
 
-    def max_node(self) -> int:
-        return int(self.conn.max()) if self.conn.size else -1
-
-    def _x(self, x):
-        x = np.ascontiguousarray(x, dtype=float).reshape(-1)
-        if 3 * (self.max_node() + 1) > len(x):
-            raise ValueError(f"TetrahedronEdges: x has {len(x)} entries, the cells need {3 * (self.max_node() + 1)}")
-        return x
-
-    def energy(self, x) -> float:
-        return float(_edges_energy(self._x(x), self.conn, self.Q, self.L2))
-
-    def gradient(self, x) -> np.ndarray:
-        x = self._x(x)
-        g = np.zeros_like(x)
-        _edges_gradient(x, self.conn, self.Q, self.L2, g)
-        return g
-
-    def hessian_pattern(self):
-        if self._pattern is None:
-            self._pattern = block_pattern(self.conn, 3)
-        return self._pattern
-
-    def hessian_values(self, x) -> np.ndarray:
-        """Element blocks (m, 12, 12), row-major, in the order of :meth:`hessian_pattern`."""
-        out = np.empty(144 * len(self.conn))
-        _edges_hessian(self._x(x), self.conn, self.Q, self.L2, out)
-        return out
-
-
-# The element loops of TetrahedronEdges. Per triangle, edge e = (a, b) of EDGES has the vector
+# The element loops of TetrahedronEdges. Per tetrahedron, edge e = (a, b) of EDGES has the vector
 # d_e = x_b - x_a and D_e = |d_e|^2 - L2_e; W = 1/4 D^T Q D, so dW/dx_b = -dW/dx_a = s_e d_e with
 # s = Q D, and the Hessian is 1/2 J^T Q J (J = dD/dx: +-2 d_e) plus s_e (+-I) on the node blocks of
 # edge e.
