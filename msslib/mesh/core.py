@@ -9,11 +9,44 @@ conventions are those of the docstring of :mod:`msslib.mesh`), the cell types
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
-CELL_TYPES = {"triangle": (2, 3), "quad": (2, 4), "tetra": (3, 4), "hexahedron": (3, 8)}
+from . import cells as _cells
+
+
+class _RegistryView(Mapping):
+    """A read-only mapping over the cell registry (:mod:`msslib.mesh.cells`), read at each access,
+    so a cell type added to the registry is seen everywhere: ``name -> value(cell type)``."""
+
+    def __init__(self, value, doc: str, only=None, extra=None):
+        self._value, self._only, self.__doc__, self._extra = value, only, doc, dict(extra or {})
+
+    def _names(self):
+        return [n for n, c in _cells._registry() if self._only is None or self._only(c)] + list(self._extra)
+
+    def __getitem__(self, name):
+        for n, c in _cells._registry():
+            if n == name and (self._only is None or self._only(c)):
+                return self._value(c)
+        if name in self._extra:
+            return self._extra[name]
+        raise KeyError(name)
+
+    def __iter__(self):
+        return iter(self._names())
+
+    def __len__(self):
+        return len(self._names())
+
+    def __repr__(self):
+        return repr(dict(self))
+
+
+#: cell type -> (dimension, nodes per cell), of every type of the registry (:mod:`msslib.mesh.cells`)
+CELL_TYPES = _RegistryView(lambda c: (c.dim, c.nodes), "cell type -> (dimension, nodes per cell)")
 
 #: default tolerance of :func:`coincident_nodes`, relative to the diagonal of the bounding box
 COINCIDENT_RTOL = 1e-10
@@ -33,7 +66,8 @@ class Mesh:
     * ``cell_groups[name]``: sorted unique cell indices, ``(k,)`` int64;
     * ``facet_groups[name]``: ``(k, nodes_per_facet)`` node indices of lower-dimensional elements
       of the facet type of the cells (lines of a 2D mesh, triangles of a tetra mesh, quads of a
-      hexahedron mesh), in the order and orientation of the file;
+      hexahedron mesh; triangles or quads of a wedge mesh, one type per group), in the order and
+      orientation of the file;
     * ``node_groups[name]``: sorted unique node indices, ``(k,)`` int64.
 
     Every group has at least one member.  Group arrays are read-only; functions that renumber
@@ -50,9 +84,10 @@ class Mesh:
     node_groups: dict = field(default=None)
 
     def __post_init__(self):
-        if self.cell_type not in CELL_TYPES:
+        if not isinstance(self.cell_type, str) or self.cell_type not in CELL_TYPES:
             raise ValueError(f"unknown cell_type {self.cell_type!r}; expected one of {sorted(CELL_TYPES)}")
-        dim, nv = CELL_TYPES[self.cell_type]
+        ct = _cells.get(self.cell_type)
+        dim, nv = ct.dim, ct.nodes
         points = np.ascontiguousarray(self.points, dtype=float)
         cells = np.ascontiguousarray(self.cells, dtype=np.int64)
         if points.ndim != 2 or points.shape[1] != dim:
@@ -67,7 +102,8 @@ class Mesh:
         object.__setattr__(self, "points", points)
         object.__setattr__(self, "cells", cells)
         object.__setattr__(self, "material", material)
-        nf = _LOCAL_FACETS[self.cell_type].shape[1]
+        nf = sorted({len(f) for f in ct.faces})
+        nf = nf[0] if len(nf) == 1 else tuple(nf)
         for kind, size, shape in (("cell_groups", len(cells), None), ("facet_groups", len(points), nf),
                                   ("node_groups", len(points), None)):
             object.__setattr__(self, kind, _checked_groups(kind, getattr(self, kind), size, shape))
@@ -89,9 +125,10 @@ class Mesh:
         return self.cells.shape[1]
 
 
-def _checked_groups(kind: str, groups, size: int, facet_nodes: int | None) -> dict:
+def _checked_groups(kind: str, groups, size: int, facet_nodes) -> dict:
     """``groups`` as a dict of read-only int64 arrays: indices below ``size``, sorted and unique
-    (cell and node groups) or rows of ``facet_nodes`` node indices (facet groups)."""
+    (cell and node groups) or rows of ``facet_nodes`` node indices (facet groups; a tuple of the
+    allowed counts for a cell type with facets of several types, a group holding facets of one)."""
     if groups is None:
         return {}
     if not isinstance(groups, dict):
@@ -107,8 +144,9 @@ def _checked_groups(kind: str, groups, size: int, facet_nodes: int | None) -> di
         a = a.astype(np.int64)
         if facet_nodes is None:
             a = np.unique(a.ravel())
-        elif a.ndim != 2 or a.shape[1] != facet_nodes:
-            raise ValueError(f"{kind}[{name!r}]: expected shape (k, {facet_nodes}), got {a.shape}")
+        elif a.ndim != 2 or a.shape[1] not in np.atleast_1d(facet_nodes):
+            shape = " or ".join(f"(k, {n})" for n in np.atleast_1d(facet_nodes))
+            raise ValueError(f"{kind}[{name!r}]: expected shape {shape}, got {a.shape}")
         if a.size == 0:
             raise ValueError(f"{kind}[{name!r}] is empty; allowed: groups with at least one member")
         if a.min() < 0 or a.max() >= size:
@@ -124,31 +162,17 @@ def _checked_groups(kind: str, groups, size: int, facet_nodes: int | None) -> di
 # local numbering tables (VTK/meshio node order, see the docstring of msslib.mesh)
 # --------------------------------------------------------------------------------------------
 
-LOCAL_EDGES = {
-    "triangle": np.array([[0, 1], [1, 2], [2, 0]]),
-    "quad": np.array([[0, 1], [1, 2], [2, 3], [3, 0]]),
-    "tetra": np.array([[0, 1], [1, 2], [2, 0], [0, 3], [1, 3], [2, 3]]),
-    "hexahedron": np.array(
-        [[0, 1], [1, 2], [2, 3], [3, 0], [4, 5], [5, 6], [6, 7], [7, 4], [0, 4], [1, 5], [2, 6], [3, 7]]
-    ),
-}
+#: cell type -> ``(edges, 2)`` local node pairs of its edges
+LOCAL_EDGES = _RegistryView(lambda c: c.edges, "cell type -> local edges")
 
-# Facets with outward orientation for a positively oriented cell.  In 2D an edge (a, b) is outward
-# oriented when the cell lies on its left, i.e. the outward normal is (dy, -dx).  In 3D the
-# right-hand-rule normal of the facet points out of the cell.
-_LOCAL_FACETS = {
-    "triangle": LOCAL_EDGES["triangle"],
-    "quad": LOCAL_EDGES["quad"],
-    "tetra": np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]]),
-    "hexahedron": np.array(
-        [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
-    ),
-}
+# Facets with outward orientation for a positively oriented cell, of the cell types whose facets
+# are of one type.  In 2D an edge (a, b) is outward oriented when the cell lies on its left, i.e.
+# the outward normal is (dy, -dx).  In 3D the right-hand-rule normal of the facet points out of the
+# cell.  (A type with facets of several types, the wedge, has them per type: ``CellType.facets``.)
+_LOCAL_FACETS = _RegistryView(lambda c: c.facets(), "cell type -> local facets",
+                              only=lambda c: c.single_facet_type is not None)
 
-_HEX_REF = np.array(
-    [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]],
-    dtype=float,
-)
+_HEX_REF = _cells.get("hexahedron").reference
 
 # Corners of the unit cube in hexahedron order: corner c sits at _HEX_REF01[c].
 _HEX_REF01 = (_HEX_REF + 1.0) / 2.0

@@ -10,23 +10,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from .core import _HEX_REF, Mesh
-
-
-def _hex_volumes(x: np.ndarray) -> np.ndarray:
-    """Exact volume of trilinear hexahedra (det J is of degree <= 2 per variable: 2^3 Gauss)."""
-    g = np.array([-1.0, 1.0]) / np.sqrt(3.0)
-    gp = np.array(np.meshgrid(g, g, g, indexing="ij")).reshape(3, -1).T  # (8, 3)
-    s = _HEX_REF  # (8 nodes, 3)
-    # dN[g, a, d] = d N_a / d xi_d at Gauss point g
-    f = 1.0 + gp[:, None, :] * s[None, :, :]  # (8 gp, 8 nodes, 3)
-    dn = np.empty((len(gp), 8, 3))
-    dn[..., 0] = s[:, 0] * f[..., 1] * f[..., 2]
-    dn[..., 1] = s[:, 1] * f[..., 0] * f[..., 2]
-    dn[..., 2] = s[:, 2] * f[..., 0] * f[..., 1]
-    dn /= 8.0
-    jac = np.einsum("cai,gad->cgid", x, dn)  # (cells, gp, 3, 3)
-    return np.linalg.det(jac).sum(axis=1)
+from . import cells as _cells
+from .core import Mesh
 
 
 def cell_measures(mesh: Mesh) -> np.ndarray:
@@ -35,18 +20,10 @@ def cell_measures(mesh: Mesh) -> np.ndarray:
 
     Triangles and tetrahedra: exact.  Quads: exact area of the bilinear quad (shoelace formula).
     Hexahedra: exact volume of the trilinear hexahedron (2 x 2 x 2 Gauss quadrature of det J).
+    Wedges: exact volume of the wedge (det J integrated exactly).  The formula of each type is
+    its cell module's (:mod:`msslib.mesh.cells`).
     """
-    x = mesh.points[mesh.cells]
-    t = mesh.cell_type
-    if t == "triangle":
-        a, b = x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]
-        return 0.5 * (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-    if t == "quad":
-        d1, d2 = x[:, 2] - x[:, 0], x[:, 3] - x[:, 1]
-        return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
-    if t == "tetra":
-        return np.linalg.det(x[:, 1:] - x[:, :1]) / 6.0
-    return _hex_volumes(x)
+    return _cells.get(mesh.cell_type).measure(mesh.points[mesh.cells])
 
 
 def check_cells(mesh: Mesh, rtol: float = 1e-12, max_report: int = 5) -> np.ndarray:
@@ -73,22 +50,15 @@ def check_cells(mesh: Mesh, rtol: float = 1e-12, max_report: int = 5) -> np.ndar
     return measures
 
 
-_FLIP = {
-    "triangle": np.array([0, 2, 1]),
-    "quad": np.array([0, 3, 2, 1]),
-    "tetra": np.array([0, 2, 1, 3]),
-    "hexahedron": np.array([4, 5, 6, 7, 0, 1, 2, 3]),
-}
-
-
 def orient(mesh: Mesh) -> Mesh:
     """Return a mesh whose cells with negative measure are flipped: triangles and tetrahedra swap
-    nodes 1 and 2, quads reverse their order, hexahedra swap their bottom and top faces."""
+    nodes 1 and 2, quads reverse their order, hexahedra swap their bottom and top faces, wedges
+    swap nodes 1 and 2 and nodes 4 and 5 (each type's ``flip``, :mod:`msslib.mesh.cells`)."""
     flip = cell_measures(mesh) < 0
     if not flip.any():
         return mesh
     cells = mesh.cells.copy()
-    cells[flip] = cells[flip][:, _FLIP[mesh.cell_type]]
+    cells[flip] = cells[flip][:, np.array(_cells.get(mesh.cell_type).flip)]
     return replace(mesh, cells=cells)  # material and groups unchanged (cell and node numbers are kept)
 
 

@@ -12,7 +12,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .core import LOCAL_EDGES, _LOCAL_FACETS, COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _compact, _fmt_point
+from . import cells as _cells
+from .core import LOCAL_EDGES, COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _compact, _fmt_point
 from .geometry import cell_measures
 from .groups import _renumbered_groups
 from .topology import facet_connected_cells
@@ -394,19 +395,22 @@ def cell_shapes(mesh: Mesh) -> tuple[np.ndarray, np.ndarray | None]:
     x = mesh.points[mesh.cells]
     edges = x[:, LOCAL_EDGES[mesh.cell_type][:, 1]] - x[:, LOCAL_EDGES[mesh.cell_type][:, 0]]
     longest = np.linalg.norm(edges, axis=2).max(axis=1, initial=0.0)
-    facets = x[:, _LOCAL_FACETS[mesh.cell_type]]  # (m, n_facets, nodes per facet, dim)
-    if mesh.dim == 2:
-        facet = np.linalg.norm(facets[:, :, 1] - facets[:, :, 0], axis=2)
-    elif facets.shape[2] == 3:
-        facet = 0.5 * np.linalg.norm(np.cross(facets[:, :, 1] - facets[:, :, 0], facets[:, :, 2] - facets[:, :, 0]),
-                                     axis=2)
-    else:
-        facet = 0.5 * np.linalg.norm(np.cross(facets[:, :, 2] - facets[:, :, 0], facets[:, :, 3] - facets[:, :, 1]),
-                                     axis=2)
-    simplex = mesh.cell_type in ("triangle", "tetra")
+    largest = np.zeros(len(x))
+    for local in _cells.get(mesh.cell_type).facets_by_type().values():
+        facets = x[:, local]  # (m, n_facets, nodes per facet, dim)
+        if mesh.dim == 2:
+            facet = np.linalg.norm(facets[:, :, 1] - facets[:, :, 0], axis=2)
+        elif facets.shape[2] == 3:
+            facet = 0.5 * np.linalg.norm(np.cross(facets[:, :, 1] - facets[:, :, 0],
+                                                  facets[:, :, 2] - facets[:, :, 0]), axis=2)
+        else:
+            facet = 0.5 * np.linalg.norm(np.cross(facets[:, :, 2] - facets[:, :, 0],
+                                                  facets[:, :, 3] - facets[:, :, 1]), axis=2)
+        largest = np.maximum(largest, facet.max(axis=1, initial=0.0))
+    simplex = _cells.get(mesh.cell_type).simplex
     measure = np.abs(cell_measures(mesh)) * (mesh.dim if simplex else 1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        aspect = np.where(measure > 0, longest * facet.max(axis=1, initial=0.0) / measure, np.inf)
+        aspect = np.where(measure > 0, longest * largest / measure, np.inf)
     if mesh.cell_type != "triangle":
         return aspect, None
     angles = []

@@ -11,7 +11,9 @@ Sample points (:data:`SAMPLE_POINTS`): triangles and tetrahedra have a constant 
 point); quads the 4 corners (``det J`` of a bilinear quad is linear in each reference coordinate,
 so its minimum lies at a corner); hexahedra the 8 corners and the centre (``det J`` of a trilinear
 hexahedron is quadratic in each coordinate, so the corners alone do not bound it; a hexahedron with
-one corner pushed through the opposite faces is inverted there while its volume stays positive).
+one corner pushed through the opposite faces is inverted there while its volume stays positive);
+wedges their 6 corners and the centre.  Each type's points are its cell module's
+(:mod:`msslib.mesh.cells`).
 
 Classification of a cell with relative Jacobian ``r`` (:func:`check_state`):
 
@@ -38,7 +40,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from msslib.mesh import CELL_TYPES, Mesh
+from msslib.mesh import Mesh
+from msslib.mesh import cells as _cells
+from msslib.mesh.core import _RegistryView
 
 __all__ = [
     "COLLAPSE_THRESHOLD",
@@ -67,44 +71,14 @@ _REST_RTOL = 1e-6
 #: about this many float64 values per temporary array when checking a history
 _CHUNK_VALUES = 4_000_000
 
-_QUAD_CORNERS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=float)
-_HEX_CORNERS = np.array(
-    [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]],
-    dtype=float,
-)
-
-#: reference coordinates of the sample points of each cell type
-SAMPLE_POINTS = {
-    "triangle": np.array([[1.0, 1.0]]) / 3.0,
-    "quad": _QUAD_CORNERS.copy(),
-    "tetra": np.array([[1.0, 1.0, 1.0]]) / 4.0,
-    "hexahedron": np.vstack([_HEX_CORNERS, np.zeros((1, 3))]),
-}
-
-
-def _tensor_gradients(nodes: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """d N_a / d xi_d at ``points`` for the multilinear shape functions
-    ``N_a = prod_d (1 + xi_d s_ad) / 2^dim`` with node signs ``s`` (shape (points, nodes, dim))."""
-    dim = nodes.shape[1]
-    f = 1.0 + points[:, None, :] * nodes[None, :, :]  # (points, nodes, dim)
-    grad = np.empty((len(points), len(nodes), dim))
-    for d in range(dim):
-        others = np.prod(np.delete(f, d, axis=2), axis=2)
-        grad[..., d] = nodes[:, d] * others
-    return grad / 2.0**dim
+#: reference coordinates of the sample points of each cell type (its cell module's, :mod:`msslib.mesh.cells`)
+SAMPLE_POINTS = _RegistryView(lambda c: c.sample_points.copy(), "cell type -> sample points")
 
 
 def _gradients(cell_type: str) -> np.ndarray:
     """Shape-function gradients at the sample points, shape (points, nodes, dim)."""
-    if cell_type == "triangle":  # N = (1 - xi - eta, xi, eta)
-        return np.array([[[-1.0, -1.0], [1.0, 0.0], [0.0, 1.0]]])
-    if cell_type == "tetra":
-        return np.array([[[-1.0, -1.0, -1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]])
-    nodes = _QUAD_CORNERS if cell_type == "quad" else _HEX_CORNERS
-    return _tensor_gradients(nodes, SAMPLE_POINTS[cell_type])
-
-
-_GRADIENTS = {t: _gradients(t) for t in CELL_TYPES}
+    cell = _cells.get(cell_type)
+    return cell.gradients(cell.sample_points)
 
 
 def _det(j: np.ndarray) -> np.ndarray:
@@ -118,7 +92,7 @@ def _det(j: np.ndarray) -> np.ndarray:
 
 def _jacobians(cell_type: str, x: np.ndarray) -> np.ndarray:
     """det J at the sample points; ``x`` (..., cells, nodes, dim) -> (..., cells, points)."""
-    grad = _GRADIENTS[cell_type]  # (points, nodes, dim)
+    grad = _gradients(cell_type)  # (points, nodes, dim)
     n_pts, nv, dim = grad.shape
     g = grad.transpose(1, 0, 2).reshape(nv, n_pts * dim)
     j = np.swapaxes(x, -1, -2) @ g  # (..., cells, dim_x, points * dim_xi): one matrix product

@@ -12,7 +12,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .core import LOCAL_EDGES, _LOCAL_FACETS, Mesh
+from . import cells as _cells
+from .core import LOCAL_EDGES, Mesh
 
 
 class NodePairs(NamedTuple):
@@ -64,32 +65,46 @@ def unique_edges(mesh: Mesh) -> NodePairs:
     return _local_pairs(mesh, LOCAL_EDGES[mesh.cell_type])
 
 
-_FACE_DIAGONALS = {
-    "quad": np.array([[0, 2], [1, 3]]),
-    "hexahedron": _LOCAL_FACETS["hexahedron"][:, [[0, 2], [1, 3]]].reshape(-1, 2),
-}
-INNER_DIAGONALS = np.array([[0, 6], [1, 7], [2, 4], [3, 5]])
+#: the four space diagonals of a hexahedron (local node pairs)
+INNER_DIAGONALS = _cells.get("hexahedron").inner_diagonals
+
+
+def _with(attr: str) -> list[str]:
+    return [n for n, c in _cells.registry().items() if getattr(c, attr) is not None]
 
 
 def face_diagonals(mesh: Mesh) -> NodePairs:
-    """Diagonals of the faces of hexahedra (12 per cell; of the cell itself for quads, 2 per cell).
+    """Diagonals of the quadrilateral faces of the cells (12 per hexahedron, 6 per wedge; of the
+    cell itself for quads, 2 per cell).
 
-    A diagonal of a face shared by two hexahedra appears once with ``counts == 2``.
+    A diagonal of a face shared by two cells appears once with ``counts == 2``.
     """
-    if mesh.cell_type not in _FACE_DIAGONALS:
-        raise ValueError(f"face diagonals need hexahedron or quad cells, got {mesh.cell_type}")
-    return _local_pairs(mesh, _FACE_DIAGONALS[mesh.cell_type])
+    local = _cells.get(mesh.cell_type).face_diagonals
+    if local is None:
+        raise ValueError(f"face diagonals need {' or '.join(reversed(_with('face_diagonals')))} cells, "
+                         f"got {mesh.cell_type}")
+    return _local_pairs(mesh, local)
 
 
 def inner_diagonals(mesh: Mesh) -> NodePairs:
     """The four space diagonals (0-6, 1-7, 2-4, 3-5) of each hexahedron; counts are 1."""
-    if mesh.cell_type != "hexahedron":
-        raise ValueError(f"inner diagonals need hexahedron cells, got {mesh.cell_type}")
-    return _local_pairs(mesh, INNER_DIAGONALS)
+    local = _cells.get(mesh.cell_type).inner_diagonals
+    if local is None:
+        raise ValueError(f"inner diagonals need {' or '.join(_with('inner_diagonals'))} cells, got {mesh.cell_type}")
+    return _local_pairs(mesh, local)
 
 
-def _facet_table(mesh: Mesh):
-    local = _LOCAL_FACETS[mesh.cell_type]
+def _single_facets(mesh: Mesh) -> np.ndarray:
+    """The local facets of the cells of ``mesh``, of one type; ValueError for a cell type with
+    facets of several types (see :func:`boundary_facets_by_type`)."""
+    ct = _cells.get(mesh.cell_type)
+    if ct.single_facet_type is None:
+        raise ValueError(f"{mesh.cell_type} cells have facets of several types "
+                         f"({', '.join(ct.facets_by_type())}); use boundary_facets_by_type")
+    return ct.facets()
+
+
+def _facet_table(mesh: Mesh, local: np.ndarray):
     facets = mesh.cells[:, local].reshape(-1, local.shape[1])
     keys = np.sort(facets, axis=1)
     _, inverse, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
@@ -105,12 +120,24 @@ def boundary_facets(mesh: Mesh, return_cells: bool = False):
     cells (see :func:`orient`).  Facets are listed cell by cell in local facet order.  With
     ``return_cells``, also the cell of each facet: ``(facets, cells)``.
     """
-    facets, counts = _facet_table(mesh)
+    local = _single_facets(mesh)
+    facets, counts = _facet_table(mesh, local)
     on = counts == 1
     if return_cells:
-        n_local = len(_LOCAL_FACETS[mesh.cell_type])
-        return facets[on], np.flatnonzero(on) // n_local
+        return facets[on], np.flatnonzero(on) // len(local)
     return facets[on]
+
+
+def boundary_facets_by_type(mesh: Mesh) -> dict:
+    """Facet type -> ``(facets, cells)``: the boundary facets of each type of the cells' facets
+    (as :func:`boundary_facets` with ``return_cells``), for every cell type; a wedge mesh has
+    triangles and quads."""
+    out = {}
+    for kind, local in _cells.get(mesh.cell_type).facets_by_type().items():
+        facets, counts = _facet_table(mesh, local)
+        on = counts == 1
+        out[kind] = (facets[on], np.flatnonzero(on) // len(local))
+    return out
 
 
 def facet_cell_counts(mesh: Mesh, facets) -> np.ndarray:
@@ -118,9 +145,11 @@ def facet_cell_counts(mesh: Mesh, facets) -> np.ndarray:
     orientation), the number of cells of ``mesh`` it is a face of: 0 (not a face: on no cell, or
     across one), 1 (a boundary facet) or 2 (an interior facet)."""
     facets = np.asarray(facets, dtype=np.int64)
-    local = _LOCAL_FACETS[mesh.cell_type]
-    if facets.ndim != 2 or facets.shape[1] != local.shape[1]:
-        raise ValueError(f"facets of {mesh.cell_type} cells must have shape (k, {local.shape[1]}), got {facets.shape}")
+    by_width = {f.shape[1]: f for f in _cells.get(mesh.cell_type).facets_by_type().values()}
+    if facets.ndim != 2 or facets.shape[1] not in by_width:
+        shape = " or ".join(f"(k, {n})" for n in by_width)
+        raise ValueError(f"facets of {mesh.cell_type} cells must have shape {shape}, got {facets.shape}")
+    local = by_width[facets.shape[1]]
     own = np.sort(mesh.cells[:, local].reshape(-1, local.shape[1]), axis=1)
     keys = np.concatenate([own, np.sort(facets, axis=1)])
     _, inverse = np.unique(keys, axis=0, return_inverse=True)
@@ -143,21 +172,24 @@ def facet_connected_cells(mesh: Mesh) -> tuple[int, np.ndarray]:
     m = mesh.n_cells
     if m == 0:
         return 0, np.zeros(0, dtype=np.int64)
-    local = _LOCAL_FACETS[mesh.cell_type]
-    facets = np.sort(mesh.cells[:, local].reshape(-1, local.shape[1]), axis=1).astype(np.int64)
     n = np.int64(max(mesh.n_nodes, 1))
-    # pairs of node indices as one int64 key each (n^2 < 2^63): a lexsort of 2 keys, not np.unique(axis=0)
-    keys = [facets[:, j] * n + facets[:, j + 1] if j + 1 < facets.shape[1] else facets[:, j]
-            for j in range(0, facets.shape[1], 2)]
-    order = np.lexsort(keys[::-1])
-    new = np.ones(len(order), dtype=bool)
-    for k in keys:
-        new[1:] &= k[order][1:] == k[order][:-1]
-    new[1:] = ~new[1:]
-    inverse = np.empty(len(order), dtype=np.int64)
-    inverse[order] = np.cumsum(new) - 1
-    n_facets = int(inverse.max()) + 1
-    cell_of = np.repeat(np.arange(m, dtype=np.int64), len(local))
+    inverses, cell_ofs, n_facets = [], [], 0
+    for local in _cells.get(mesh.cell_type).facets_by_type().values():  # facets of each type apart
+        facets = np.sort(mesh.cells[:, local].reshape(-1, local.shape[1]), axis=1).astype(np.int64)
+        # pairs of node indices as one int64 key each (n^2 < 2^63): a lexsort of 2 keys, not np.unique(axis=0)
+        keys = [facets[:, j] * n + facets[:, j + 1] if j + 1 < facets.shape[1] else facets[:, j]
+                for j in range(0, facets.shape[1], 2)]
+        order = np.lexsort(keys[::-1])
+        new = np.ones(len(order), dtype=bool)
+        for k in keys:
+            new[1:] &= k[order][1:] == k[order][:-1]
+        new[1:] = ~new[1:]
+        inverse = np.empty(len(order), dtype=np.int64)
+        inverse[order] = np.cumsum(new) - 1
+        inverses.append(n_facets + inverse)
+        n_facets += int(inverse.max()) + 1
+        cell_ofs.append(np.repeat(np.arange(m, dtype=np.int64), len(local)))
+    inverse, cell_of = np.concatenate(inverses), np.concatenate(cell_ofs)
     graph = coo_matrix((np.ones(len(cell_of)), (cell_of, m + inverse)), shape=(m + n_facets, m + n_facets))
     n_pieces, label = connected_components(graph, directed=False)
     label = label[:m]
