@@ -7,18 +7,42 @@ import numpy as np
 import scipy.sparse as sp
 
 from msslib.mesh import Mesh, check_cells
+from msslib.mesh import cells as _cells
+from msslib.mesh.cells import RegistryView as _RegistryView
 
 #: column permutation taking a VTK hexahedron to scikit-fem's ``MeshHex1`` node order.
-HEX_VTK_TO_SKFEM = np.array([0, 4, 3, 1, 7, 5, 2, 6])
+HEX_VTK_TO_SKFEM = np.array(_cells.get("hexahedron").linear.vtk_to_skfem)
 
-# quadrature order per cell type: 1 point for P1 simplices, 2x2(x2) Gauss for Q1; for quadratic
-# elements exact for the linear-elastic stiffness on straight-sided simplices (degree 2), and 3x3(x3)
-# Gauss for Q2.
-_INTORDER = {"triangle": 1, "tetra": 1, "quad": 2, "hexahedron": 2}
-_INTORDER_ORDER = {1: _INTORDER, 2: {"triangle": 2, "tetra": 2, "quad": 4, "hexahedron": 4}}
+# The elements and their quadrature are the cell types' (msslib.mesh.cells): 1 point for P1
+# simplices, 2x2(x2) Gauss for Q1, a rule of its own for the wedge; for quadratic elements exact for
+# the linear-elastic stiffness on straight-sided simplices (degree 2), and 3x3(x3) Gauss for Q2.
+_INTORDER = _RegistryView(lambda c: c.linear.intorder, "cell type -> quadrature order of its linear element")
+_INTORDER_ORDER = {1: _INTORDER, 2: _RegistryView(lambda c: c.quadratic.intorder, "cell type -> quadrature order "
+                                                  "of its quadratic element", only=lambda c: c.quadratic is not None)}
 #: element orders: 1 linear (P1/Q1), 2 quadratic (P2/Q2, scikit-fem's ElementTriP2 ... ElementHex2)
 ORDERS = (1, 2)
-_ORDER2 = {"triangle": "ElementTriP2", "tetra": "ElementTetP2", "quad": "ElementQuad2", "hexahedron": "ElementHex2"}
+_ORDER2 = _RegistryView(lambda c: c.quadratic.element, "cell type -> scikit-fem quadratic element",
+                        only=lambda c: c.quadratic is not None)
+
+
+def element_of(cell_type: str, order: int = 1):
+    """The :class:`msslib.mesh.cells.FemElement` of ``order`` of ``cell_type``; ValueError in one
+    line where the type has none (no quadratic wedge in scikit-fem)."""
+    cell = _cells.get(cell_type)
+    element = cell.linear if order == 1 else cell.quadratic
+    if element is None:
+        have = ", ".join(n for n, c in _cells.registry().items() if c.quadratic is not None)
+        raise ValueError(f"order must be 1 for {cell_type} cells (scikit-fem has no quadratic {cell_type} element), "
+                         f"got {order!r}; quadratic elements exist for {have} cells")
+    return element
+
+
+def _quadrature(element, intorder):
+    """Keyword arguments of ``skfem.Basis`` for ``element``: its own rule, else ``intorder``."""
+    if intorder is None and element.rule is not None:
+        points, weights = element.rule
+        return {"quadrature": (np.asarray(points, dtype=float), np.asarray(weights, dtype=float))}
+    return {"intorder": element.intorder if intorder is None else intorder}
 
 
 def to_skfem(mesh: Mesh):
@@ -31,16 +55,10 @@ def to_skfem(mesh: Mesh):
 
     p = np.ascontiguousarray(mesh.points.T)
     t = mesh.cells
-    ct = mesh.cell_type
-    if ct == "triangle":
-        return skfem.MeshTri1(p, np.ascontiguousarray(t.T)), skfem.ElementTriP1()
-    if ct == "quad":
-        return skfem.MeshQuad1(p, np.ascontiguousarray(t.T)), skfem.ElementQuad1()
-    if ct == "tetra":
-        return skfem.MeshTet1(p, np.ascontiguousarray(t.T)), skfem.ElementTetP1()
-    if ct == "hexahedron":
-        return skfem.MeshHex1(p, np.ascontiguousarray(t[:, HEX_VTK_TO_SKFEM].T)), skfem.ElementHex1()
-    raise ValueError(f"unsupported cell_type {ct!r}")
+    element = element_of(mesh.cell_type)
+    if element.vtk_to_skfem is not None:
+        t = t[:, np.array(element.vtk_to_skfem)]
+    return getattr(skfem, element.mesh)(p, np.ascontiguousarray(t.T)), getattr(skfem, element.element)()
 
 
 class _Geometry:
@@ -60,14 +78,14 @@ class _Geometry:
         check_cells(mesh)  # ValueError naming inverted or degenerate cells (else a singular matrix)
         self.mesh, self.order = mesh, order
         self.dim = mesh.dim
+        element = element_of(mesh.cell_type, order)
         self.skmesh, elem1 = to_skfem(mesh)
-        self.elem = elem1 if order == 1 else getattr(skfem, _ORDER2[mesh.cell_type])()
-        if intorder is None:
-            intorder = _INTORDER_ORDER[order][mesh.cell_type]
+        self.elem = elem1 if order == 1 else getattr(skfem, element.element)()
         # ``quadrature``: an explicit rule ``(points (dim, q), weights (q,))`` on the reference cell
-        # (scikit-fem takes at least 2 points per direction from ``intorder``)
+        # (scikit-fem takes at least 2 points per direction from ``intorder``); without one, the
+        # element's own rule where it has one, else ``intorder`` (by default the element's)
         self.basis = (skfem.Basis(self.skmesh, self.elem, quadrature=quadrature) if quadrature is not None
-                      else skfem.Basis(self.skmesh, self.elem, intorder=intorder))
+                      else skfem.Basis(self.skmesh, self.elem, **_quadrature(element, intorder)))
         nb = self.basis.Nbfun
         nodal = np.asarray(self.basis.nodal_dofs).ravel()
         n_sk = nodal.size  # scikit-fem drops trailing unused nodes
@@ -179,7 +197,7 @@ def _skfem_linear_stiffness(geo: _Geometry, lam_c: np.ndarray, mu_c: np.ndarray)
     import skfem
     from skfem.helpers import ddot, sym_grad, trace
 
-    vb = skfem.Basis(geo.skmesh, skfem.ElementVector(geo.elem), intorder=_INTORDER[geo.mesh.cell_type])
+    vb = skfem.Basis(geo.skmesh, skfem.ElementVector(geo.elem), **_quadrature(element_of(geo.mesh.cell_type), None))
     nq = vb.X.shape[-1]
 
     @skfem.BilinearForm

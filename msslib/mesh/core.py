@@ -9,40 +9,12 @@ conventions are those of the docstring of :mod:`msslib.mesh`), the cell types
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import cells as _cells
-
-
-class _RegistryView(Mapping):
-    """A read-only mapping over the cell registry (:mod:`msslib.mesh.cells`), read at each access,
-    so a cell type added to the registry is seen everywhere: ``name -> value(cell type)``."""
-
-    def __init__(self, value, doc: str, only=None, extra=None):
-        self._value, self._only, self.__doc__, self._extra = value, only, doc, dict(extra or {})
-
-    def _names(self):
-        return [n for n, c in _cells._registry() if self._only is None or self._only(c)] + list(self._extra)
-
-    def __getitem__(self, name):
-        for n, c in _cells._registry():
-            if n == name and (self._only is None or self._only(c)):
-                return self._value(c)
-        if name in self._extra:
-            return self._extra[name]
-        raise KeyError(name)
-
-    def __iter__(self):
-        return iter(self._names())
-
-    def __len__(self):
-        return len(self._names())
-
-    def __repr__(self):
-        return repr(dict(self))
+from .cells import RegistryView as _RegistryView
 
 
 #: cell type -> (dimension, nodes per cell), of every type of the registry (:mod:`msslib.mesh.cells`)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .cells import RegistryView as _RegistryView
 from .core import CELL_TYPES, COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _fmt_point
 from .gmsh_file import entity_groups, physical_names
 from .hygiene import resolve_coincident_nodes
@@ -118,9 +119,10 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
     """Read any mesh file meshio can read.
 
     The cells are the elements of the highest dimension in the file, which must all be of one
-    supported type (``tetra`` or ``hexahedron`` in 3D, ``triangle`` or ``quad`` in 2D); blocks of
-    that type are concatenated.  A mixed mesh (hexahedra with wedges or tetrahedra, triangles
-    with quads) or cells of another type (wedges, pyramids, quadratic cells) are refused, naming
+    supported type (a type of :mod:`msslib.mesh.cells`: ``tetra``, ``hexahedron`` or ``wedge`` in
+    3D, ``triangle`` or ``quad`` in 2D); blocks of that type are concatenated.  A mixed mesh
+    (hexahedra with wedges or tetrahedra, triangles with quads) or cells of another type
+    (pyramids, quadratic cells) are refused, naming
     the types, their counts and the cells that would be dropped; lower-dimensional elements
     (facets, lines, vertices) are not cells of the mesh: they carry groups.  Nodes no chosen cell
     uses are dropped (the others keep their order).  For 2D cells the z coordinate must be constant and is
@@ -141,7 +143,8 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
     skipped) become ``cell_groups`` for elements of the chosen cell type, ``facet_groups`` for
     elements of its facet type (lines in 2D, triangles for tetra, quads for hexahedron cells) and
     ``node_groups`` (the nodes of the elements) for other lower-dimensional elements (gmsh
-    physical points and curves of a 3D mesh, triangles of a hexahedron mesh); meshio's
+    physical points and curves of a 3D mesh, triangles of a hexahedron mesh, the triangles and
+    quads of a wedge mesh, whose facets are of two types); meshio's
     ``point_sets`` (Abaqus NSET, Exodus node sets) become ``node_groups``.  A group of the same
     name from both sources is their union.  Groups of different dimensions with one name (a
     physical surface and a physical volume both called ``body``) are kept apart, one group of each
@@ -272,15 +275,15 @@ def _mesh_from_meshio(path: Path, m, material_key: str):
 
 
 #: plural of the cell types in messages
-_PLURAL = {"tetra": "tetrahedra", "hexahedron": "hexahedra", "wedge": "wedges", "pyramid": "pyramids",
-           "triangle": "triangles", "quad": "quads", "polygon": "polygons"}
+_PLURAL = _RegistryView(lambda c: c.plural, "cell type -> its plural",
+                        extra={"wedge": "wedges", "pyramid": "pyramids", "polygon": "polygons"})
 
 
 def _one_cell_type(path: Path, blocks) -> str:
     """The cell type of the mesh: the type of the cells of the highest dimension in the file (the
     lower-dimensional elements carry groups).  Cells of that dimension of two or more types (a
     mixed mesh: hexahedra with wedges or tetrahedra, triangles with quads), or of a type msslib
-    has no model for (wedges, pyramids, quadratic cells), are a ValueError naming the types, how
+    has no cell type for (pyramids, quadratic cells), are a ValueError naming the types, how
     many cells of each there are and how many would be dropped."""
     counts = {}
     for block in blocks:
@@ -343,8 +346,9 @@ _TOPOLOGICAL_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle
                     "quad9": 2, "polygon": 2, "tetra": 3, "tetra10": 3, "hexahedron": 3, "hexahedron20": 3,
                     "hexahedron27": 3, "wedge": 3, "pyramid": 3}
 
-#: the element type of the facets of each cell type
-_FACET_TYPE = {"triangle": "line", "quad": "line", "tetra": "triangle", "hexahedron": "quad"}
+#: the element type of the facets of each cell type (None for a type with facets of several types,
+#: whose facet elements in a file become node groups)
+_FACET_TYPE = _RegistryView(lambda c: c.single_facet_type, "cell type -> its facet type")
 
 
 def _block_dim(cell_type: str) -> int | None:

@@ -23,7 +23,7 @@ import numpy as np
 
 from msslib.mesh import Mesh
 from msslib.mesh import cells as _cells
-from msslib.mesh.core import _RegistryView
+from msslib.mesh.cells import RegistryView as _RegistryView
 
 __all__ = ["CHILDREN", "uniform"]
 

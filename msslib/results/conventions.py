@@ -63,7 +63,7 @@ dimension      meaning
 ``axis``       spatial axes x, y (2D) and z (3D); the label variable ``axis_name`` names them
                (CF coordinate variables are numeric, so there is no coordinate variable ``axis``)
 ``cell``       mesh cells, in the order of ``Mesh.cells``
-``cell_node``  nodes of one cell (3 triangle, 4 quad, 4 tetra, 8 hexahedron)
+``cell_node``  nodes of one cell (3 triangle, 4 quad, 4 tetra, 8 hexahedron, 6 wedge)
 ``material``   materials; coordinate variable ``material`` holds ``0, 1, ...``
 ``spring``     springs of a mass-spring system (optional)
 ``spring_end`` the two end nodes of a spring (length 2; optional, with ``spring``)
@@ -94,7 +94,9 @@ variable                                               units    content
                                                                 ``volume_node_connectivity`` (3D),
                                                                 ``start_index = 0``; attribute
                                                                 ``cell_type`` (``triangle``,
-                                                                ``quad``, ``tetra``, ``hexahedron``)
+                                                                ``quad``, ``tetra``, ``hexahedron``,
+                                                                ``wedge``: a type of
+                                                                :mod:`msslib.mesh.cells`)
 ``cell_shape(cell)``                                   -        3D only: int8 UGRID volume shape flag
                                                                 (``flag_values 0 1 2 3``,
                                                                 ``flag_meanings "tetrahedron pyramid
@@ -174,6 +176,8 @@ attributes above); physical quantities belong in variables, where they carry uni
 
 from __future__ import annotations
 
+from msslib.mesh.cells import RegistryView as _RegistryView
+
 #: value of the global attribute ``Conventions``
 CONVENTIONS = "CF-1.11 UGRID-1.0"
 #: value of the global attribute ``msslib_schema``
@@ -193,7 +197,8 @@ SCHEMA_ATTRS = (
 MESH, SPRING_NETWORK = "mesh", "spring_network"
 #: UGRID volume shapes (flag values of ``cell_shape``) and the msslib cell types they stand for
 VOLUME_SHAPES = ("tetrahedron", "pyramid", "wedge", "hexahedron")
-_VOLUME_SHAPE_OF = {"tetra": "tetrahedron", "hexahedron": "hexahedron"}
+_VOLUME_SHAPE_OF = _RegistryView(lambda c: c.volume_shape, "3D cell type -> UGRID volume shape",
+                                 only=lambda c: c.dim == 3 and c.volume_shape in VOLUME_SHAPES)
 #: the netCDF default fill value of doubles, used where a material has no density
 DOUBLE_FILL = 9.969209968386869e36
 #: variables stored with a ``_FillValue`` (:data:`DOUBLE_FILL`; NaN in memory)

@@ -22,6 +22,7 @@ from __future__ import annotations
 import importlib
 import itertools
 import pkgutil
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
 from types import ModuleType
@@ -29,7 +30,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["CellType", "FemElement", "Refinement", "LINE", "registry", "get", "names", "facet_type",
+__all__ = ["CellType", "FemElement", "Refinement", "RegistryView", "LINE", "registry", "get", "names", "facet_type",
            "refinement_of", "lattice_refinement", "simplex_gradients", "tensor_gradients", "measure_by_quadrature"]
 
 
@@ -289,6 +290,34 @@ def get(name: str) -> CellType:
         if key == name:
             return cell
     raise ValueError(f"unknown cell_type {name!r}; expected one of {sorted(names())}")
+
+
+class RegistryView(Mapping):
+    """A read-only mapping over the cell registry (:mod:`msslib.mesh.cells`), read at each access,
+    so a cell type added to the registry is seen everywhere: ``name -> value(cell type)``."""
+
+    def __init__(self, value, doc: str, only=None, extra=None):
+        self._value, self._only, self.__doc__, self._extra = value, only, doc, dict(extra or {})
+
+    def _names(self):
+        return [n for n, c in _registry() if self._only is None or self._only(c)] + list(self._extra)
+
+    def __getitem__(self, name):
+        for n, c in _registry():
+            if n == name and (self._only is None or self._only(c)):
+                return self._value(c)
+        if name in self._extra:
+            return self._extra[name]
+        raise KeyError(name)
+
+    def __iter__(self):
+        return iter(self._names())
+
+    def __len__(self):
+        return len(self._names())
+
+    def __repr__(self):
+        return repr(dict(self))
 
 
 def refinement_of(kind: str) -> Refinement:
