@@ -41,13 +41,15 @@ Contents of this package, one concern per module; every name below is importable
 * :mod:`msslib.terms.internal`: :class:`Springs`, :class:`TetVolume`, :class:`HexVolume`;
 * :mod:`msslib.terms.external`: :class:`ExternalForce`, :class:`NodalForces`, :class:`Gravity`,
   :class:`Traction`, :func:`sum_external_forces`;
+* :mod:`msslib.terms.pressure`: :class:`Pressure` (dead or follower pressure on boundary facets)
+  and :func:`pressure_nodal_forces`;
 * :mod:`msslib.terms.baudet`: Baudet's correction in its two readings, :class:`BaudetCorrection`
   (from the surface loads) and :class:`ElementBaudetCorrection` (every cube from the forces acting
   on it from outside).
 
 The modules import one another in one direction: ``jit`` <- ``loops``, ``assembly``;
 ``assembly`` <- ``base``; ``base``, ``loops`` <- ``internal``; ``assembly``, ``base`` <-
-``external`` <- ``baudet``.
+``external`` <- ``baudet``; ``base``, ``external`` <- ``pressure``.
 """
 
 from __future__ import annotations
@@ -56,6 +58,7 @@ from .base import Term
 from .baudet import BaudetCorrection, ElementBaudetCorrection
 from .external import ExternalForce, Gravity, NodalForces, Traction, sum_external_forces
 from .internal import HexVolume, Springs, TetVolume
+from .pressure import Pressure, pressure_nodal_forces
 
 __all__ = [
     "Term",
@@ -67,6 +70,8 @@ __all__ = [
     "Gravity",
     "NodalForces",
     "Traction",
+    "Pressure",
+    "pressure_nodal_forces",
     "BaudetCorrection",
     "sum_external_forces",
 ]
