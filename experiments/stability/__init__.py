@@ -10,19 +10,25 @@ the same mesh where that is meaningful, the volume ratio V/V0, the smallest elem
 the number of inverted elements, the Newton iterations and a one-line text of the outcome (how it
 broke).  The result is an xarray Dataset written atomically (:func:`msslib.results.write_result`).
 
-Models (dimension ``model``, the ``models`` of cases.yaml): ``lloyd_tetrahedron`` /
-``lloyd_tetrahedron_volume`` on Kuhn tetrahedral meshes; ``baudet_cube`` (springs plus the
-orthogonal correction, built from the external loads: it acts in force-controlled cases only);
-``golec_derived`` / ``golec_published`` / ``golec_springs_only`` (Golec's cube with the derived
-constants, the printed ones, and the derived springs without the volume term); ``fem_linear``,
-``fem_svk``, ``fem_neohookean`` (scikit-fem references on the cube mesh).
+Models (dimension ``model``, the ``models`` of cases.yaml, plus every mass-spring model of the
+registry on tetrahedra or hexahedra that no column runs, under its own name): ``lloyd_tetrahedron``
+/ ``lloyd_tetrahedron_volume`` on Kuhn tetrahedral meshes; ``baudet_cube`` (springs plus the
+correction under the element reading: each cube corrected from the forces it receives from
+outside, active under displacement control too) and ``baudet_cube_boundary`` (the correction
+built from the loaded surface: it acts in force-controlled cases only; the variable ``reading``
+records which reading each column ran); ``golec_derived`` / ``golec_published`` /
+``golec_springs_only`` (Golec's cube with the derived constants, the printed ones, and the
+derived springs without the volume term); ``lsq_tetrahedron`` and ``kikuuwe_tetrahedron`` (from
+the registry); ``fem_linear``, ``fem_svk``, ``fem_neohookean`` (scikit-fem references on the
+cube mesh) and ``fem_svk_tetra`` (St Venant-Kirchhoff FEM on the tetrahedral mesh).
 
 Cases (dimension ``case``):
 
 * ``nu_0.45`` ... ``nu_0.4999``: unit cube, 10 % compression by a prescribed top displacement,
   frictionless symmetry planes (the exact solution is homogeneous, so linear elements represent it
-  exactly and the FEM reference does not lock).  Baudet's cube is loaded instead by the FEM
-  reaction on top as a traction (force control) so that its correction is active.
+  exactly and the FEM reference does not lock).  Baudet's cube under the boundary reading is
+  loaded instead by the FEM reaction on top as a traction (force control) so that its correction
+  is active.
 * ``compress_10/30/50``: 0.1 m cube clamped at top and bottom (barrelling), nu = 0.3, prescribed
   top displacement (the static solver's F_ref is then the linearised reaction of the motion).
 * ``inverted_input``: the sliding scene on 2^3 meshes with one cell numbered backwards (an in-memory
@@ -61,7 +67,7 @@ import numpy as np
 import xarray as xr
 
 from experiments import script
-from experiments.stability.scenes import load_cases
+from experiments.stability.scenes import load_cases, reading
 from experiments.stability.shapes import SHAPES, TET_EDGES
 from experiments.stability.study import FIELDS, record, run_all
 from msslib.results import write_result
@@ -83,11 +89,15 @@ META = {
     "stop_step": ("1", ("explicit run with allow_unstable: the step at which the divergence detector stopped it "
                         "(-1: n/a)")),
     "stop_displacement": ("1", "explicit run with allow_unstable: max |u| when stopped / static max |u| (NaN: n/a)"),
+    "dt_limit": ("s", "explicit and implicit cases: the explicit stability limit of the model at rest, the step the "
+                      "case multiplies (NaN: n/a)"),
     "outcome": ("1", "how the run ended or broke (one line)"),
 }
 
 
-def to_dataset(cases, shape_data, models, E, quick) -> xr.Dataset:
+def to_dataset(cases, shape_data, models, E, quick, readings=None) -> xr.Dataset:
+    """The result: per (case, model) the fields of :data:`FIELDS`; per model the Baudet correction
+    reading it ran (``readings``, column -> "element", "boundary" or "" for other models)."""
     names = list(cases)
     table = {f: [[(cases[c].get(m) or record(outcome="n/a"))[f] for m in models] for c in names] for f in FIELDS}
     data = {}
@@ -101,6 +111,11 @@ def to_dataset(cases, shape_data, models, E, quick) -> xr.Dataset:
             values = values.astype(str)
         units, long_name = META[f]
         data[f] = (("case", "model"), values, {"units": units, "long_name": long_name})
+    readings = readings or {}
+    data["reading"] = (("model",), np.array([str(readings.get(m, "")) for m in models], dtype=str),
+                       {"units": "1", "long_name": "reading of Baudet's correction force the column ran (element: each "
+                                                   "cube from the forces it receives from outside; boundary: from the "
+                                                   "loaded surface); empty for the other models"})
     shapes = list(SHAPES)
     data["k_lloyd"] = (("shape",), np.array([shape_data[s]["k_lloyd"] for s in shapes]),
                        {"units": "N/m", "long_name": "Lloyd per-element constant (regular tetrahedron of equal volume)"})
@@ -145,7 +160,8 @@ def main(argv=None) -> int:
         warnings.simplefilter("ignore", RuntimeWarning)
         cases, shape_data = run_all(data, args.quick,
                                     log=lambda s: print(f"[{time.perf_counter() - t0:6.1f} s] {s}", file=sys.stderr))
-    ds = to_dataset(cases, shape_data, list(data["models"]), float(data["E"]), args.quick)
+    ds = to_dataset(cases, shape_data, list(data["models"]), float(data["E"]), args.quick,
+                    readings={m: reading(spec) for m, spec in data["models"].items()})
     ds.attrs["wall_time_s"] = time.perf_counter() - t0
     write_result(out, ds)
     print(summary(ds))

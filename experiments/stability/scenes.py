@@ -17,13 +17,48 @@ GRIDS = {"hexahedron": "hex_grid", "tetra": "tet_grid"}
 FLIP = {"tetra": [0, 2, 1, 3], "hexahedron": [4, 5, 6, 7, 0, 1, 2, 3]}
 
 
+def model_type(spec) -> str:
+    """The registry name of a column's scene model (``{type: ...}`` or a bare name)."""
+    model = spec["model"]
+    return model if isinstance(model, str) else model["type"]
+
+
+def reading(spec) -> str:
+    """The reading of Baudet's correction force a column runs (its ``correction`` option, else the
+    model's default), or "" for a model without that option."""
+    from msslib import models as registry
+
+    options = {o.name: o.default for o in registry.get(model_type(spec)).options}
+    if "correction" not in options:
+        return ""
+    model = spec["model"]
+    return str(model.get("correction", options["correction"]) if isinstance(model, dict) else options["correction"])
+
+
+def registry_columns(columns: dict) -> dict:
+    """``columns`` with a column for every mass-spring model of the registry on tetrahedra or
+    hexahedra that no column runs, named after it and placed before the first FEM column."""
+    from msslib import models as registry
+
+    ran = {model_type(spec) for spec in columns.values()}
+    extra = {name: {"cells": cells, "model": name} for cells in GRIDS
+             for name in registry.for_cells(cells, "mss") if name not in ran}
+    extra = {name: spec for name, spec in extra.items() if spec["cells"] == registry.get(name).cells[0]}
+    fem = [name for name, spec in columns.items() if registry.get(model_type(spec)).kind == "fem"]
+    at = list(columns).index(fem[0]) if fem else len(columns)
+    items = list(columns.items())
+    return dict(items[:at] + list(extra.items()) + items[at:])
+
+
 def load_cases(path=CASES_FILE) -> dict:
-    """``cases.yaml``: ``E``, ``density``, ``models`` (column -> cells and scene model), ``cases``."""
+    """``cases.yaml``: ``E``, ``density``, ``models`` (column -> cells and scene model; with
+    :func:`registry_columns`), ``cases``."""
     data = yaml.safe_load(Path(path).read_text())
     kinds = {"sliding", "clamped", "inverted", "shape", "contrast", "explicit", "implicit", "unloaded", "beam"}
     for name, case in data["cases"].items():
         if case.get("kind") not in kinds:
             raise ValueError(f"{path}: case {name}: kind {case.get('kind')!r}; allowed: {', '.join(sorted(kinds))}")
+    data["models"] = registry_columns(data["models"])
     return data
 
 

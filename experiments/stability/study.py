@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 
-from experiments.stability.scenes import pick, scene
+from experiments.stability.scenes import model_type, pick, reading, scene
 from experiments.stability.shapes import shape_analysis
 from msslib import mesh as M
 from msslib.errors import DivergenceError, MsslibWarning, StabilityError
@@ -17,17 +17,18 @@ from msslib.scene import FEM_MODELS, load_scene, prepare, run_scene
 from msslib.solvers import ConvergenceError, explicit_stability_limit
 
 FIELDS = ("ran", "converged", "error", "volume_ratio", "min_volume_ratio", "n_inverted", "iterations", "stop_step",
-          "stop_displacement", "outcome")
+          "stop_displacement", "dt_limit", "outcome")
 REFERENCE = "fem_neohookean"  # the reference of the error, on the same mesh as the model
 
 
 def record(ran=False, converged=False, error=np.nan, volume_ratio=np.nan, min_volume_ratio=np.nan,
-           n_inverted=-1, outcome="", iterations=-1, stop_step=-1, stop_displacement=np.nan) -> dict:
+           n_inverted=-1, outcome="", iterations=-1, stop_step=-1, stop_displacement=np.nan, dt_limit=np.nan) -> dict:
     """One (case, model) outcome, the fields of :data:`FIELDS`."""
     return {"ran": bool(ran), "converged": bool(converged), "error": float(error),
             "volume_ratio": float(volume_ratio), "min_volume_ratio": float(min_volume_ratio),
             "n_inverted": int(n_inverted), "iterations": int(iterations), "stop_step": int(stop_step),
-            "stop_displacement": float(stop_displacement), "outcome": " ".join(str(outcome).split())[:300]}
+            "stop_displacement": float(stop_displacement), "dt_limit": float(dt_limit),
+            "outcome": " ".join(str(outcome).split())[:300]}
 
 
 def short(exc: BaseException) -> str:
@@ -37,6 +38,15 @@ def short(exc: BaseException) -> str:
 def is_fem(spec) -> bool:
     model = spec["model"]
     return (model if isinstance(model, str) else model["type"]) in FEM_MODELS
+
+
+def is_svk(spec) -> bool:
+    """St Venant-Kirchhoff FEM, or a model whose energy is that element's on any mesh (registry
+    exactness ``element`` on ``any`` mesh, e.g. Kikuuwe's edge-based tetrahedron)."""
+    from msslib import models as registry
+
+    name = model_type(spec)
+    return name == "fem_svk" or any(e.level == "element" and e.mesh == "any" for e in registry.get(name).exact)
 
 
 def run(sc):
@@ -98,20 +108,21 @@ def static_case(name, case, data, quick) -> dict:
         if kind in ("sliding", "clamped", "contrast"):
             ref = reference(cells)
             ref_u = None if ref is None else ref["displacement"].values
-            if kind == "sliding" and column == "baudet_cube" and ref is not None:
-                # force control, so that the correction acts: the reference's top reaction as a traction
+            if kind == "sliding" and reading(spec) == "boundary" and ref is not None:
+                # force control, so that the boundary reading's correction acts: the reference's top
+                # reaction as a traction (the element reading's acts under displacement control too)
                 size = float(case["size"])
                 top = np.isclose(ref["rest_position"].values[:, 2], size)
                 extra["traction"] = float(ref["reaction_force"].values[top, 2].sum()) / size**2
                 note = "; force control (the FEM reaction on top as a traction), correction active"
-            elif kind == "clamped" and column == "baudet_cube":
+            elif kind == "clamped" and reading(spec) == "boundary":
                 note = "; displacement control: no external load, correction inactive"
         t0 = time.perf_counter()
         ds, failed = run(scene(name, case, cells, spec["model"], data, quick, **extra))
         if failed is not None:
             out[column] = failed
             continue
-        rec = measured(ds, cells, t0, ref_u, svk=spec["model"] == "fem_svk")
+        rec = measured(ds, cells, t0, ref_u, svk=is_svk(spec))
         u = ds["displacement"].values
         if kind == "unloaded":  # max |u| / edge length
             rec["error"] = np.abs(u).max() / float(case["size"])
@@ -178,7 +189,7 @@ def dynamic_case(name, case, data, quick) -> dict:
                 continue
             u = ds["displacement_history"].values
             umax = np.abs(u).max()
-            out[column] = record(True, bool(np.isfinite(u).all()), error=umax / u_static,
+            out[column] = record(True, bool(np.isfinite(u).all()), error=umax / u_static, dt_limit=limit,
                                  outcome=f"stable: max |u| = {umax / u_static:.3f} x static max |u| over {steps} "
                                  "steps (numerical damping)")
             continue
@@ -190,7 +201,7 @@ def dynamic_case(name, case, data, quick) -> dict:
             refused, detail = "refused", f"; {short(exc)[:120]}"
         try:
             run_scene(scene(name, case, cells, model, data, quick, allow_unstable=True, **kw), progress=False)
-            out[column] = record(True, True, outcome=f"{refused}; NOT DETECTED: no divergence in {steps} steps with "
+            out[column] = record(True, True, dt_limit=limit, outcome=f"{refused}; NOT DETECTED: no divergence in {steps} steps with "
                                  f"allow_unstable{detail}")
             continue
         except DivergenceError as exc:
@@ -205,7 +216,7 @@ def dynamic_case(name, case, data, quick) -> dict:
         wrong = float(np.abs(stop.x_last - x_ref).max()) / u_static
         moved = stop.max_displacement / u_static
         state = "finite" if np.isfinite(stop.x_last).all() else "NON-FINITE"
-        out[column] = record(ran=True, error=wrong, stop_step=stop.step, stop_displacement=moved,
+        out[column] = record(ran=True, error=wrong, stop_step=stop.step, stop_displacement=moved, dt_limit=limit,
                              outcome=f"{refused}; allow_unstable: stopped at step {stop.step}, off a stable run by "
                              f"{wrong:.2g} x static (max |u| {moved:.3g} x static, {stop.quantity}, last state "
                              f"{state}){detail}")
