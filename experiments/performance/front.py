@@ -10,7 +10,8 @@ level below the finest (``below=1``: its dofs are exactly the finest level's nod
 finest (``below=0``), solved on up to two coarser levels for its own error estimate (Richardson
 with the observed order). Every variant is compared with it at its own nodes: no interpolation.
 
-Variants: each MSS model of the cell type solved non-linearly (load-stepped Newton) and
+Variants: each MSS model of the cell type (read from the registry, :data:`msslib.planning.MODELS`)
+solved non-linearly (load-stepped Newton) and
 linearly (one solve with its Hessian at rest, ``solver.linear``), linear FEM and the non-linear
 FEM law. Timing: the CPU time of the
 single-threaded run (mesh, model set-up and solve; its wall time on an idle machine, and unlike
@@ -78,9 +79,26 @@ def measure(scene_file, levels, repeats, progress=print, below=1):
     out["last_rate"] = (("model",), rate, {"units": "1", "long_name": "log2 of the max-error ratio of the last two levels"})
     out["family"] = (("model",), np.array(["fem" if n.startswith("fem") else "mss" for n in names]),
                      {"units": "1", "long_name": "fem or mss"})
-    out.attrs.update({"long_run_s": LONG, "cpu_budget_s": BUDGET, "cell_type": cell_type})
+    out["reading"] = (("model",), np.array([_reading(raw, str(n).removesuffix("_linear")) for n in names], dtype=str),
+                      {"units": "1", "long_name": "reading of Baudet's correction force the variant ran (element: each "
+                                                  "cube from the forces it receives from outside; boundary: from the "
+                                                  "loaded surface); empty for the other models"})
+    out.attrs.update({"long_run_s": LONG, "cpu_budget_s": BUDGET, "cell_type": cell_type,
+                      "baudet_reading": ",".join(sorted({str(r) for r in out.reading.values if str(r)})) or "none"})
     out.attrs.update(crossover(out))
     return with_summaries(out)
+
+
+def _reading(raw, model):
+    """The reading of Baudet's correction force that ``model`` runs in the scene ``raw`` (its
+    ``correction`` option as the engine passes it, else the default), "" for a model without it."""
+    from msslib import models as registry
+    from msslib.planning import _with_model
+
+    options = {o.name: o.default for o in registry.get(model).options}
+    if "correction" not in options:
+        return ""
+    return str(_with_model(raw, model)["model"].get("correction", options["correction"]))
 
 
 def _reference(setup, law):
