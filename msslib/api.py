@@ -152,7 +152,9 @@ def build_model(name: str, mesh, materials, *, fixed=None, loads=None, thickness
         whose nodes are fixed along every axis, or an entry ``{"select": ..., "fix": [...],
         "displacement": [...]}``, or a list of either.
     loads : a load entry (``{"type": "gravity", "g": [...]}``, ``{"type": "traction", "select": ...,
-        "traction": [...]}``, ``{"type": "nodal_force", "select": ..., "total": [...]}``) or a list.
+        "traction": [...]}``, ``{"type": "nodal_force", "select": ..., "total": [...]}``,
+        ``{"type": "pressure", "select": ..., "pressure": p, "follow": True}``: Pa, positive into the
+        body, following the deforming surface unless ``"follow": False``) or a list.
     thickness : 2D meshes (m).
     solver : the scene's ``solver`` mapping, the default of :func:`solve_static` /
         :func:`solve_dynamic`; ``{"type": "dynamic", "dt": ..., "t_end": ...}`` lets a body move

@@ -3,7 +3,7 @@
 * :func:`check_load_scale`, before a run: a load whose stress is far above the smallest Young's
   modulus (the classic: E given in MPa, loads in Pa) is refused, one line giving the ratio; a
   load above E but within :data:`REFUSE_RATIO` of it is a warning (strains above 1 ahead).  The
-  stress of a load (:func:`load_stresses`): a traction's magnitude; gravity's ``rho g L`` with
+  stress of a load (:func:`load_stresses`): a traction's magnitude, a pressure's; gravity's ``rho g L`` with
   ``L`` the extent of the mesh along ``g`` (the weight a column of that height puts on its
   base); a nodal force over the mean cross-section of the mesh across it (volume, or area times
   thickness in 2D, over its extent along the force).  These are the stresses of a bar pulled,
@@ -50,6 +50,9 @@ def load_stresses(mesh, loads, cell_density=None, thickness: float = 1.0, held: 
         if kind == "traction":
             t = float(np.linalg.norm(np.asarray(load["traction"], dtype=float)))
             out.append(LoadStress(i, t, f"traction |t| = {t:.3g} Pa"))
+        elif kind == "pressure":
+            p = abs(float(load["pressure"]))
+            out.append(LoadStress(i, p, f"pressure |p| = {p:.3g} Pa"))
         elif kind == "gravity":
             g = np.asarray(load["g"], dtype=float)
             gn = float(np.linalg.norm(g))
@@ -106,7 +109,7 @@ def check_load_scale(mesh, loads, moduli, cell_density=None, thickness: float = 
     ratio = worst.stress / E
     what = (f"{source}[{worst.index}]: the load is {times(ratio)} E ({worst.how} against the smallest Young's "
             f"modulus E = {E:.6g} Pa, scene.materials[{softest}])")
-    units = ("E is in Pa (an E given in MPa is 1e6 times larger in Pa, in GPa 1e9 times), tractions in Pa, "
+    units = ("E is in Pa (an E given in MPa is 1e6 times larger in Pa, in GPa 1e9 times), tractions and pressures in Pa, "
              "forces in N, lengths in m")
     if ratio >= REFUSE_RATIO:
         raise ValueError(f"{what}: strains of order {times(ratio)}, far beyond any elastic model; {units}; "

@@ -44,7 +44,7 @@ def nearly_incompressible(setup) -> float | None:
 
 
 def _loads(setup):
-    """``(nodal_forces, tractions, body_force)`` of the scene's loads."""
+    """``(nodal_forces, tractions, body_force)`` of the scene's loads (its pressures: ``setup.pressures``)."""
     from msslib.mesh.selection import loaded_facets, select_nodes
 
     mesh, dim = setup.mesh, setup.mesh.dim
@@ -81,9 +81,12 @@ def solve_setup(setup, *, order: int = 2, law: str | None = None, volumetric: st
               tractions=tractions, volumetric=volumetric, linear_solver=linear_solver)
     if mesh.dim == 2:
         kw.update(thickness=setup.thickness, plane=scene.model_options.get("plane", "stress"))
+    from msslib.scene.run import pressure_keywords
+
     if law is None:
-        return fem.solve_linear(mesh, E, nu, **kw)
-    return fem.solve_nonlinear(mesh, E, nu, law=law, steps=steps, tol=tol, max_iter=max_iter, initial=initial, **kw)
+        return fem.solve_linear(mesh, E, nu, **kw, **pressure_keywords(setup, fem.solve_linear))
+    return fem.solve_nonlinear(mesh, E, nu, law=law, steps=steps, tol=tol, max_iter=max_iter, initial=initial, **kw,
+                               **pressure_keywords(setup, fem.solve_nonlinear))
 
 
 def at_points(result, points, rtol: float = 1e-9):

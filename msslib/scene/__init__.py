@@ -153,7 +153,14 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
       (each must be a boundary facet) or the boundary facets of the cells of that cell group,
       those all of whose nodes lie in ``plane``/``box`` when given;
     * ``{type: nodal_force, select: SELECTION, total: [Fx, Fy(, Fz)]}`` — a total force (N) split
-      equally over the selected nodes.
+      equally over the selected nodes;
+    * ``{type: pressure, select: SELECTION, pressure: p, follow: true}`` — a pressure (Pa,
+      positive pushing into the body: the force per area is ``-p n``, ``n`` the outward normal) on
+      the boundary facets chosen as for ``traction`` (a facet group's facets are re-oriented
+      outward from their cell), consistent nodal forces (:class:`msslib.terms.Pressure`; in 2D
+      times ``thickness``).  ``follow: true`` (default): normal to the current surface, with its
+      load stiffness in Newton's tangent (non-symmetric in general: no Cholesky or CG on it);
+      ``follow: false``: dead, normal to the reference surface.  The FEM references take it too.
 ``solver``
     ``{type: static, load_steps: 1, tol: 1.0e-8, max_iter: 50}`` (default; load-stepped Newton
     of :func:`msslib.solvers.static_solve` for MSS, :func:`msslib.fem.solve_nonlinear` for the

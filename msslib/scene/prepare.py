@@ -25,7 +25,10 @@ class Setup:
     ``fixed`` (n, dim) bool and ``prescribed`` (n, dim) m; ``surface_forces`` (n, dim) N, the
     traction and nodal-force loads; ``gravity`` (dim,) m/s^2 or None; ``cell_density`` (n_cells,)
     (NaN where not given); ``masses`` (n,) kg lumped node masses (None without densities);
-    ``model`` the :class:`msslib.system.Model` of an MSS scene (None for FEM).
+    ``model`` the :class:`msslib.system.Model` of an MSS scene (None for FEM); ``pressures`` one
+    ``(facets, pressure, follow)`` per pressure load: facets ``(k, nodes per facet)`` outward
+    oriented, the pressure (Pa) at load factor 1, positive into the body, and whether it follows
+    the deforming surface.
     """
 
     scene: Scene
@@ -37,6 +40,7 @@ class Setup:
     cell_density: np.ndarray
     masses: np.ndarray | None
     model: Any = None
+    pressures: tuple = ()
 
     @property
     def thickness(self) -> float:
@@ -122,6 +126,7 @@ def prepare(scene: Scene) -> Setup:
     surface = np.zeros((n, dim))
     gravity = None
     facet_cache = {}
+    pressures = []
     for i, load in enumerate(scene.loads):
         p = f"scene.loads[{i}]"
         if load["type"] == "gravity":
@@ -131,6 +136,9 @@ def prepare(scene: Scene) -> Setup:
             total = _check_dim(f"{p}.total", load["total"], dim)
             nodes = select_nodes(f"{p}.select", mesh, load["select"], default_tol)
             surface[nodes] += total / len(nodes)
+        elif load["type"] == "pressure":
+            loaded = loaded_facets(f"{p}.select", mesh, load["select"], default_tol, facet_cache)
+            pressures.append((_outward(mesh, loaded, facet_cache), float(load["pressure"]), bool(load["follow"])))
         else:
             from msslib.terms import Traction
 
@@ -142,7 +150,7 @@ def prepare(scene: Scene) -> Setup:
     check_load_scale(mesh, scene.loads, [m.E for m in scene.materials], cell_density, thickness, fixed.any())
 
     setup = Setup(scene=scene, mesh=mesh, fixed=fixed, prescribed=prescribed, surface_forces=surface,
-                  gravity=gravity, cell_density=cell_density, masses=masses)
+                  gravity=gravity, cell_density=cell_density, masses=masses, pressures=tuple(pressures))
     if scene.is_fem:
         _check_held(scene, mesh, fixed)
         try:
@@ -153,6 +161,18 @@ def prepare(scene: Scene) -> Setup:
         setup.model = _build_model(setup)
         _check_held(scene, mesh, fixed, setup.model.terms)
     return setup
+
+
+def _outward(mesh, facets, cache) -> np.ndarray:
+    """``facets`` (boundary facets in any node order, e.g. a gmsh facet group's) as the mesh's
+    boundary lists them: outward oriented, corners in the order of their cell's facet."""
+    if "boundary" not in cache:
+        cache["boundary"] = _mesh.boundary_facets(mesh, return_cells=True)
+    boundary = cache["boundary"][0]
+    if boundary.shape[1] != facets.shape[1]:
+        raise ValueError(f"facets of {facets.shape[1]} nodes on a mesh whose boundary facets have {boundary.shape[1]}")
+    index = {tuple(sorted(f)): i for i, f in enumerate(boundary.tolist())}
+    return boundary[[index[tuple(sorted(f))] for f in np.asarray(facets).tolist()]]
 
 
 # --------------------------------------------------------------------------------------------
@@ -169,8 +189,16 @@ def _build_model(setup: Setup):
     spec = _models.get(name)
     if mesh.cell_type not in spec.cells:
         _fail("scene.model", f"{name} needs {spec.cell_type} cells, the mesh has {mesh.cell_type} cells")
+    from msslib.terms import Pressure
+
+    # the pressure terms (scaled by the load factor), one per load, named by the load's index
+    at = [i for i, load in enumerate(scene.loads) if load["type"] == "pressure"]
+    pressures = [Pressure(mesh, facets, p, follow=follow, thickness=setup.thickness, name=f"pressure_{i}")
+                 for i, (facets, p, follow) in zip(at, setup.pressures)]
+    # the surface loads a model's build reads (Baudet's correction): the pressures' forces at rest
+    surface = setup.surface_forces + sum((t.nodal for t in pressures), np.zeros_like(setup.surface_forces))
     ctx = _models.BuildContext(mesh=mesh, materials=[(m.E, m.nu) for m in scene.materials], options=opts,
-                               thickness=setup.thickness, surface_forces=setup.surface_forces)
+                               thickness=setup.thickness, surface_forces=surface)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
@@ -182,5 +210,6 @@ def _build_model(setup: Setup):
         terms.append(NodalForces(setup.surface_forces))
     if setup.gravity is not None:
         terms.append(Gravity(setup.masses, setup.gravity))
+    terms += pressures
     damping = scene.solver.get("damping", 0.0) if scene.is_dynamic else 0.0
     return Model(mesh, terms, fixed=setup.fixed, prescribed=setup.prescribed, masses=setup.masses, damping=damping)

@@ -38,6 +38,8 @@ def _solve_fem(setup: Setup, report):
     if mesh.dim == 2:
         kw.update(thickness=setup.thickness, plane=scene.model_options["plane"])
     law = _models.get(scene.model).law
+    kw.update(pressure_keywords(setup, fem.solve_linear if law is None or scene.solver.get("linear")
+                                else fem.solve_nonlinear))
     if law is None or scene.solver.get("linear"):
         res = fem.solve_linear(mesh, E, nu, **kw)
     else:
@@ -50,6 +52,20 @@ def _solve_fem(setup: Setup, report):
     stats = {"type": "static", **res.stats}
     return {"displacement": res.displacement, "reaction": res.reaction, "stats": stats,
             "extra_attrs": {"strain_energy": res.strain_energy}}
+
+
+def pressure_keywords(setup: Setup, solve) -> dict:
+    """``{"pressures": setup.pressures}`` for the FEM function ``solve``, or ``{}`` without pressure
+    loads; a ValueError naming the load when ``solve`` takes no pressures."""
+    import inspect
+
+    if not setup.pressures:
+        return {}
+    if "pressures" not in inspect.signature(solve).parameters:
+        i = next(i for i, load in enumerate(setup.scene.loads) if load["type"] == "pressure")
+        raise ValueError(f"scene.loads[{i}]: the FEM reference ({solve.__name__}) takes no pressure loads in this "
+                         f"version; allowed for {setup.scene.model}: gravity, nodal_force, traction")
+    return {"pressures": setup.pressures}
 
 
 def _solve_mss_static(setup: Setup, report):

@@ -34,7 +34,7 @@ MSS_MODELS = {name: (spec.cell_type, spec.terms) for name, spec in _models.regis
 FEM_MODELS = {name: spec.law for name, spec in _models.registry().items() if spec.kind == "fem"}
 MODELS = tuple(_models.names())
 
-LOAD_TYPES = ("gravity", "nodal_force", "traction")
+LOAD_TYPES = ("gravity", "nodal_force", "traction", "pressure")
 SOLVER_TYPES = ("static", "dynamic")
 METHODS = ("symplectic_euler", "velocity_verlet", "implicit_euler")
 _TOP_KEYS = ("name", "description", "geometry", "materials", "regions", "thickness", "model", "boundary",
@@ -303,7 +303,7 @@ def _boundary(path, value):
 
 
 _LOAD_KEYS = {"gravity": ("type", "g"), "traction": ("type", "select", "traction"),
-              "nodal_force": ("type", "select", "total")}
+              "nodal_force": ("type", "select", "total"), "pressure": ("type", "select", "pressure", "follow")}
 
 
 def _loads(path, value):
@@ -316,10 +316,14 @@ def _loads(path, value):
             _fail(f"{p}.type", f"required key missing; one of {', '.join(LOAD_TYPES)}")
         kind = _choice(f"{p}.type", load["type"], LOAD_TYPES, "load type")
         keys = _LOAD_KEYS[kind]
-        _mapping(p, load, keys, required=keys)
+        _mapping(p, load, keys, required=keys[:3])
         entry = {"type": kind}
         if kind == "gravity":
             entry["g"] = _vector(f"{p}.g", load["g"])
+        elif kind == "pressure":  # Pa, positive into the body; follow: normal to the current surface
+            entry["select"] = _selection(f"{p}.select", load["select"])
+            entry["pressure"] = _number(f"{p}.pressure", load["pressure"], what="a number (Pa, positive into the body)")
+            entry["follow"] = _boolean(f"{p}.follow", load.get("follow", True))
         else:
             entry["select"] = _selection(f"{p}.select", load["select"])
             key = keys[2]

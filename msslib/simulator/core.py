@@ -9,6 +9,8 @@ import numpy as np
 
 from msslib.solvers.dynamics import Integrator
 
+from msslib.terms.pressure import pressure_nodal_forces
+
 from .loads import time_function
 from msslib.explicit.network import network_terms
 
@@ -70,7 +72,9 @@ class Simulator:
     * :meth:`set_load`: the load factor of the model's own loads (and prescribed displacements);
     * :meth:`apply_force`: nodal forces on a selection (per node, or a total shared equally);
     * :meth:`prescribe`: a displacement of a selection along a path (a tool); its dofs stop
-      being free and their reactions are what the tool must push with.
+      being free and their reactions are what the tool must push with;
+    * :meth:`apply_pressure`: a pressure on boundary facets, following the current surface (its
+      forces evaluated every step on the current positions) or dead (constant forces).
 
     State, read as snapshots (read-only copies taken when read, on every engine; they do not
     follow later steps): :attr:`x` and :attr:`v` (``(n_nodes, dim)``), :attr:`reaction` (``-f``
@@ -118,6 +122,7 @@ class Simulator:
         self._load, self._load_varies = time_function(load, "load")
         self._value(self._load, 0.0, "load", ())
         self._forces: dict[int, tuple] = {}
+        self._pressures: dict[int, tuple] = {}
         self._shift_cache: dict = {}
         self._paths: dict[int, tuple] = {}
         self._next = 0
@@ -134,7 +139,7 @@ class Simulator:
         if self._engine_request == "jax":
             from msslib.explicit.jax_backend import use_jax
 
-            if self._varies() or self._forces or self._paths:
+            if self._varies() or self._forces or self._paths or self._pressures:
                 raise ValueError("engine='jax' runs constant loads: a load curve, nodal forces or prescribed paths "
                                  "run on the network engine (engine='network')")
             if use_jax("jax"):  # else a warning names the reason and the network engine runs
@@ -159,7 +164,7 @@ class Simulator:
 
     def _varies(self) -> bool:
         return (self._load_varies or any(e[3] for e in self._forces.values())
-                or any(e[2] for e in self._paths.values()))
+                or any(e[2] for e in self._paths.values()) or any(e[4] for e in self._pressures.values()))
 
     def _build(self, x, v, t, n_taken):
         self.engine = self._engine()
@@ -207,11 +212,14 @@ class Simulator:
             x2[dofs // self.dim, dofs % self.dim] = model.x0[dofs] + np.repeat(u[None, :], dofs.size // u.size, 0).ravel()
         if st is None:
             return
-        if self._forces:
+        if self._forces or self._pressures:
             extra = np.zeros(model.n_dof)
             for dofs, fn, share, _ in self._forces.values():
                 f = fn(t) * share
                 np.add.at(extra, dofs, np.tile(f, dofs.size // f.size))
+            for facets, fn, follow, thickness, _ in self._pressures.values():  # follower: at the current x
+                on = x2 if follow else model.x0.reshape(-1, self.dim)
+                extra += pressure_nodal_forces(on, facets, fn(t), thickness).ravel()
             st.extra = extra
         else:
             st.extra = None
@@ -246,13 +254,13 @@ class Simulator:
         """Apply ``change()`` (which edits the load tables) and rebuild; on any error restore the
         tables and the stepper as they were, so a refused call changes nothing."""
         saved = (self._load, self._load_varies, dict(self._forces), dict(self._paths), self._next,
-                 self._stepper, self.engine)
+                 self._stepper, self.engine, dict(self._pressures))
         try:
             out = change()
             self._rebuild()
         except BaseException:
             (self._load, self._load_varies, self._forces, self._paths, self._next,
-             self._stepper, self.engine) = saved
+             self._stepper, self.engine, self._pressures) = saved
             raise
         return out
 
@@ -342,6 +350,50 @@ class Simulator:
         fn(self.t)
         return self._add(self._paths, (self._dofs(nodes, ax), fn, varies))
 
+    def apply_pressure(self, facets, pressure, *, follow: bool = True, thickness: float = 1.0) -> int:
+        """Add a pressure ``pressure`` (Pa, positive into the body; a number, a callable of time or
+        a table ``[[t, p], ...]``) on boundary facets: ``facets`` node ids ``(k, 2)`` (2D) or
+        ``(k, 3|4)`` (3D) of boundary facets in any node order, or a selection dict as the scene's
+        ``select`` of a pressure load.  ``follow`` (default): the consistent forces of the current
+        surface, evaluated every step on the current positions; else dead, constant forces normal
+        to the rest surface (:func:`msslib.terms.pressure_nodal_forces`); 2D: ``thickness`` (m).
+        Not scaled by the load factor.  Returns a handle for :meth:`remove`."""
+        from msslib.mesh.selection import loaded_facets
+        from msslib.scene.prepare import _outward
+
+        mesh = self.model.mesh
+        if not isinstance(follow, (bool, np.bool_)):
+            raise ValueError(f"follow must be True or False, got {follow!r}")
+        if isinstance(facets, dict):
+            size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if mesh.n_nodes else 1.0
+            found = loaded_facets("facets", mesh, facets, max(1e-8 * size, 1e-15), {})
+        else:
+            found = np.asarray(facets)
+            nf = (2,) if self.dim == 2 else (3, 4)
+            if found.ndim != 2 or found.shape[1] not in nf or found.dtype.kind not in "iu" or not len(found):
+                raise ValueError(f"facets must be node ids of shape (k, {' or '.join(map(str, nf))}) with k >= 1 "
+                                 f"on a {self.dim}D mesh, or a selection dict, got {facets!r}")
+            if found.min() < 0 or found.max() >= self.n_nodes:
+                raise ValueError(f"facets: node ids must lie in 0..{self.n_nodes - 1}, got "
+                                 f"{int(found[(found < 0) | (found >= self.n_nodes)][0])}")
+            from msslib.mesh import facet_cell_counts
+
+            counts = facet_cell_counts(mesh, found)
+            if np.any(counts != 1):
+                i = int(np.flatnonzero(counts != 1)[0])
+                raise ValueError(f"facets: {int(np.sum(counts != 1))} of {len(found)} facets are not on the boundary "
+                                 f"of the mesh (facet {i}, nodes {found[i].tolist()}); allowed: boundary facets")
+        found = _outward(mesh, found.astype(np.int64), {})
+        if self.dim == 3 and float(thickness) != 1.0:
+            raise ValueError(f"thickness applies to 2D meshes only, got {thickness!r}")
+        thickness = _finite(thickness, "thickness", "a finite thickness > 0 (m)")
+        if thickness <= 0:
+            raise ValueError(f"thickness must be a finite thickness > 0 (m), got {thickness!r}")
+        fn, varies = time_function(pressure, "pressure")
+        fn = self._checked(fn, "pressure", (), callable(pressure))
+        fn(self.t)
+        return self._add(self._pressures, (found, fn, bool(follow), thickness, varies or bool(follow)))
+
     def _add(self, table, entry):
         def change():
             handle = self._next
@@ -353,12 +405,12 @@ class Simulator:
 
     def remove(self, handle: int) -> None:
         """Remove a force or a prescribed path (its nodes move freely again)."""
-        for table in (self._forces, self._paths):
+        for table in (self._forces, self._paths, self._pressures):
             if isinstance(handle, (numbers.Integral, np.integer)) and not isinstance(handle, bool) and handle in table:
                 self._transaction(lambda: table.pop(handle))
                 return
-        raise KeyError(f"handle: no force or path with handle {handle!r} (handles: "
-                       f"{sorted([*self._forces, *self._paths])})")
+        raise KeyError(f"handle: no force, path or pressure with handle {handle!r} (handles: "
+                       f"{sorted([*self._forces, *self._paths, *self._pressures])})")
 
     # ---- stepping ------------------------------------------------------------------------
 
@@ -382,7 +434,7 @@ class Simulator:
         t0 = time.perf_counter()
         st = self._stepper
         user = (getattr(self._load, "user", False) or any(e[1].user for e in self._forces.values())
-                or any(e[1].user for e in self._paths.values()))
+                or any(e[1].user for e in self._paths.values()) or any(e[1].user for e in self._pressures.values()))
         saved = (st.x.copy(), st.v.copy(), st.t, st.n_taken) if user else None  # a callable may raise
         try:
             if self.engine in ("network", "jax"):
