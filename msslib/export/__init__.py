@@ -13,7 +13,9 @@ displacements, the loads and gravity. The writers turn it into
     ``hex_volume`` (Golec), ``baudet_correction`` (factor and face forces per cell) and
     ``baudet_correction_forces`` (the nodal forces it adds at load factor 1),
     ``baudet_element_correction`` (Baudet's element reading: k_edge, k_diagonal, factor per cube),
-    ``delingette_triangle`` (Delingette's six constants and rest squared lengths per triangle): each
+    ``delingette_triangle`` (Delingette's six constants and rest squared lengths per triangle),
+    ``pressure_I`` and ``pressure_I_forces`` for the pressure load ``loads[I]`` of the scene (its
+    outward facets, pressure and reading, and its nodal forces at rest at load factor 1): each
     term gives its own tables (:meth:`msslib.terms.Term.export_tables`). Node indices are
     0-based. Floats are written with ``repr`` (they read back bit for bit): :func:`msslib.export.text.read_csv`.
 ``json``
@@ -52,6 +54,11 @@ module there and its test. Which terms a format carries each term says itself
 (:attr:`msslib.terms.Term.export_formats`; a format may also take terms by its own rule), and a
 format that leaves one out says so in the file and on the command line, naming the model and the
 term.
+
+Pressure loads: a dead pressure is carried by every format (its constant nodal forces at load factor
+1, labelled ``pressure_I``, beside the surface loads); a follower pressure, whose forces follow the
+deforming surface, only by the CSV and JSON tables: the VTU, MuJoCo and SOFA files say in a comment
+that they do not carry it, and the command line says so too for MuJoCo and SOFA.
 
 Units are SI throughout. The writers are in :mod:`msslib.export.text` (CSV, JSON, VTU) and
 :mod:`msslib.export.simulators` (MuJoCo, SOFA); :mod:`msslib.export.files` chooses formats and

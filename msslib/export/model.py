@@ -147,7 +147,7 @@ def from_setup(setup) -> MssExport:
     for t in model.terms:
         if t.kind == "springs":
             springs.append(t)
-        elif t.kind == "external":
+        elif t.kind == "external" and not t.export_name:
             pass  # the scene's surface loads and gravity, taken from the setup below
         elif t.kind is not None and t.export_name:
             if any(o.export_name == t.export_name for o in others):

@@ -150,4 +150,16 @@ def write_vtu(path, exp: MssExport) -> Path:
         cells, cell_data = [("vertex", np.arange(len(exp.points), dtype=np.int64)[:, None])], {}
     mesh = meshio.Mesh(_pad3(exp.points), cells, point_data=point_data, cell_data=cell_data)
     meshio.write(path, mesh, file_format="vtu")
+    from msslib.export import formats
+    from msslib.export.model import not_carried
+
+    missing = not_carried(exp, "vtu")
+    if any(t.kind == "external" for t in exp.terms if not formats.get("vtu").carries_term(t)):
+        # a load the file cannot hold (a follower pressure): said in an XML comment after the declaration
+        note = ("NOT CARRIED (a ParaView file of the model at rest): " + "; ".join(missing).replace("--", "- -")
+                + ". The CSV/JSON export carries them.")
+        raw = Path(path).read_bytes()
+        head, sep, rest = raw.partition(b"?>")
+        Path(path).write_bytes(head + sep + f"\n<!-- {note} -->".encode() + rest if sep else
+                               f"<!-- {note} -->\n".encode() + raw)
     return Path(path)

@@ -67,6 +67,7 @@ def _facet_forces(X, p, thickness):
         normal = np.stack([d[:, 1], -d[:, 0]], axis=1)  # outward normal times the length
         f = -(0.5 * thickness * p)[:, None] * normal
         return np.repeat(f[:, None, :], 2, axis=1)
+    X = X - X[:, :1]  # the sum is the same about any origin (sum_b C_abc = 0); about a corner it rounds less
     out = np.zeros((k, nf, 3))
     for b, c, a_bc in _pairs(_coefficients(nf)):
         cross = np.cross(X[:, b], X[:, c])
@@ -96,7 +97,7 @@ def _facet_stiffness(X, p, thickness):
         return K
     C = _coefficients(nf)
     D = np.transpose(C, (0, 2, 1)) - C  # D[a, m, c] = C_acm - C_amc
-    S = _skew(X)  # (k, nf, 3, 3)
+    S = _skew(X - X[:, :1])  # (k, nf, 3, 3); about a corner, as the forces
     K = np.einsum("amc,ecij->eamij", D, S)
     return K * p[:, None, None, None, None]
 
