@@ -65,26 +65,49 @@ def _problem_class():
         and the band orderings of the solver context; the state stays the displacement (a
         position ``X + u`` would round a small ``u`` to the precision of ``X``)."""
 
-        def __init__(self, internal: Callable, f_ext, constrained, prescribed, points):
+        def __init__(self, internal: Callable, f_ext, constrained, prescribed, points, followers=()):
             super().__init__(internal, f_ext, constrained, prescribed)
             self.coordinates = np.asarray(points, dtype=float)
             self.dim = int(self.coordinates.shape[1])
+            self.followers = list(followers)
+            # a follower pressure's load stiffness is not symmetric in general: LU, never Cholesky/CG
+            self.symmetric = not self.followers
+
+        def _follower(self, u):
+            return sum((load.forces(u) for load in self.followers), np.zeros(self.n_dof))
+
+        def force(self, u, load=1.0):
+            f = super().force(u, load)
+            return f + load * self._follower(u) if self.followers and load != 0.0 else f
+
+        def stiffness(self, u, load=1.0):
+            K = super().stiffness(u, load)
+            for f in self.followers:  # K = -d force / d u
+                K = K - load * f.stiffness(u)
+            return K
+
+        def force_magnitude(self, u, load=1.0):
+            m = super().force_magnitude(u, load)
+            return m + abs(load) * np.abs(self._follower(u)) if self.followers else m
 
     return LocatedProblem
 
 
 def newton_solve(internal, f_ext, constrained, prescribed, points, *, steps: int, tol: float, max_iter: int,
                  max_halvings: int, progress: Callable[[int, int], None] | None = None, linear_solver="auto",
-                 initial=None):
+                 initial=None, followers=()):
     """Solve ``f_int(u) = f_ext`` from ``u = 0`` by :func:`msslib.solvers.static_solve` (Newton
     without line search, ``steps`` load increments each halved at most ``max_halvings`` times in a
     row, the convergence test of the mass-spring models) with the linear solver chosen by the
     policy of :mod:`msslib.solvers`. ``internal(u, tangent)`` -> ``(f_int, K, energy, f_abs)``.
-    ``initial``: the first iterate (all dofs, flat; default zero).
+    ``initial``: the first iterate (all dofs, flat; default zero). ``followers``: loads at load
+    factor 1 with ``forces(u)`` and ``stiffness(u)`` (``d forces / d u``), e.g.
+    :class:`msslib.fem.pressure.FacetPressure`, scaled by the load factor; with any, the tangent
+    is treated as non-symmetric.
     Returns ``(u, stats)`` as :func:`msslib.solvers.displacement.solve_displacement`."""
     from msslib.solvers import static_solve
 
-    problem = _problem_class()(internal, f_ext, constrained, prescribed, points)
+    problem = _problem_class()(internal, f_ext, constrained, prescribed, points, followers)
     reported = [1]
 
     def on_load_step(_count, lam):

@@ -73,6 +73,7 @@ def solve_linear(
     linear_solver="auto",
     volumetric: str = "full",
     quadrature: str = "full",
+    pressures=(),
 ) -> FemResult:
     """Small-strain isotropic linear elasticity on ``mesh``.
 
@@ -100,13 +101,21 @@ def solve_linear(
     :class:`numpy.linalg.LinAlgError` naming them, and ``stats["hourglass_energy_fraction"]`` is
     the share of the solution's full-quadrature (bilinear) energy that the one-point element does
     not see, with a :class:`~msslib.errors.MsslibWarning` above :data:`HOURGLASS_WARN`.
+
+    ``pressures``: tuples ``(facets, pressure, follow)`` of outward boundary facets (node indices,
+    ``(k, nodes per facet)``, as :func:`msslib.mesh.boundary_facets` gives them), a pressure (Pa,
+    positive pushes into the body: traction ``-p n``) and ``follow``; integrated on the element's
+    facets (quadratic ones with order 2, see :mod:`msslib.fem.pressure`). In small strain the
+    current surface is the reference one, so ``follow`` has no effect here.
     """
     from msslib.fem.newton import SOLVER
+    from msslib.fem.pressure import check_pressures, facet_pressures
 
     t0 = time.perf_counter()
     _check_plane(plane, mesh.dim)
     if thickness <= 0:
         raise ValueError(f"thickness={thickness!r} must be > 0")
+    pressures = check_pressures(pressures, mesh)
     E_c, nu_c = _cell_materials(mesh, E, nu)
     if order == 1:
         warn_locking(mesh, nu_c, plane)
@@ -131,6 +140,8 @@ def solve_linear(
     else:
         raise ValueError(f"assembly must be 'fast' or 'skfem', got {assembly!r}")
     cons, presc, f = _boundary(mesh, fixed, prescribed, nodal_forces, body_force, geo, thickness, tractions)
+    for load in facet_pressures(geo, pressures, thickness):
+        f = f + load.forces()
     t1 = time.perf_counter()
 
     u = presc.copy()
@@ -278,8 +289,9 @@ def solve_nonlinear(
     linear_solver="auto",
     volumetric: str = "full",
     initial=None,
+    pressures=(),
 ) -> FemResult:
-    """Geometrically non-linear (total Lagrangian) reference solution with dead loads.
+    """Geometrically non-linear (total Lagrangian) reference solution with dead loads and pressures.
 
     ``law``: ``"svk"`` (St Venant-Kirchhoff, Green-Lagrange strain) or ``"neohookean"``
     (``W = mu/2 (I1 - 3) - mu ln J + lam/2 (ln J)^2``). Loads and prescribed displacements are
@@ -309,8 +321,16 @@ def solve_nonlinear(
     ``n_dofs``, ``wall_time``, ``solver``, ``tol``, ``roundoff_floor`` and ``threshold`` (of the
     last converged increment, absolute), ``roundoff_steps`` (increments accepted at the floor,
     1-based) and ``messages``.
+
+    ``pressures``: tuples ``(facets, pressure, follow)`` as in :func:`solve_linear`, scaled by the
+    load factor. ``follow=False``: dead, normal to the reference surface (added to the external
+    forces). ``follow=True``: normal to the current surface (:mod:`msslib.fem.pressure`); its
+    force enters the residual and its load stiffness the tangent, which is then not symmetric
+    (solved by LU, never by Cholesky or CG). ``strain_energy`` is the internal energy; ``reaction``
+    includes the pressure forces at the solution.
     """
     from msslib.fem.newton import NEWTON, newton_solve
+    from msslib.fem.pressure import check_pressures, facet_pressures
 
     t0 = time.perf_counter()
     d = mesh.dim
@@ -322,6 +342,7 @@ def solve_nonlinear(
         raise ValueError(f"steps={steps!r} must be >= 1")
     if thickness <= 0:
         raise ValueError(f"thickness={thickness!r} must be > 0")
+    pressures = check_pressures(pressures, mesh)
     E_c, nu_c = _cell_materials(mesh, E, nu)
     if order == 1:
         warn_locking(mesh, nu_c, plane)
@@ -339,6 +360,11 @@ def solve_nonlinear(
             raise ValueError(f"initial is a guess of the solution: it needs steps=1, got steps={steps!r}")
         x0 = np.asarray(geo.interp @ guess).ravel()
     cons, presc, f_ext = _boundary(mesh, fixed, prescribed, nodal_forces, body_force, geo, thickness, tractions)
+    loads = facet_pressures(geo, pressures, thickness)
+    for load in loads:
+        if not load.follow:
+            f_ext = f_ext + load.forces()
+    followers = [load for load in loads if load.follow]
     free = ~cons
     pl = plane if d == 2 else None
     parts = _parts(mesh, geo, lam_c, mu_c, volumetric, pl)
@@ -374,9 +400,9 @@ def solve_nonlinear(
 
     u, newton = newton_solve(internal, f_ext, cons, presc, geo.points, steps=steps, tol=tol, max_iter=max_iter,
                              max_halvings=max_halvings, progress=progress, linear_solver=linear_solver,
-                             initial=x0)
+                             initial=x0, followers=followers)
     fint, _, energy, _ = internal(u, tangent=False)
-    r = fint - f_ext
+    r = fint - f_ext - sum((load.forces(u) for load in followers), np.zeros_like(f_ext))
     reaction = np.where(cons, r, 0.0)
     stats = {"n_dofs": int(u.size), "n_free_dofs": int(free.sum()), **newton, "law": law, "plane": pl,
              "wall_time": time.perf_counter() - t0, "solver": NEWTON, "order": order, "volumetric": volumetric}
