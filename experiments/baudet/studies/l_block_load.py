@@ -5,7 +5,7 @@ solution is singular along the loaded edges. Here the same block carries, beside
 force as a uniform traction (+x) on the faces normal to x (x = 0, 2 and 4 m: 32 m^2, 0.625 Pa), whose
 solution has no singularity at the load. For each load, the MSS (derived factor, both readings of the
 correction) at n = 2, 4, 8 cubes per edge (Baudet's) and 16 is compared with linear FEM
-on a fine mesh (Q1, n = 32; the experiment ``l_block`` compares against n = 16) and with linear
+on a fine mesh (Q1, n = 48, as the experiment ``l_block``) and with linear
 FEM on the MSS's own mesh (Q1, same nodes, same nodal loads: the lattice's error alone, without the discretisation of the singular field); the same-mesh
 FEM is also compared with the fine reference. Errors as in the experiment: per-node |u - u_ref| over
 the largest reference displacement (Baudet's M, SD, MAX). The rate of a refinement is the ratio of
@@ -22,7 +22,7 @@ from experiments.baudet import make_l_block as LB
 
 LOADS = ("line", "face")
 NS = (2, 4, 8, 16)  # n = 16 has no published counterpart: the refinement continued
-REF_N = 32
+REF_N = 48  # the experiment l_block's reference
 MODELS = ("mss_boundary", "mss_element", "fem_same_mesh")
 STATS = ("mean", "sd", "max")
 FACES = (0.0, 2.0, 4.0)  # x of the faces normal to x (boundary facets only: at x = 2 the upper arm's face)
