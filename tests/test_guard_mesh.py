@@ -289,7 +289,7 @@ BAD_FILES = {
     "not_utf8": "not UTF-8",
     "unknown_suffix": r"unknown mesh file suffix '\.xyz'; allowed: the suffixes meshio reads.*\.msh.*\.vtu",
     "directory": "is a directory",
-    "no_cells": r"the mesh has no cells \(3 points\); allowed: triangle, quad, tetra, hexahedron cells",
+    "no_cells": r"the mesh has no cells \(3 points\); allowed: " + ", ".join(M.CELL_TYPES) + " cells",  # the registry's
     "node_out_of_range": r"tetra cell 0 refers to node 7, which does not exist; allowed: nodes 0 to 3",
     "nan_coordinate": r"node 3 has coordinates \(0, 0, nan\)",
     "fractional_material": r"cell data 'material' of cell 0 is 0\.5; allowed: integer",

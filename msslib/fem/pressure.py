@@ -45,7 +45,7 @@ def check_pressures(pressures, mesh) -> list:
                          f"{type(pressures).__name__}") from None
     out = []
     boundary = None
-    nf = boundary_facets(mesh).shape[1] if len(mesh.cells) else 0
+    nf = boundary_facets(mesh).shape[1] if len(mesh.cells) and items else 0  # (no facets to find without pressures)
     for n, item in enumerate(items):
         if not isinstance(item, (tuple, list)) or len(item) != 3:
             raise ValueError(f"pressures[{n}] must be a tuple (facets, pressure, follow), got {item!r:.80}")

@@ -6,7 +6,9 @@ Conventions (shared by every module of msslib):
 * ``cells`` has shape ``(n_cells, nodes_per_cell)``; node order is meshio's/VTK's:
   ``triangle`` and ``quad`` counter-clockwise; ``tetra`` positively oriented
   (``det[p1-p0, p2-p0, p3-p0] > 0``); ``hexahedron`` nodes 0-3 the bottom face counter-clockwise
-  seen from above, 4-7 the top face, node ``i + 4`` above node ``i``.
+  seen from above, 4-7 the top face, node ``i + 4`` above node ``i``; ``wedge`` nodes 0-2 the
+  bottom triangle clockwise seen from above (its normal points out), 3-5 the top triangle, node
+  ``i + 3`` above node ``i``.
 * ``material`` has shape ``(n_cells,)``: an index into the list of materials of a model.
 * ``cell_groups``, ``facet_groups``, ``node_groups``: named groups of cells, boundary facets and
   nodes from a mesh file (see :class:`Mesh` and :func:`read`).
@@ -14,11 +16,14 @@ Conventions (shared by every module of msslib):
 Contents of this package, one concern per module; every name below is importable from ``msslib.mesh``
 (all lengths in metres, areas in m^2, volumes in m^3):
 
-* :mod:`msslib.mesh.core`: :class:`Mesh`, :data:`CELL_TYPES`, the local numbering tables of
-  the cell types, :data:`COINCIDENT_RTOL`, :data:`COINCIDENT_POLICIES`;
+* :mod:`msslib.mesh.cells`: the cell types, one module each (``triangle``, ``quad``, ``tetra``,
+  ``hexahedron``, ``wedge``), found by :func:`msslib.mesh.cells.registry`: their local numbering
+  (edges, faces of each facet type), measure, refinement rule, scikit-fem elements and names;
+* :mod:`msslib.mesh.core`: :class:`Mesh`, :data:`CELL_TYPES` (read from the cell registry),
+  :data:`COINCIDENT_RTOL`, :data:`COINCIDENT_POLICIES`;
 * :mod:`msslib.mesh.structured`, structured generators: :func:`quad_grid`,
   :func:`triangle_grid_right`, :func:`triangle_grid_equilateral` (with :func:`equilateral_rows`),
-  :func:`hexagon_equilateral`, :func:`hex_grid`, :func:`tet_grid`, :func:`l_block_hex`;
+  :func:`hexagon_equilateral`, :func:`hex_grid`, :func:`tet_grid`, :func:`wedge_grid`, :func:`l_block_hex`;
 * :mod:`msslib.mesh.unstructured`, meshes generated with gmsh: :func:`polygon_mesh`,
   :func:`cylinder_mesh`, :func:`cylinder_with_hole_mesh`, :func:`cone_mesh`, :func:`l_block_tet`.
   Element sizes are at most ``h``, refined to about 12 elements per full circle on curved
@@ -32,8 +37,9 @@ Contents of this package, one concern per module; every name below is importable
 * :mod:`msslib.mesh.groups`, groups and selections: :func:`materials_from_groups` (a material
   index per cell from cell groups), :func:`select_nodes`;
 * :mod:`msslib.mesh.topology`: :class:`NodePairs`, :func:`unique_edges`, :func:`face_diagonals`,
-  :func:`inner_diagonals`, :func:`boundary_facets`, :func:`facet_cell_counts` (is a facet a face
-  of the mesh);
+  :func:`inner_diagonals`, :func:`boundary_facets`, :func:`boundary_facets_by_type` (of a cell type
+  with facets of several types: a wedge has triangles and quads), :func:`facet_cell_counts` (is a
+  facet a face of the mesh);
 * :mod:`msslib.mesh.geometry`: :func:`cell_measures`, :func:`check_cells`, :func:`orient`,
   :func:`facet_areas`, :func:`lumped_masses`;
 * :mod:`msslib.mesh.hygiene`: :func:`coincident_nodes` and :func:`resolve_coincident_nodes`
@@ -80,10 +86,12 @@ from .structured import (
     tet_grid,
     triangle_grid_equilateral,
     triangle_grid_right,
+    wedge_grid,
 )
 from .topology import (
     NodePairs,
     boundary_facets,
+    boundary_facets_by_type,
     face_diagonals,
     facet_cell_counts,
     inner_diagonals,
@@ -108,6 +116,7 @@ __all__ = [
     "hexagon_equilateral",
     "hex_grid",
     "tet_grid",
+    "wedge_grid",
     "l_block_hex",
     "polygon_mesh",
     "cylinder_mesh",
@@ -125,6 +134,7 @@ __all__ = [
     "face_diagonals",
     "inner_diagonals",
     "boundary_facets",
+    "boundary_facets_by_type",
     "facet_areas",
     "cell_measures",
     "check_cells",

@@ -1,5 +1,6 @@
 """Structured meshes generated without gmsh: :func:`quad_grid`, :func:`triangle_grid_right`,
 :func:`triangle_grid_equilateral` (with :func:`equilateral_rows`), :func:`hexagon_equilateral`,
+:func:`wedge_grid`,
 :func:`hex_grid`, :func:`tet_grid` and :func:`l_block_hex`.  All lengths in metres.
 
 The L-shaped block (:func:`l_block_hex`, and :func:`msslib.mesh.l_block_tet` meshed by gmsh) of
@@ -164,6 +165,20 @@ def hex_grid(lx: float, ly: float, lz: float, nx: int, ny: int, nz: int, origin=
     points = _grid3_points(lx, ly, lz, nx, ny, nz, origin)
     corners, _ = _grid3_cube_corners(nx, ny, nz)
     return Mesh(points, corners, "hexahedron")
+
+
+def wedge_grid(lx: float, ly: float, lz: float, nx: int, ny: int, nz: int, origin=(0.0, 0.0, 0.0)) -> Mesh:
+    """Box of :func:`hex_grid` with each cube split into two wedges (triangular prisms) along the
+    diagonal of its bottom face from corner 0 to corner 2, their triangles in planes z = const.
+
+    Same nodes as :func:`hex_grid`; ``2 * nx * ny * nz`` positively oriented wedges (VTK order:
+    the triangle of nodes 0-2 below, its normal pointing down, out of the cell), the two halves of
+    a cube numbered consecutively.
+    """
+    hexes = hex_grid(lx, ly, lz, nx, ny, nz, origin)
+    c = hexes.cells
+    halves = np.stack([c[:, [0, 2, 1, 4, 6, 5]], c[:, [0, 3, 2, 4, 7, 6]]], axis=1)
+    return Mesh(hexes.points, halves.reshape(-1, 6), "wedge")
 
 
 # Five tetrahedra of a cube whose corner 0 has even parity: the central tetrahedron joins the even

@@ -8,6 +8,7 @@ import warnings
 
 import numpy as np
 
+from msslib.mesh import cells as _cells
 from msslib.models.spec import ModelSpec, Option, choice
 
 __all__: list = []  # no spring-constant formulas (msslib.parameters gathers the families' __all__)
@@ -17,7 +18,8 @@ RANK = 0
 
 VALID_NU: dict = {}
 
-CELLS = ("triangle", "quad", "tetra", "hexahedron")
+#: every cell type of the registry (msslib.mesh.cells): each has a linear scikit-fem element
+CELLS = _cells.names()
 
 _PLANE = Option("plane", choice("stress", "strain", what="plane"), "stress",
                 "2D meshes: plane stress (default) or plane strain")
@@ -37,8 +39,6 @@ SPECS = (
 
 #: at and above this Poisson's ratio a FEM solve warns that its linear elements lock
 LOCKING_NU = 0.45
-_ELEMENT_NAMES = {"triangle": "P1 triangles", "quad": "Q1 quadrilaterals with full 2x2 integration",
-                  "tetra": "P1 tetrahedra", "hexahedron": "Q1 hexahedra with full 2x2x2 integration"}
 
 
 def warn_locking(mesh, nu_c, plane) -> None:
@@ -51,7 +51,8 @@ def warn_locking(mesh, nu_c, plane) -> None:
     nu_max = float(np.max(nu_c)) if np.size(nu_c) else 0.0
     if nu_max < LOCKING_NU or (mesh.dim == 2 and plane == "stress"):
         return
-    warnings.warn(f"linear-element FEM locks near nu = 1/2 (nu = {nu_max:.6g}, {_ELEMENT_NAMES[mesh.cell_type]}): "
+    element = _cells.get(mesh.cell_type).linear.title
+    warnings.warn(f"linear-element FEM locks near nu = 1/2 (nu = {nu_max:.6g}, {element}): "
                   f"its displacements are too small, by a factor that depends on the mesh (a clamped cube of "
                   f"3^3 hexahedra at nu = 0.4999 settles 3.7 times less than one of 6^3); use quadratic elements with "
                   f"the volumetric part reduced (msslib.fem: order=2, volumetric='reduced'), or nu < {LOCKING_NU} "

@@ -236,6 +236,7 @@ def check_scene(scene, *, levels=(1, 2, 3), models=None):
     ``(raw, base_dir, cell_type, models, reference_model)``; ValueError (or FileNotFoundError)
     naming what is wrong."""
     from msslib import models as registry
+    from msslib.mesh import cells
     from msslib.planning.front import at_level, check_scene_levels
     from msslib.scene import load_scene, prepare
 
@@ -246,6 +247,11 @@ def check_scene(scene, *, levels=(1, 2, 3), models=None):
         raise ValueError("scene.solver: planning compares static solves; the scene is dynamic")
     setup = prepare(load_scene(at_level(raw, min(levels), "fem_linear"), base_dir=base_dir))  # the mesh, no solve
     cell_type = setup.mesh.cell_type
+    quadratic = [n for n, c in cells.registry().items() if c.quadratic is not None]
+    if cell_type not in quadratic:
+        raise ValueError(f"scene.geometry: {cell_type} cells have no quadratic FEM element (scikit-fem has none), so "
+                         f"plan has no reference to measure errors against; allowed: meshes of "
+                         f"{', '.join(quadratic)} cells")
     if cell_type not in MODELS:
         raise ValueError(f"scene.geometry: planning knows no models for {cell_type} cells")
     models = list(models or MODELS[cell_type])
