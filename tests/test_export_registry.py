@@ -12,8 +12,10 @@ import numpy as np
 import pytest
 import yaml
 
+from cell_helpers import example_geometry
 from cli_helpers import run_cli
 from msslib import export, models
+from msslib.mesh import cells
 from msslib.export import files as export_files
 from msslib.export.text import read_csv, read_json
 
@@ -21,12 +23,7 @@ SPECS = models.registry()
 #: (model, options): every MSS model with its default options, and Baudet's element reading
 CASES = [(name, {}) for name, spec in SPECS.items() if spec.kind == "mss"] + [("baudet_cube", {"correction": "element"})]
 
-_GEOMETRY = {
-    "triangle": {"generator": "triangle_grid_equilateral", "args": {"width": 0.04, "height": 0.02, "n": 4}},
-    "quad": {"generator": "quad_grid", "args": {"lx": 0.04, "ly": 0.01, "nx": 4, "ny": 2}},
-    "tetra": {"generator": "tet_grid", "args": {"lx": 0.02, "ly": 0.02, "lz": 0.02, "nx": 2, "ny": 2, "nz": 2}},
-    "hexahedron": {"generator": "hex_grid", "args": {"lx": 0.02, "ly": 0.02, "lz": 0.02, "nx": 2, "ny": 2, "nz": 2}},
-}
+_GEOMETRY = {cell: example_geometry(cell) for cell in cells.names()}  # the cell registry's examples, 1 cm
 
 
 def _scene(name, opts):

@@ -11,8 +11,10 @@ import numpy as np
 import pytest
 import yaml
 
+from cell_helpers import example_geometry, example_mesh
 from fem_helpers import fem_stiffness
 from msslib import mesh as M
+from msslib.mesh import cells
 from msslib import models
 from msslib.system import Model
 
@@ -22,15 +24,11 @@ T = 0.1  # membrane thickness (m)
 
 
 def _mesh(cell, kind="any"):
-    """A small mesh of ``cell`` cells: equilateral triangles, squares or cubes unless ``kind`` is
-    ``"rectangle"`` (2 x 1 quads, aspect ratio r = b / a = 0.5)."""
-    if cell == "triangle":
-        return M.triangle_grid_equilateral(3.0, 2.0, 3)
-    if cell == "quad":
-        return M.quad_grid(3.0, 1.5, 3, 3) if kind == "rectangle" else M.quad_grid(3.0, 2.0, 3, 2)
-    if cell == "tetra":
-        return M.tet_grid(1.0, 1.0, 1.0, 2, 2, 2)
-    return M.hex_grid(1.0, 1.0, 1.0, 2, 2, 2)
+    """A small mesh of ``cell`` cells, the cell registry's example (equilateral triangles, squares,
+    cubes, ...) unless ``kind`` is ``"rectangle"`` (2 x 1 quads, aspect ratio r = b / a = 0.5)."""
+    if cell == "quad" and kind == "rectangle":
+        return M.quad_grid(3.0, 1.5, 3, 3)
+    return example_mesh(cell)
 
 
 def _options(spec, **given):
@@ -221,12 +219,7 @@ def test_patch_claims_are_not_vacuous():
 
 # ---- scene round trip --------------------------------------------------------------------------
 
-_GEOMETRY = {
-    "triangle": {"generator": "triangle_grid_equilateral", "args": {"width": 0.04, "height": 0.02, "n": 4}},
-    "quad": {"generator": "quad_grid", "args": {"lx": 0.04, "ly": 0.01, "nx": 4, "ny": 2}},
-    "tetra": {"generator": "tet_grid", "args": {"lx": 0.02, "ly": 0.02, "lz": 0.02, "nx": 2, "ny": 2, "nz": 2}},
-    "hexahedron": {"generator": "hex_grid", "args": {"lx": 0.02, "ly": 0.02, "lz": 0.02, "nx": 2, "ny": 2, "nz": 2}},
-}
+_GEOMETRY = {cell: example_geometry(cell) for cell in cells.names()}  # the cell registry's examples, 1 cm
 
 
 @pytest.mark.parametrize("name", MSS)

@@ -5,6 +5,8 @@ and the state is read without copies."""
 import numpy as np
 import pytest
 
+from cell_helpers import example_mesh
+
 import msslib
 from msslib import mesh as M
 from msslib import solvers as S
@@ -182,14 +184,10 @@ def test_scene_load_curve(tmp_path, column):
 def _registry_cases():
     from msslib import models
 
-    meshes = {"tetra": lambda: M.cylinder_mesh(0.02, 0.06, 0.012),
-              "hexahedron": lambda: M.hex_grid(0.04, 0.01, 0.01, 4, 1, 1),
-              "triangle": lambda: M.triangle_grid_right(0.04, 0.02, 4, 2),
-              "quad": lambda: M.quad_grid(0.04, 0.02, 4, 2)}
     for name in models.names():
         spec = models.get(name)
-        if spec.kind == "mss":
-            yield name, spec.cells[0], meshes[spec.cells[0]]
+        if spec.kind == "mss":  # the cell registry's example of its first cell type, 2 cm across
+            yield name, spec.cells[0], lambda cell=spec.cells[0]: example_mesh(cell, 0.02)
 
 
 @pytest.mark.parametrize("name,cell,make", list(_registry_cases()), ids=lambda v: v if isinstance(v, str) else "")
@@ -197,7 +195,7 @@ def test_every_model_steps_as_integrate_does(name, cell, make):
     """Every registered MSS model runs on the simulator (the engine it picks) and equals integrate."""
     mesh = make()
     dim = mesh.dim
-    axis = "z" if cell == "tetra" else "x"
+    axis = "x"  # clamped at x = 0
     g = [0.0, -9.81] if dim == 2 else [0.0, 0.0, -9.81]
     kw = {"thickness": 0.001} if dim == 2 else {}
     import warnings
@@ -237,3 +235,25 @@ def test_jax_engine_equals_the_network_engine_and_refuses_what_it_cannot_run(col
     with pytest.warns(msslib.errors.MsslibWarning, match="jax cannot be imported"):
         c = Simulator(model, dt=dt, damping=3.0, engine="jax")
     assert c.engine == "network"
+
+
+@pytest.mark.parametrize("engine", ["network", "generic"])
+def test_a_path_on_permuted_axes_and_one_on_a_support_removed(column, engine):
+    """Paths are written from indices kept per build: axes in any order move the axes named, in
+    that order, and a support that a path moved returns to its rest position when the path is
+    removed (the support's own prescribed displacement is zero)."""
+    model, limit = column
+    pts = model.mesh.points
+    top = int(np.argmax(pts[:, 2]))
+    base = int(np.flatnonzero(pts[:, 2] < 1e-12)[0])
+    sim = Simulator(model, dt=0.5 * limit, damping=3.0, engine=engine)
+    sim.prescribe([top], [[0.0, 0.0, 0.0, 0.0], [10 * sim.dt, 1e-4, 2e-4, 3e-4]], axes=[2, 0, 1])
+    h = sim.prescribe([base], [[0.0, 0.0, 0.0, 0.0], [10 * sim.dt, 1e-4, 0.0, 0.0]])
+    sim.step(10)
+    assert sim.displacement[top].tolist() == pytest.approx([2e-4, 3e-4, 1e-4], rel=1e-12)
+    assert sim.displacement[base].tolist() == pytest.approx([1e-4, 0.0, 0.0], rel=1e-12, abs=1e-18)
+    sim.remove(h)
+    assert sim.displacement[base].tolist() == [0.0, 0.0, 0.0]
+    sim.step(3)
+    assert sim.displacement[base].tolist() == [0.0, 0.0, 0.0]
+    assert sim.displacement[top].tolist() == pytest.approx([2e-4, 3e-4, 1e-4], rel=1e-12)

@@ -87,6 +87,9 @@ class CellType:
     quadrilateral faces (of the cell itself for a 2D quad); ``inner_diagonals``: pairs across the
     cell (both None where there are none).  ``vtk_id``: the VTK cell type number; ``meshio``: the
     name meshio gives it; ``volume_shape``: the UGRID volume shape of a 3D type.
+    ``example``: a small mesh of the type for tests and examples, ``(generator, arguments)``: a
+    generator of :mod:`msslib.mesh` and its keyword arguments (lengths in metres, about 1 m; the
+    registry-wide tests build it, scaled where they need another size).
     """
 
     name: str
@@ -109,6 +112,7 @@ class CellType:
     face_diagonals: np.ndarray | None = None
     inner_diagonals: np.ndarray | None = None
     description: str = field(default="")
+    example: tuple = ()
 
     def __post_init__(self):
         reference = np.asarray(self.reference, dtype=float)

@@ -32,4 +32,5 @@ CELL = CellType(
     quadratic=FemElement("MeshQuad1", "ElementQuad2", "Q2 quadrilaterals", intorder=4, reduced_intorder=3),
     vtk_id=9, meshio="quad",
     face_diagonals=[[0, 2], [1, 3]],
+    example=("quad_grid", {"lx": 3.0, "ly": 2.0, "nx": 3, "ny": 2}),
 )

@@ -28,4 +28,5 @@ CELL = CellType(
     linear=FemElement("MeshTri1", "ElementTriP1", "P1 triangles", intorder=1),
     quadratic=FemElement("MeshTri1", "ElementTriP2", "P2 triangles", intorder=2, reduced_intorder=1),
     vtk_id=5, meshio="triangle", simplex=True,
+    example=("triangle_grid_equilateral", {"width": 3.0, "height": 2.0, "n": 3}),
 )

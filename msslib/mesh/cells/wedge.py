@@ -91,4 +91,5 @@ CELL = CellType(
     quadratic=None,
     vtk_id=13, meshio="wedge", volume_shape="wedge",
     face_diagonals=np.array(_SIDES)[:, [[0, 2], [1, 3]]].reshape(-1, 2),
+    example=("wedge_grid", {"lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 2, "ny": 2, "nz": 2}),
 )
