@@ -239,21 +239,22 @@ def test_jax_engine_equals_the_network_engine_and_refuses_what_it_cannot_run(col
 
 @pytest.mark.parametrize("engine", ["network", "generic"])
 def test_a_path_on_permuted_axes_and_one_on_a_support_removed(column, engine):
-    """Paths are written from indices kept per build: axes in any order move the axes named, in
-    that order, and a support that a path moved returns to its rest position when the path is
+    """Paths are written from indices kept per build: axes named in any order take their own
+    components of the displacement, and a support that a path moved returns to its rest position when the path is
     removed (the support's own prescribed displacement is zero)."""
     model, limit = column
     pts = model.mesh.points
     top = int(np.argmax(pts[:, 2]))
     base = int(np.flatnonzero(pts[:, 2] < 1e-12)[0])
     sim = Simulator(model, dt=0.5 * limit, damping=3.0, engine=engine)
-    sim.prescribe([top], [[0.0, 0.0, 0.0, 0.0], [10 * sim.dt, 1e-4, 2e-4, 3e-4]], axes=[2, 0, 1])
+    sim.prescribe([top], [[0.0, 0.0, 0.0, 0.0], [10 * sim.dt, 1e-4, 2e-4, 3e-4]], axes=[2, 0])
     h = sim.prescribe([base], [[0.0, 0.0, 0.0, 0.0], [10 * sim.dt, 1e-4, 0.0, 0.0]])
     sim.step(10)
-    assert sim.displacement[top].tolist() == pytest.approx([2e-4, 3e-4, 1e-4], rel=1e-12)
-    assert sim.displacement[base].tolist() == pytest.approx([1e-4, 0.0, 0.0], rel=1e-12, abs=1e-18)
+    assert sim.displacement[top][[0, 2]].tolist() == pytest.approx([1e-4, 3e-4], rel=0, abs=1e-17)
+    assert sim.displacement[top][1] != 0.0  # y moves freely
+    assert sim.displacement[base].tolist() == pytest.approx([1e-4, 0.0, 0.0], rel=0, abs=1e-17)
     sim.remove(h)
     assert sim.displacement[base].tolist() == [0.0, 0.0, 0.0]
     sim.step(3)
     assert sim.displacement[base].tolist() == [0.0, 0.0, 0.0]
-    assert sim.displacement[top].tolist() == pytest.approx([2e-4, 3e-4, 1e-4], rel=1e-12)
+    assert sim.displacement[top][[0, 2]].tolist() == pytest.approx([1e-4, 3e-4], rel=0, abs=1e-17)

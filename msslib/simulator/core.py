@@ -171,7 +171,8 @@ class Simulator:
         free = self._free()
         varies = self._varies()
         holder = []  # the stepper, once built (it calls drive from its constructor already)
-        drive = (lambda tt, xx: self._apply(tt, xx, holder[0] if holder else None)) if varies else None
+        plan = self._drive_plan()  # travels with the stepper: a refused change restores both
+        drive = (lambda tt, xx: self._apply(tt, xx, holder[0] if holder else None, plan, False)) if varies else None
         kw = dict(dt=self._options["dt"], damping=self._options["damping"], load=self._load(t),
                   blowup=self._options["blowup"], allow_unstable=self._options["allow_unstable"], free=free,
                   drive=drive)
@@ -187,7 +188,7 @@ class Simulator:
         stepper.n_taken = n_taken
         holder.append(stepper)
         self._stepper = stepper
-        self._apply(t, stepper.x, stepper)
+        self._apply(t, stepper.x, stepper, plan, True)
         if self.engine in ("network", "jax"):
             stepper.evaluate()
         else:
@@ -195,21 +196,40 @@ class Simulator:
         if hasattr(stepper, "restart_detector"):
             stepper.restart_detector()  # its reference from the force with this call's loads
 
-    def _apply(self, t, x, st):
+    def _drive_plan(self):
+        """What :meth:`_apply` writes, indexed once per build instead of once per step: the
+        model's prescribed dofs (rows, columns, rest positions, prescribed displacements, whether
+        any is nonzero; None without prescribed dofs) and per path (rows, columns, rest positions,
+        the rest positions as (nodes, axes), its function)."""
+        model, dim = self.model, self.dim
+        prescribed = getattr(model, "prescribed", None)
+        presc = None
+        if prescribed is not None:
+            fixed = np.flatnonzero(~model.free)
+            presc = (fixed // dim, fixed % dim, model.x0[fixed].copy(), prescribed[fixed].copy(),
+                     bool(np.any(prescribed[fixed])))
+        paths = []
+        for dofs, fn, _ in self._paths.values():
+            nodes = np.unique(dofs // dim)
+            paths.append((dofs // dim, dofs % dim, model.x0[dofs].reshape(nodes.size, -1).copy(), fn))
+        return presc, paths
+
+    def _apply(self, t, x, st, plan, full):
         """Loads at time ``t`` onto the stepper ``st`` (None: not built yet) and the driven
-        positions onto ``x``."""
+        positions onto ``x`` (``plan``: :meth:`_drive_plan`).  Between steps (not ``full``) the
+        supports that prescribe zero are not written again: they keep the rest positions the
+        build gave them, which no step moves."""
         lam = self._load(t)
         if st is not None:
             st.load = lam
         model = self.model
         x2 = x.reshape(-1, self.dim)  # a view of a flat array, or the network engine's (n, 3) view
-        prescribed = getattr(model, "prescribed", None)
-        if prescribed is not None:
-            fixed = np.flatnonzero(~model.free)
-            x2[fixed // self.dim, fixed % self.dim] = model.x0[fixed] + lam * prescribed[fixed]
-        for dofs, fn, _ in self._paths.values():
-            u = fn(t)
-            x2[dofs // self.dim, dofs % self.dim] = model.x0[dofs] + np.repeat(u[None, :], dofs.size // u.size, 0).ravel()
+        presc, paths = plan
+        if presc is not None and (full or presc[4]):
+            rows, cols, x0, u, _ = presc
+            x2[rows, cols] = x0 + lam * u
+        for rows, cols, x0, fn in paths:
+            x2[rows, cols] = (x0 + fn(t)).ravel()
         if st is None:
             return
         if self._forces or self._pressures:
@@ -239,7 +259,13 @@ class Simulator:
 
     def _checked(self, fn, name, shape, user=False):
         """``fn`` wrapped so that every value it returns is checked like a constant (``user``: a
-        caller's callable, which may raise in the middle of a step call)."""
+        caller's callable, which may raise in the middle of a step call).  A constant or a table
+        is returned as it is: :func:`time_function` checked its values (a table's curve
+        interpolates finite rows of the right shape), and a step reads it without a check."""
+        if not user:
+            fn.user = False
+            return fn
+
         def checked(t, _f=fn):
             return self._value(_f, t, name, shape)
 
@@ -346,6 +372,8 @@ class Simulator:
         def fn(t, _f=whole, _a=ax):
             return _f(t)[_a]
 
+        if np.array_equal(ax, np.arange(self.dim)):  # all axes in order: the vector itself
+            fn = whole
         fn.user = whole.user
         fn(self.t)
         return self._add(self._paths, (self._dofs(nodes, ax), fn, varies))

@@ -46,6 +46,9 @@ class NetworkStepper(Integrator):
         self._h = None
         self._set_step(self.dt)
         self.mon = np.zeros((1, N_MONITOR))
+        self._fixed_at = 6 * (self._fixed // 3) + self._fixed % 3  # in the flat records
+        self._R_flat = self.R.reshape(-1)  # a view
+        self._fext_of = None  # (load, extra) that fext holds
         self.evaluate()
 
     def _set_step(self, h):
@@ -55,9 +58,13 @@ class NetworkStepper(Integrator):
             self.damp = 1.0 - self._h * self.alpha
 
     def _update_external(self):
+        of = self._fext_of
+        if of is not None and of[0] == self.load and of[1] is self.extra:
+            return  # unchanged since the last pass (the reference keeps the array alive)
         np.multiply(self._external, self.load, out=self.fext)
         if self.extra is not None:
             self.fext += self.extra
+        self._fext_of = (self.load, self.extra)
 
     def _preload(self):
         if not self.others:
@@ -74,7 +81,7 @@ class NetworkStepper(Integrator):
     def _fixed_positions(self):
         if self.drive is None or not self._fixed.size:
             return None
-        return self.x[self._fixed // 3, self._fixed % 3]
+        return self._R_flat[self._fixed_at]
 
     def evaluate(self):
         """The force, reactions and monitor at the current state (no step): after a change of the
