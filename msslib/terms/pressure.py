@@ -237,7 +237,7 @@ class FollowerPressure(Pressure, ElementTerm):
     export_formats = ("csv", "json")
 
     def __init__(self, mesh, facets, pressure, follow=True, thickness: float = 1.0, name: str = ""):
-        super().__init__(mesh, facets, pressure, True, thickness, name)
+        super().__init__(mesh, facets, pressure, follow, thickness, name)
         self.conn = self.facets
         self._n_local = (self.facets.shape[1] * self.dim) ** 2
         self._p = np.array([self.pressure])
