@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import cells as _cells
 from .cells import RegistryView as _RegistryView
 from .core import CELL_TYPES, COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _fmt_point
 from .gmsh_file import entity_groups, physical_names
@@ -516,7 +517,7 @@ def write_vtu(path, mesh: Mesh, point_data: dict | None = None, cell_data: dict 
             raise ValueError(f"cell_data[{name!r}] has {len(values)} rows, the mesh {mesh.n_cells} cells")
         cdata[name] = [_pad_columns(values, mesh.dim)]
     points = _pad_columns(mesh.points, mesh.dim)
-    out = meshio.Mesh(points, [(mesh.cell_type, mesh.cells)], point_data=pdata, cell_data=cdata)
+    out = meshio.Mesh(points, [(_cells.get(mesh.cell_type).meshio, mesh.cells)], point_data=pdata, cell_data=cdata)
     tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
     try:
         meshio.write(tmp, out, file_format="vtu")
