@@ -87,6 +87,9 @@ def main():
     vals = np.stack([ds["G_error"].interp(angle=v).values for v in LEVELS.values()], axis=-1)
     ds["G_error_at"] = (("reading", "factor", "nu", "level"), vals,
                         {"units": "1", "long_name": "relative error of G at the quoted angles"})
+    ds["G_error_largest"] = (("reading", "factor"), np.nanmax(np.abs(ds["G_error"].values), axis=(2, 3)),
+                             {"units": "1", "long_name": "largest |relative error of G| over every nu and every "
+                              f"angle up to {float(angles[-1]):g} degrees"})
     ds = C.split_readings(ds)
     ds.attrs.update(title="Baudet Fig. 6: G error against the shear angle", quick=int(args.quick), cube_edge_m=C.A0)
     C.write(ds, args.out, t0)
