@@ -90,8 +90,8 @@ class FacetPressure:
         self.w = float(thickness) if geo.dim == 2 else 1.0
         index = {tuple(sorted(r)): i for i, r in enumerate(np.asarray(geo.skmesh.facets).T.tolist())}
         ids = np.array([index[tuple(sorted(r))] for r in np.asarray(facets).tolist()], dtype=np.int64)
-        # the integrand phi_a cof(F) N is of degree order + (dim - 1) * (order - 1) on simplices
-        fb = skfem.FacetBasis(geo.skmesh, geo.elem, facets=ids, intorder=2 * geo.order + 1)
+        # exact for phi_a cof(F) N and for x times it (the torque) on simplices and Q1, Q2 facets
+        fb = skfem.FacetBasis(geo.skmesh, geo.elem, facets=ids, intorder=3 * geo.order + 1)
         nb, d = fb.Nbfun, geo.dim
         self.phi = np.stack([np.asarray(fb.basis[a][0]) for a in range(nb)])  # (nb, k, q)
         self.dphi = np.stack([np.asarray(fb.basis[a][0].grad) for a in range(nb)])  # (nb, d, k, q)
