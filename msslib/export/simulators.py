@@ -279,8 +279,8 @@ def mjcf_text(exp: MssExport) -> str:
         f"{MJCF_ARENA_MIN >> 20} MiB); MuJoCo's default grows with tendons times degrees of freedom "))
     if actuators:
         act = ET.SubElement(root, "actuator")
-        act.append(ET.Comment(" constant forces (N) at load factor 1: surface loads (load_*) and Baudet's "
-                              "correction (baudet_correction_*) "))
+        act.append(ET.Comment(" constant forces (N) at load factor 1: surface loads (load_*), dead pressures "
+                              "(pressure_I_*, the scene's loads[I]) and Baudet's correction (baudet_correction_*) "))
         for attrs in actuators:
             ET.SubElement(act, "general", **attrs)
     ET.indent(root, space=" ")
