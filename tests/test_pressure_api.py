@@ -117,9 +117,11 @@ def test_apply_pressure_can_be_removed_and_scales_with_its_curve_not_the_load_fa
 
 
 @pytest.mark.parametrize("facets, pressure, message", [
-    (np.array([[0, 1, 2]]), 1.0, r"^facets of hexahedron cells must have shape \(k, 4\), got \(1, 3\)"),
+    (np.array([[0, 1, 2]]), 1.0, r"^facets must be node ids of shape \(k, 4\) with k >= 1 \(the facets of the "
+                                 r"mesh's hexahedron cells\), got array\(\[\[0, 1, 2\]\]\)"),
     (np.array([[0, 1, 4, 3]]) + 100, 1.0, r"^facets: node ids must lie in 0\.\.26, got 100"),
-    (np.zeros((0, 4), dtype=int), 1.0, r"^facets must be node ids of shape \(k, 3 or 4\) with k >= 1"),
+    (np.zeros((0, 4), dtype=int), 1.0, r"^facets must be node ids of shape \(k, 4\) with k >= 1"),
+    ([[0.5, 1, 4, 3]], 1.0, r"^facets must be node ids of shape \(k, 4\)"),
     (None, float("nan"), r"^pressure: expected a number or a table \[\[t, \.\.\.\], \.\.\.\], got nan"),
     (None, float("inf"), r"^pressure: expected a number or a table"),
     (None, [1.0, 2.0], r"^pressure: expected a number or a table"),

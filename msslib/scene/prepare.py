@@ -164,15 +164,12 @@ def prepare(scene: Scene) -> Setup:
 
 
 def _outward(mesh, facets, cache) -> np.ndarray:
-    """``facets`` (boundary facets in any node order, e.g. a gmsh facet group's) as the mesh's
-    boundary lists them: outward oriented, corners in the order of their cell's facet."""
+    """``facets`` turned outward (:func:`msslib.terms.pressure.outward_facets`), the boundary cached."""
+    from msslib.terms.pressure import outward_facets
+
     if "boundary" not in cache:
         cache["boundary"] = _mesh.boundary_facets(mesh, return_cells=True)
-    boundary = cache["boundary"][0]
-    if boundary.shape[1] != facets.shape[1]:
-        raise ValueError(f"facets of {facets.shape[1]} nodes on a mesh whose boundary facets have {boundary.shape[1]}")
-    index = {tuple(sorted(f)): i for i, f in enumerate(boundary.tolist())}
-    return boundary[[index[tuple(sorted(f))] for f in np.asarray(facets).tolist()]]
+    return outward_facets(mesh, facets, cache["boundary"][0])
 
 
 # --------------------------------------------------------------------------------------------

@@ -9,7 +9,7 @@ import numpy as np
 
 from msslib.solvers.dynamics import Integrator
 
-from msslib.terms.pressure import pressure_nodal_forces
+from msslib.terms.pressure import outward_facets, pressure_nodal_forces
 
 from .loads import time_function
 from msslib.explicit.network import network_terms
@@ -387,40 +387,21 @@ class Simulator:
         to the rest surface (:func:`msslib.terms.pressure_nodal_forces`); 2D: ``thickness`` (m).
         Not scaled by the load factor.  Returns a handle for :meth:`remove`."""
         from msslib.mesh.selection import loaded_facets
-        from msslib.scene.prepare import _outward
 
         mesh = self.model.mesh
         if not isinstance(follow, (bool, np.bool_)):
             raise ValueError(f"follow must be True or False, got {follow!r}")
         if isinstance(facets, dict):
             size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if mesh.n_nodes else 1.0
-            found = loaded_facets("facets", mesh, facets, max(1e-8 * size, 1e-15), {})
-        else:
-            found = np.asarray(facets)
-            nf = (2,) if self.dim == 2 else (3, 4)
-            if found.ndim != 2 or found.shape[1] not in nf or found.dtype.kind not in "iu" or not len(found):
-                raise ValueError(f"facets must be node ids of shape (k, {' or '.join(map(str, nf))}) with k >= 1 "
-                                 f"on a {self.dim}D mesh, or a selection dict, got {facets!r}")
-            if found.min() < 0 or found.max() >= self.n_nodes:
-                raise ValueError(f"facets: node ids must lie in 0..{self.n_nodes - 1}, got "
-                                 f"{int(found[(found < 0) | (found >= self.n_nodes)][0])}")
-            from msslib.mesh import facet_cell_counts
-
-            counts = facet_cell_counts(mesh, found)
-            if np.any(counts != 1):
-                i = int(np.flatnonzero(counts != 1)[0])
-                raise ValueError(f"facets: {int(np.sum(counts != 1))} of {len(found)} facets are not on the boundary "
-                                 f"of the mesh (facet {i}, nodes {found[i].tolist()}); allowed: boundary facets")
-        found = _outward(mesh, found.astype(np.int64), {})
-        if self.dim == 3 and float(thickness) != 1.0:
-            raise ValueError(f"thickness applies to 2D meshes only, got {thickness!r}")
-        thickness = _finite(thickness, "thickness", "a finite thickness > 0 (m)")
-        if thickness <= 0:
-            raise ValueError(f"thickness must be a finite thickness > 0 (m), got {thickness!r}")
+            facets = loaded_facets("facets", mesh, facets, max(1e-8 * size, 1e-15), {})
+        found = outward_facets(mesh, facets)
+        t = _finite(thickness, "thickness", "a finite thickness > 0 (m)")
+        if t <= 0 or (self.dim == 3 and t != 1.0):
+            raise ValueError(f"thickness must be a finite thickness > 0 (m), on a 2D mesh only, got {thickness!r}")
         fn, varies = time_function(pressure, "pressure")
         fn = self._checked(fn, "pressure", (), callable(pressure))
         fn(self.t)
-        return self._add(self._pressures, (found, fn, bool(follow), thickness, varies or bool(follow)))
+        return self._add(self._pressures, (found, fn, bool(follow), t, varies or bool(follow)))
 
     def _add(self, table, entry):
         def change():

@@ -23,7 +23,7 @@ import numpy as np
 from .base import ElementTerm, Table, _as_flat, make_column
 from .external import ExternalForce
 
-__all__ = ["Pressure", "pressure_nodal_forces"]
+__all__ = ["Pressure", "pressure_nodal_forces", "outward_facets"]
 
 # reference facets: corner shape functions and their derivatives at the quadrature points
 _QUAD_SU = np.array([-1.0, 1.0, 1.0, -1.0])
@@ -153,6 +153,33 @@ def pressure_nodal_forces(points, facets, pressure, thickness: float = 1.0) -> n
         for d in range(dim):
             out[:, d] = np.bincount(facets.ravel(), weights=f[:, :, d].ravel(), minlength=len(points))
     return out
+
+
+def outward_facets(mesh, facets, boundary=None) -> np.ndarray:
+    """``facets`` (node ids ``(k, nodes per facet)`` of boundary facets of ``mesh`` in any node order,
+    e.g. a gmsh facet group's) as the mesh's boundary lists them: outward oriented, corners in the
+    order of their cell's facet (:func:`msslib.mesh.boundary_facets`; ``boundary``: its result, if
+    at hand).  A ValueError in one line for a wrong shape, an empty list, a node id off the mesh or a
+    facet that is not on the boundary."""
+    from msslib import mesh as _mesh
+
+    if boundary is None:
+        boundary = _mesh.boundary_facets(mesh)
+    nf = boundary.shape[1]
+    a = np.asarray(facets)
+    if a.ndim != 2 or a.shape[1] != nf or a.dtype.kind not in "iu" or not len(a):
+        raise ValueError(f"facets must be node ids of shape (k, {nf}) with k >= 1 (the facets of the mesh's "
+                         f"{mesh.cell_type} cells), got {facets!r:.120}")
+    if a.min() < 0 or a.max() >= mesh.n_nodes:
+        raise ValueError(f"facets: node ids must lie in 0..{mesh.n_nodes - 1}, got "
+                         f"{int(a[(a < 0) | (a >= mesh.n_nodes)][0])}")
+    index = {tuple(sorted(f)): i for i, f in enumerate(boundary.tolist())}
+    found = [index.get(tuple(sorted(f)), -1) for f in a.tolist()]
+    bad = [i for i, j in enumerate(found) if j < 0]
+    if bad:
+        raise ValueError(f"facets: {len(bad)} of {len(a)} facets are not on the boundary of the mesh (facet "
+                         f"{bad[0]}, nodes {a[bad[0]].tolist()}); allowed: boundary facets")
+    return boundary[found]
 
 
 class Pressure(ExternalForce):
