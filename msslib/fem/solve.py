@@ -15,6 +15,7 @@ from msslib.fem.materials import _cell_materials, _check_plane, _law, lame
 from msslib.fem.space import _boundary, _Geometry, _linear_stiffness, _skfem_linear_stiffness
 from msslib.errors import MsslibWarning
 from msslib.mesh import CELL_TYPES, Mesh
+from msslib.mesh.cells import RegistryView
 from msslib.models.references import warn_locking
 
 
@@ -213,7 +214,9 @@ def _hourglass_fraction(geo, lam_c, mu_c, w, u, one_point_energy) -> float:
 #: quadrature of the volumetric term with volumetric="reduced": one point on P2 simplices (the
 #: volumetric strain's cell mean: the penalty form of the inf-sup stable P2-P0 pair), 2x2(x2) Gauss
 #: on Q2 (selective reduced integration)
-_REDUCED_INTORDER = {"triangle": 1, "tetra": 1, "quad": 3, "hexahedron": 3}
+#: (each cell type's quadratic element says it: msslib.mesh.cells)
+_REDUCED_INTORDER = RegistryView(lambda c: c.quadratic.reduced_intorder, "cell type -> reduced quadrature order",
+                                 only=lambda c: c.quadratic is not None)
 VOLUMETRIC = ("full", "reduced")
 
 
