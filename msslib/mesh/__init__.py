@@ -47,7 +47,8 @@ Contents of this package, one concern per module; every name below is importable
   refused), :func:`connected_parts` and :func:`loose_parts` (parts whose fixed dofs leave a
   rigid-body mode free: floating, or free to slide or turn; :class:`LoosePart`).
 
-The modules import one another in one direction: ``core`` <- ``topology``, ``geometry``,
+The modules import one another in one direction: ``cells`` (which imports nothing of the mesh
+package; its registry imports the cell modules) <- ``core`` <- ``topology``, ``geometry``,
 ``groups``; ``geometry`` <- ``structured``, ``unstructured``; ``groups`` <- ``hygiene`` <-
 ``files`` -> ``meshio_output``.  gmsh and meshio are imported only when a mesh is generated or a file is read or
 written.
