@@ -4,7 +4,8 @@ Public functions
 ----------------
 * :func:`solve_linear` -- small-strain isotropic linear elasticity (2D plane stress/strain, 3D).
 * :func:`solve_nonlinear` -- total-Lagrangian finite-strain reference (St Venant-Kirchhoff or
-  compressible neo-Hookean), dead loads, Newton with load stepping and step halving.
+  compressible neo-Hookean), dead loads and pressures (dead or follower), Newton with load
+  stepping and step halving.
 * :func:`element_stiffness` -- numeric stiffness matrix of one element, dofs interleaved by node
   ``(n0_x, n0_y, [n0_z], n1_x, ...)`` in the VTK node order of the given coordinates.
 
@@ -54,10 +55,17 @@ stress of the 3D law: at every quadrature point the out-of-plane stretch ``F33``
 tangent is statically condensed. For St Venant-Kirchhoff this is identical to the 2D SVK law with
 the plane-stress Lame constant ``lambda* = 2 lambda mu / (lambda + 2 mu)``. Integrals are taken
 over the reference thickness (nominal quantities), so thickness changes are accounted for exactly.
+Pressures (``pressures=((facets, p, follow), ...)`` of both solves): integrated with scikit-fem
+facet forms on the element's own facets (quadratic ones with ``order=2``); a follower pressure
+adds its non-symmetric load stiffness to Newton's tangent (:mod:`~msslib.fem.pressure`). The
+closed-form solutions they are verified against (thick-walled cylinder and sphere) are in
+:mod:`~msslib.fem.exact`.
+
 Modules: :mod:`~msslib.fem.materials` (Lame constants, per-cell materials, the finite-strain
 laws), :mod:`~msslib.fem.space` (scikit-fem conversion, the element basis of either order,
-assembly, boundary conditions and loads), :mod:`~msslib.fem.newton` (the solves on
-:mod:`msslib.solvers`), :mod:`~msslib.fem.solve` (the solves).
+assembly, boundary conditions and loads), :mod:`~msslib.fem.pressure` (pressure loads),
+:mod:`~msslib.fem.newton` (the solves on :mod:`msslib.solvers`), :mod:`~msslib.fem.solve` (the
+solves), :mod:`~msslib.fem.exact` (exact solutions under pressure).
 """
 
 from msslib.fem.materials import lame
