@@ -494,6 +494,9 @@ def comparison_figure(pairs: dict, *, plane: str = "yz", length_unit: str = "cm"
 #: one colour per Poisson's ratio, the same in every figure of curves
 NU_COLORS = {"0.1": "tab:blue", "0.2": "tab:orange", "0.25": "tab:brown", "0.3": "tab:green", "0.4": "tab:red",
              "0.499": "tab:purple"}
+# one marker per Poisson's ratio on the solid curves, so that curves lying on each other (nu = 0.4 and
+# 0.499 in several of Baudet's panels) stay apart by their markers, not by colour alone
+NU_MARKERS = {"0.1": "o", "0.2": "s", "0.25": "^", "0.3": "v", "0.4": "D", "0.499": "P"}
 
 
 def curves_figure(da, x, *, xlabel, ylabel, panels, xscale=100.0, yscale=100.0, absolute=False, dashed=None,
@@ -516,13 +519,16 @@ def curves_figure(da, x, *, xlabel, ylabel, panels, xscale=100.0, yscale=100.0, 
     solid = {"lw": 3.0, "alpha": 0.45} if dashed else {}
     every = max(len(x) // 8, 1)
     for ax, (title, sel) in zip(axes, panels.items()):
-        for nu in da["nu"].values:
+        for i, nu in enumerate(da["nu"].values):
             y = da.sel(**sel, nu=nu).values * yscale
-            ax.plot(x * xscale, np.abs(y) if absolute else y, color=NU_COLORS.get(str(nu)), label=f"nu = {nu}", **solid)
+            # markers staggered along x by the curve's index: on coinciding curves they do not cover each other
+            start = (i * max(every // 3, 1)) % every
+            ax.plot(x * xscale, np.abs(y) if absolute else y, color=NU_COLORS.get(str(nu)), label=f"nu = {nu}",
+                    marker=NU_MARKERS.get(str(nu), "o"), ms=4.5, mfc="none", mew=1.0, markevery=(start, every), **solid)
             for sel2 in (dashed or {}).values():
                 y2 = da.sel(**{**sel, **sel2}, nu=nu).values * yscale
                 ax.plot(x * xscale, np.abs(y2) if absolute else y2, color=NU_COLORS.get(str(nu)), ls="--", lw=1.1,
-                        marker="x", ms=3.5, markevery=every)
+                        marker="x", ms=3.5, markevery=(start, every))
         for (px, py, nu) in (marks or {}).get(title, []):
             ax.plot(px, py, "o", mfc=NU_COLORS.get(nu, "k"), mec="k", ms=6)
         ax.set_title(title)

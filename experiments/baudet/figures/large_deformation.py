@@ -67,8 +67,10 @@ def main():
         for k, txt in (("reading_density", "kg/m³"), ("reading_linear_density", "kg/m"), ("reading_total_mass", "kg")):
             v = float(ds[k])
             ax.axvline(v, color="0.7", lw=0.8)
-            ax.annotate(f"0.0125 {txt}", (v, 1.0), xycoords=("data", "axes fraction"), rotation=90, va="top", ha="right",
-                        fontsize=7, color="0.4")
+            # inside the axes, below its top edge, on a white ground: never clipped by the frame nor hidden by a curve
+            ax.annotate(f"0.0125 {txt}", (v, 1.0), xycoords=("data", "axes fraction"), xytext=(-1.5, -4),
+                        textcoords="offset points", rotation=90, va="top", ha="right", fontsize=7, color="0.3",
+                        bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 0.8}, zorder=5, annotation_clip=False)
         ax.set_xscale("log")
         plotting.label_log_axis(ax, "x")
         ax.set_xlabel("density of the beam (kg/m³)")
