@@ -192,3 +192,44 @@ def test_pressure_refusals_name_the_argument():
         Pressure(mesh, facets[:0], 1.0)
     with pytest.raises(ValueError, match=r"^follow must be true or false, got 'yes'"):
         Pressure(mesh, facets, 1.0, follow="yes")
+
+
+def _square_ring(pressure, follow=True, k=100.0, R=1.0):
+    """Four springs (k, rest length sqrt(2) R) joining the nodes (R, 0), (0, R), (-R, 0), (0, -R), each
+    node free along its radius only, and a pressure pulling the ring outward (negative on the
+    outward edges).  Exact radius: follower r = 2 k R / (2 k - |p|) (no equilibrium from |p| = 2 k,
+    where the radial stiffness 2 k - |p| vanishes), dead r = R (1 + |p| / (2 k))."""
+    from msslib.mesh import Mesh
+    from msslib.system import Model
+    from msslib.terms import Springs
+
+    pts = np.array([[R, 0.0], [0.0, R], [-R, 0.0], [0.0, -R], [0.0, 0.0]])
+    mesh = Mesh(pts, np.array([[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]), "triangle")
+    edges = np.array([[0, 1], [1, 2], [2, 3], [3, 0]])
+    fixed = np.zeros((5, 2), dtype=bool)
+    fixed[4] = True
+    fixed[[0, 2], 1] = True
+    fixed[[1, 3], 0] = True
+    terms = [Springs(edges, k, np.full(4, np.sqrt(2.0) * R), 2), Pressure(mesh, edges, -pressure, follow=follow)]
+    return Model(mesh, terms, fixed=fixed, masses=np.ones(5))
+
+
+@pytest.mark.parametrize("follow, radius", [(True, 2.0), (False, 1.5)])
+def test_pressurised_ring_reaches_the_exact_radius(follow, radius):
+    model = _square_ring(100.0, follow)
+    res = static_solve(model, model.x0, load_steps=2, tol=1e-12)
+    r = np.linalg.norm(res.x.reshape(-1, 2)[:4], axis=1)
+    np.testing.assert_allclose(r, radius, rtol=1e-12)
+
+
+def test_a_follower_load_past_its_limit_stops_at_the_load_factor_reached_and_says_so():
+    from msslib.solvers import ConvergenceError
+
+    # |p| = 4 k: the tangent's radial stiffness 2 k - lambda |p| vanishes at lambda = 1/2
+    model = _square_ring(400.0)
+    with pytest.raises(ConvergenceError) as info:
+        static_solve(model, model.x0, load_steps=4, tol=1e-10)
+    message = str(info.value)
+    reached = float(message.split("last converged load factor ")[1].split(",")[0])
+    assert 0.49 < reached < 0.5 and info.value.load <= 0.5 + 1e-12
+    assert "\n" not in message
