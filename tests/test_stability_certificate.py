@@ -1,0 +1,101 @@
+"""The certified short Lanczos run of the stability check: the step it accepts is never above the
+exact limit (dense eigenvalues) on models of every cell type, with springs run without a matrix
+and other terms assembled, at rest and prestressed; a step over the limit is refused; steps at
+0.99 of the limit it certifies stay bounded where steps just over the exact limit blow up."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+import msslib
+from msslib import mesh as M
+from msslib import solvers as S
+from msslib.errors import DivergenceError, StabilityError
+from msslib.solvers import stability as ST
+
+
+def _exact_omega(model, x):
+    free = model.free
+    K = model.stiffness(x).toarray()[np.ix_(free, free)]
+    d = 1.0 / np.sqrt(model.mass[free])
+    return float(np.sqrt(np.linalg.eigvalsh(0.5 * (d[:, None] * (K + K.T) * d[None, :])).max()))
+
+
+def _models():
+    """Over 400 free dofs each (below, the check solves the dense problem exactly)."""
+    mat = msslib.Material(1e4, 0.3, density=1000.0)
+    tet = M.cylinder_mesh(0.02, 0.06, 0.008)
+    hexm = M.hex_grid(0.04, 0.02, 0.02, 8, 4, 4)
+    grav = {"type": "gravity", "g": [0, 0, -9.81]}
+    for name, mesh, axis in (("lloyd_tetrahedron", tet, "z"), ("kikuuwe_tetrahedron", tet, "z"),
+                             ("golec_cube", hexm, "x"), ("baudet_cube", hexm, "x")):
+        yield name, msslib.build_model(name, mesh, mat, fixed={"plane": [axis, 0.0]}, loads=grav).model
+    yield "lloyd_triangle", msslib.build_model("lloyd_triangle", M.triangle_grid_right(0.04, 0.02, 24, 12), mat,
+                                               fixed={"plane": ["x", 0.0]}, thickness=0.001).model
+
+
+MODELS = list(_models())
+
+
+def _states(model):
+    rng = np.random.default_rng(5)
+    size = float(np.ptp(model.x0.reshape(-1, model.dim), axis=0).max())
+    # at rest, and prestressed (some springs compressed: the shift is needed)
+    return model.x0, model.x0 + 0.002 * size * rng.standard_normal(model.n_dof) * model.free
+
+
+@pytest.mark.parametrize("name,model", MODELS, ids=[n for n, _ in MODELS])
+def test_a_certified_step_is_never_above_the_exact_limit(name, model):
+    assert int(model.free.sum()) > 400
+    for x in _states(model):
+        exact = _exact_omega(model, x)
+        limit = 2.0 / exact
+        model._spectrum_cache = {}
+        info = S.check_time_step(model, x, 0.9 * limit)
+        assert info["stability_estimate"].startswith("certified ("), info["stability_estimate"]
+        assert info["omega_max"] >= exact * (1.0 - 1e-12)  # an upper bound of the exact value
+        assert 0.9 * limit <= info["stability_limit"] <= limit * (1.0 + 1e-12)
+        with pytest.raises(StabilityError):  # over the limit: the certificate cannot accept it
+            S.check_time_step(model, x, 1.02 * limit)
+        # a target below the exact value is never certified
+        matvec, n, shift = ST._scaled_operator(model, x, 1.0, model.free.copy())
+        assert ST.certified_omega_max(matvec, n, shift, 0.99 * exact, 7)[0] is None
+
+
+@pytest.mark.parametrize("name,model", MODELS, ids=[n for n, _ in MODELS])
+def test_the_operator_is_the_scaled_stiffness_and_its_shift_makes_it_semidefinite(name, model):
+    isq = np.where(model.free, 1.0 / np.sqrt(model.mass), 0.0)
+    for x in _states(model):
+        matvec, n, shift = ST._scaled_operator(model, x, 1.0, model.free.copy())
+        A = (sp.diags(isq) @ sp.csr_matrix(model.stiffness(x)) @ sp.diags(isq)).toarray()
+        A = 0.5 * (A + A.T)
+        V = np.random.default_rng(1).standard_normal((n, 3))
+        got = np.column_stack([matvec(v) for v in V.T])
+        assert np.abs(got - A @ V).max() <= 1e-12 * np.abs(A @ V).max()
+        lam = np.linalg.eigvalsh(A)
+        assert lam.min() + shift >= -1e-9 * lam.max()
+        if x is model.x0 and name == "lloyd_tetrahedron":
+            assert shift == 0.0  # springs at rest: semidefinite as they are
+
+
+def test_steps_at_099_of_the_certified_limit_stay_bounded_and_over_the_exact_limit_blow_up():
+    model = dict(MODELS)["lloyd_tetrahedron"]
+    x0 = model.x0
+    exact = 2.0 / _exact_omega(model, x0)
+    model._spectrum_cache = {}
+    info = S.check_time_step(model, x0, 0.96 * exact)
+    assert info["stability_estimate"].startswith("certified (")
+    accepted = info["stability_limit"]
+    assert 0.96 * exact <= accepted <= exact
+    rng = np.random.default_rng(2)
+    v0 = 1e-3 * rng.standard_normal(model.n_dof) * model.free  # every mode excited
+
+    def amplitude(dt, n):
+        out = S.integrate(model, x0, v0, dt=dt, t_end=n * dt, damping=0.0, allow_unstable=True, save_every=n)
+        return float(np.abs(out.x_final - x0).max())
+
+    n = 3000
+    bounded = amplitude(0.99 * accepted, n)
+    assert bounded < 1e-3 * n * 0.99 * accepted * 10  # a few times what the start velocity travels
+    with pytest.raises(DivergenceError):
+        amplitude(1.02 * exact, n)
