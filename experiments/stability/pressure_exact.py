@@ -1,0 +1,151 @@
+"""Pressure against exact solutions: every mass-spring model on its cells, linear FEM and the
+quadratic reference (reduced volumetric rule), each under an internal pressure on a thick-walled
+body whose linear-elastic solution is known in closed form (:mod:`msslib.fem.exact`):
+
+* ``cylinder``: Lame's thick cylinder (radii 1 and 2) in plane stress on a quarter annulus of
+  triangles or quads (``n`` cells through the wall, ``2 n`` around), symmetry supports;
+* ``sphere``: the thick sphere (radii 1 and 2) on a gmsh octant of tetrahedra of size ``h``.
+
+Every run is small strain: the mass-spring models by the scene's linear static solve (one solve
+with the stiffness at rest) of a dead pressure on the inner wall (the scene's ``pressure`` load on
+the mesh's facet group ``inner``), the FEM ones by :func:`msslib.fem.solve_linear` on the same
+facets.  The error is the largest nodal displacement error over the largest exact nodal
+displacement (``error_max``), the root mean square of the nodal errors over that of the exact
+displacements (``error_rms``), both at the mesh's nodes, and the largest nodal difference from the
+quadratic reference on the same mesh over its largest displacement (``error_max_vs_fem``); a model that refuses the mesh or does
+not converge gets NaN and its reason in ``outcome``.
+
+``python -m experiments.stability.pressure_exact --out F.nc [--quick]`` writes a NetCDF dataset
+(dimension ``run``: problem, cells, level, n_nodes, model, nu, the errors, outcome).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import replace
+from functools import partial
+
+import numpy as np
+
+A, B, P, E = 1.0, 2.0, 1.0e3, 1.0e6
+NUS = (0.3, 0.49)
+LEVELS = {"cylinder": (4, 8, 16), "sphere": (0.4, 0.2)}
+QUICK = {"cylinder": (4, 8), "sphere": (0.4,)}
+
+
+def problems(quick: bool):
+    """``(problem, cells, level, mesh, exact(nu))`` of every run's geometry."""
+    from msslib.fem import exact
+
+    levels = QUICK if quick else LEVELS
+    for cells in ("triangle", "quad"):
+        for n in levels["cylinder"]:
+            mesh = exact.quarter_annulus(A, B, n, cells)
+            yield "cylinder", cells, float(n), mesh, lambda nu: partial(_plane_stress_cylinder, nu=nu)
+    for h in levels["sphere"]:
+        mesh = exact.sphere_octant(A, B, h)
+        yield "sphere", "tetra", float(h), mesh, lambda nu: partial(exact.sphere_displacement, a=A, b=B, p=P, E=E,
+                                                                      nu=nu)
+
+
+def _plane_stress_cylinder(X, nu):
+    """Lame's cylinder in plane stress: the plane-strain field of ``E* = E (1 + 2 nu) / (1 + nu)^2``,
+    ``nu* = nu / (1 + nu)``."""
+    from msslib.fem import exact
+
+    return exact.cylinder_displacement(X, A, B, P, E * (1 + 2 * nu) / (1 + nu) ** 2, nu / (1 + nu))
+
+
+def models_for(cells: str) -> list[str]:
+    from msslib import models as registry
+
+    return [name for name in registry.registry() if cells in registry.get(name).cells and not name.startswith("fem_")]
+
+
+def errors(u, mesh, exact_u) -> tuple[float, float]:
+    ue = exact_u(mesh.points)
+    return (float(np.abs(u - ue).max() / np.abs(ue).max()),
+            float(np.sqrt(np.mean(np.sum((u - ue) ** 2, axis=1)) / np.mean(np.sum(ue**2, axis=1)))))
+
+
+def mss_run(model: str, mesh, inner, nu: float):
+    """The model's nodal displacement under the dead pressure (a scene, linear static solve)."""
+    from msslib.scene import run_scene
+
+    axes = "xyz"[: mesh.dim]
+    sc = {"name": f"pressure_exact_{model}", "model": model, "geometry": {"mesh": replace(mesh, facet_groups={"inner": inner})},
+          "materials": [{"E": E, "nu": nu, "density": 1000.0}],
+          "boundary": [{"select": {"plane": [a, 0.0]}, "fix": [a]} for a in axes],
+          "loads": [{"type": "pressure", "select": {"group": "inner"}, "pressure": P, "follow": False}],
+          "solver": {"type": "static", "linear": True}}
+    ds = run_scene(sc, progress=False)
+    return np.asarray(ds["displacement"].values).reshape(mesh.n_nodes, mesh.dim)
+
+
+def fem_run(order: int, mesh, inner, nu: float):
+    from msslib.fem import exact, solve_linear
+
+    r = solve_linear(mesh, E, nu, fixed=exact.symmetry_supports(mesh), order=order, plane="stress",
+                     volumetric="reduced" if order == 2 and mesh.dim == 3 else "full", linear_solver="direct",
+                     pressures=[(inner, P, False)])
+    return r.displacement
+
+
+def study(quick: bool = False, log=print) -> list[dict]:
+    from msslib.fem import exact
+
+    rows = []
+    for problem, cells, level, mesh, exact_of in problems(quick):
+        inner = exact.inner_wall(mesh, A)
+        for nu in NUS:
+            u_exact = exact_of(nu)
+            runs = [("fem_quadratic", partial(fem_run, 2)), ("fem_linear_p1", partial(fem_run, 1))]
+            runs += [(m, partial(mss_run, m)) for m in models_for(cells)]
+            reference = None
+            for name, run in runs:
+                outcome = "ok"
+                try:
+                    u = run(mesh, inner, nu)
+                    err_max, err_rms = errors(u, mesh, u_exact)
+                    if reference is None:
+                        reference = u
+                    fem_max = float(np.abs(u - reference).max() / np.abs(reference).max())
+                except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
+                    err_max = err_rms = fem_max = float("nan")
+                    outcome = f"{type(exc).__name__}: {' '.join(str(exc).split())}"[:300]
+                rows.append({"problem": problem, "cells": cells, "level": level, "model": name, "nu": nu,
+                             "n_nodes": mesh.n_nodes, "error_max": err_max, "error_rms": err_rms,
+                             "error_max_vs_fem": fem_max, "outcome": outcome})
+                log(f"{problem:8s} {cells:8s} {level:5g} nu={nu:<6g} {name:26s} max {err_max:.3e} rms {err_rms:.3e} "
+                    f"vs FEM {fem_max:.3e}" + ("" if outcome == "ok" else f"  ({outcome[:120]})"))
+    return rows
+
+
+def write(rows: list[dict], path: str) -> None:
+    import xarray as xr
+
+    data = {key: ("run", np.array([r[key] for r in rows])) for key in rows[0]}
+    ds = xr.Dataset(data)
+    ds.attrs.update(description="nodal displacement errors against the exact thick-cylinder (plane stress) and "
+                                "thick-sphere solutions under internal pressure", E=E, pressure=P, inner_radius=A,
+                    outer_radius=B)
+    ds.to_netcdf(path)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m experiments.stability.pressure_exact", description=__doc__.split("\n")[0])
+    parser.add_argument("--out", required=True, help="the NetCDF file to write")
+    parser.add_argument("--quick", action="store_true", help="coarse levels only")
+    args = parser.parse_args(argv)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rows = study(args.quick)
+    write(rows, args.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
