@@ -168,8 +168,10 @@ def test_boundary_facets_are_triangles_and_quads_pointing_out():
     np.testing.assert_allclose(total, 0.0, atol=1e-13)  # a closed surface
     area = sum(M.facet_areas(mesh, f).sum() for f, _ in by_type.values())
     assert area == pytest.approx(2 * (2 * 1 + 2 * 3 + 1 * 3), rel=1e-14)
-    with pytest.raises(ValueError, match=r"^wedge cells have facets of several types \(triangle, quad\); "
-                                         r"use boundary_facets_by_type$"):
+    with pytest.raises(ValueError, match=r"^mesh: wedge cells have facets of several types \(triangle, quad\), "
+                                         r"which one array of facets cannot hold \(so no tractions or pressures "
+                                         r"on them\); allowed: cells with facets of one type, or "
+                                         r"msslib.mesh.boundary_facets_by_type$"):
         M.boundary_facets(mesh)
 
 
@@ -292,6 +294,18 @@ def test_a_scene_on_a_wedge_mesh_file_solves_with_linear_fem(tmp_path):
     weight = 1000.0 * 9.81 * (2.0 * 1.0 * 3.0)  # rho g V of the box
     np.testing.assert_allclose(ds["reaction_force"].sum(dim="node").values, [0.0, 0.0, weight], atol=1e-9 * weight)
     assert ds["cells"].attrs["cell_type"] == "wedge" and float(ds["displacement"].min()) < 0
+
+
+def test_a_traction_on_a_wedge_mesh_is_refused_in_one_line(tmp_path, capsys):
+    from msslib.cli import main as cli
+
+    scene = _scene(tmp_path)
+    scene["loads"] = [{"type": "traction", "select": {"plane": ["z", 3.0]}, "traction": [0.0, 0.0, -1e3]}]
+    (tmp_path / "t.yaml").write_text(yaml.safe_dump(scene))
+    assert cli(["run", str(tmp_path / "t.yaml"), "--out", str(tmp_path / "t.nc"), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "wedge cells have facets of several types" in err, err
+    assert not (tmp_path / "t.nc").exists()
 
 
 def test_plan_refuses_a_wedge_mesh_in_one_line(tmp_path, capsys):

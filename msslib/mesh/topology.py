@@ -99,8 +99,10 @@ def _single_facets(mesh: Mesh) -> np.ndarray:
     facets of several types (see :func:`boundary_facets_by_type`)."""
     ct = _cells.get(mesh.cell_type)
     if ct.single_facet_type is None:
-        raise ValueError(f"{mesh.cell_type} cells have facets of several types "
-                         f"({', '.join(ct.facets_by_type())}); use boundary_facets_by_type")
+        raise ValueError(f"mesh: {mesh.cell_type} cells have facets of several types "
+                         f"({', '.join(ct.facets_by_type())}), which one array of facets cannot hold (so no "
+                         f"tractions or pressures on them); allowed: cells with facets of one type, or "
+                         f"msslib.mesh.boundary_facets_by_type")
     return ct.facets()
 
 
