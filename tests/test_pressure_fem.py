@@ -139,6 +139,17 @@ def test_bad_pressures_are_refused_in_one_line(bad, message):
         assert "\n" not in str(info.value)
 
 
+def test_pressure_on_wedges_is_refused_in_one_line():
+    from msslib.mesh import boundary_facets_by_type, wedge_grid
+
+    mesh = wedge_grid(1.0, 1.0, 1.0, 2, 2, 2)
+    top = boundary_facets_by_type(mesh)["triangle"][0][:1]
+    fixed = np.zeros((mesh.n_nodes, 3), bool)
+    with pytest.raises(ValueError, match=r"^pressures: the FEM references take pressures on meshes whose facets are "
+                                         r"of one type \(triangle, quad, tetra or hexahedron cells\), got wedge cells$"):
+        solve_linear(mesh, 1.0, 0.3, fixed=fixed, pressures=[(top, 1.0, False)])
+
+
 def test_follower_inflation_past_its_limit_stops_with_the_load_factor_reached():
     """A thin neo-Hookean ring (radius 1, wall 0.1, plane strain) inflated by a follower pressure:
     its hoop force saturates, so the pressure it holds is bounded (about mu t / R = 0.038 E); a

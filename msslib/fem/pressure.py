@@ -45,7 +45,13 @@ def check_pressures(pressures, mesh) -> list:
                          f"{type(pressures).__name__}") from None
     out = []
     boundary = None
-    nf = boundary_facets(mesh).shape[1] if len(mesh.cells) and items else 0  # (no facets to find without pressures)
+    if not items:  # (no facets to find without pressures)
+        return out
+    try:
+        nf = boundary_facets(mesh).shape[1]
+    except ValueError:  # facets of several types (wedges): no facet forms for them here
+        raise ValueError(f"pressures: the FEM references take pressures on meshes whose facets are of one type "
+                         f"(triangle, quad, tetra or hexahedron cells), got {mesh.cell_type} cells") from None
     for n, item in enumerate(items):
         if not isinstance(item, (tuple, list)) or len(item) != 3:
             raise ValueError(f"pressures[{n}] must be a tuple (facets, pressure, follow), got {item!r:.80}")
