@@ -190,3 +190,21 @@ def test_the_mesh_tables_are_read_from_the_registry():
         assert M.CELL_TYPES[name] == (ct.dim, ct.nodes)
     with pytest.raises(ValueError, match=r"^unknown cell_type 'pyramid'; expected one of \["):
         M.Mesh(np.zeros((5, 3)), np.arange(5)[None, :], "pyramid")
+
+
+def test_the_derivation_engine_numbers_its_cells_as_the_registry_does():
+    """The engine's cell list (derivations.element_stiffness, kept apart: msslib imports nothing of
+    derivations) has the registry's reference nodes in the same order, and its shape functions have
+    the registry's gradients, for every type it knows."""
+    import sympy as sp
+
+    from derivations.element_stiffness import _REF, shape_functions
+
+    assert set(_REF) <= set(NAMES)
+    for name, nodes in _REF.items():
+        ct = cells.get(name)
+        np.testing.assert_array_equal(np.array(nodes, dtype=float), ct.reference, err_msg=name)
+        N, ref = shape_functions(name)
+        point = ct.reference.mean(axis=0) + 0.05 * np.arange(1, ct.dim + 1)
+        grad = np.array([[float(sp.diff(n, r).subs(dict(zip(ref, point)))) for r in ref] for n in N])
+        np.testing.assert_allclose(grad, ct.gradients(point[None])[0], atol=1e-14, err_msg=name)
