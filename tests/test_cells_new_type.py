@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import test_cells
+from cell_helpers import example_mesh
 from msslib import mesh as M
 from msslib.mesh import cells
 
@@ -39,6 +40,13 @@ def _variants(refinement):
     return dataclasses.replace(refinement, virtual=virtual)
 
 
+def _example(lx, ly, lz, nx, ny, nz):
+    from msslib import mesh as M
+
+    grid = M.tet_grid(lx, ly, lz, nx, ny, nz)
+    return M.Mesh(grid.points, grid.cells[:, _ORDER], "scratch_tetra")
+
+
 CELL = dataclasses.replace(
     tetra.CELL, name="scratch_tetra", plural="scratch tetrahedra", reference=tetra.CELL.reference[_ORDER],
     edges=_renumbered(tetra.CELL.edges.tolist()), faces=_renumbered(tetra.CELL.faces),
@@ -46,6 +54,7 @@ CELL = dataclasses.replace(
     gradients=lambda p: tetra.CELL.gradients(p)[:, _ORDER],
     linear=dataclasses.replace(tetra.CELL.linear, vtk_to_skfem=None),
     quadratic=dataclasses.replace(tetra.CELL.quadratic, vtk_to_skfem=None),
+    example=(_example, {"lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 2, "ny": 2, "nz": 2}),
 )
 '''
 
@@ -68,6 +77,9 @@ def test_the_registry_and_the_mesh_take_the_new_cell_type(scratch):
     assert M.CELL_TYPES[scratch] == (3, 4) and scratch in M.CELL_TYPES
     mesh = M.Mesh(np.eye(4, 3), [[0, 1, 2, 3]], scratch)
     assert mesh.cell_type == scratch and mesh.n_cells == 1
+    example = example_mesh(scratch, 0.5)  # the registry-wide tests' mesh of it, from its own module
+    assert example.cell_type == scratch and example.n_cells == 48
+    assert M.check_cells(example).sum() == pytest.approx(0.125, rel=1e-13)
 
 
 def test_every_cell_test_passes_on_the_new_cell_type(scratch, tmp_path):

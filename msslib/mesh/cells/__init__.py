@@ -88,8 +88,9 @@ class CellType:
     cell (both None where there are none).  ``vtk_id``: the VTK cell type number; ``meshio``: the
     name meshio gives it; ``volume_shape``: the UGRID volume shape of a 3D type.
     ``example``: a small mesh of the type for tests and examples, ``(generator, arguments)``: a
-    generator of :mod:`msslib.mesh` and its keyword arguments (lengths in metres, about 1 m; the
-    registry-wide tests build it, scaled where they need another size).
+    generator of :mod:`msslib.mesh` (its name) or a function of the cell module returning a
+    :class:`~msslib.mesh.Mesh`, and its keyword arguments (lengths in metres, as floats, about 1
+    m; the registry-wide tests build it, scaled where they need another size).
     """
 
     name: str
