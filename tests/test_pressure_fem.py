@@ -281,3 +281,38 @@ def test_free_body_under_pressure_on_all_sides_has_zero_resultant_and_torque(mes
         assert np.abs(torque).max() < 1e-13 * scale
         assert np.abs(r.reaction).max() < 1e-8 * scale
         assert r.displacement[ex, 0] < -0.02  # compressed: the far corner moved towards the held one
+
+
+def test_follower_work_equals_pressure_times_cavity_volume_change_in_3d():
+    """The same on an octant of a thick neo-Hookean sphere (linear tetrahedra, radii 1 and 2):
+    the cavity's volume is the cone of the inner wall's facets from the centre (the symmetry planes
+    pass through it), ``V = -sum x0 . (x1 x x2) / 6`` over the outward facets."""
+    from msslib.fem import exact
+
+    mesh = exact.sphere_octant(1.0, 2.0, 0.5)
+    inner = exact.inner_wall(mesh, 1.0)
+    fixed = exact.symmetry_supports(mesh)
+    p = 0.2
+
+    def volume(x):
+        a, b, c = x[inner[:, 0]], x[inner[:, 1]], x[inner[:, 2]]
+        return -np.einsum("ki,ki->", a, np.cross(b, c)) / 6.0
+
+    assert 0.85 * np.pi / 6 < volume(mesh.points) < np.pi / 6  # an eighth of the unit ball, faceted inside it
+    geo = _Geometry(mesh, 1)
+    load = FacetPressure(geo, inner, p, True)
+    gaps = []
+    for n in (4, 8):
+        u_prev, work, pdv = np.zeros(geo.n_dofs), 0.0, 0.0
+        for k in range(1, n + 1):
+            r = solve_nonlinear(mesh, 1.0, 0.3, fixed=fixed, law="neohookean", steps=k,
+                                pressures=[(inner, k / n * p, True)])
+            u = r.dof_displacement.ravel()
+            work += 0.5 * ((k - 1) / n * load.forces(u_prev) + k / n * load.forces(u)) @ (u - u_prev)
+            dv = volume(mesh.points + u.reshape(-1, 3)) - volume(mesh.points + u_prev.reshape(-1, 3))
+            pdv += 0.5 * (2 * k - 1) / n * p * dv
+            u_prev = u
+        assert volume(mesh.points + u_prev.reshape(-1, 3)) > 1.1 * volume(mesh.points)  # a large inflation
+        gaps.append(abs(work - pdv) / pdv)
+    assert gaps[0] < 2e-2
+    assert gaps[1] < 0.3 * gaps[0]  # second order in the increment
