@@ -14,7 +14,8 @@ Euler, undamped, 0.9 of the stability limit), one core, N steps from rest:
 
 Positions after N steps are compared between the fp64 engines (max difference over the body's
 size).  Also: the stability check's share of a 100-step run (a step within the cheap bound, a
-step that needs Lanczos the first time, the same step again), and the stepping API's cost per
+step at 0.9 of the limit certified by a short Lanczos run the first time, the same step again,
+and the eigsh estimate the check took before), and the stepping API's cost per
 single step on a 10 k-spring scene against its raw multi-step kernel, and the haptic loop (a tool
 on a path, its force read after every step: steps/s and real-time factor at 10 k springs).
 """
@@ -172,22 +173,30 @@ def throughput(res, name, build, quick):
 
 
 def stability_share(res, name, model, dt):
-    """The check's wall time over a 100-step run: a step within the cheap bound, one above it
-    (Lanczos, first time), the same again (kept estimate)."""
-    run = _ours(model, dt, "network")[0]
+    """The check's wall time over a 100-step run: a step within the cheap bound, one at 0.9 of
+    the limit above it (the certified Lanczos run, first time), the same again (kept), and the
+    eigsh estimate the check took before the certificate (``estimate="lanczos"``), medians of
+    three in one process."""
     bound, _ = S.omega_max_bound(model, model.x0)
     times = {}
-    for key, step in (("bound", 0.9 * 2.0 / bound), ("lanczos", dt), ("reused", dt)):
-        if key != "reused":
-            model._spectrum_cache = {}
-        t = time.perf_counter()
-        info = S.check_time_step(model, model.x0, step)
-        times[key] = (time.perf_counter() - t, info["stability_estimate"])
+    runs = []
+    for _ in range(3):
+        runs.append(_ours(model, dt, "network")[0])
+        for key, step, how in (("bound", 0.9 * 2.0 / bound, "auto"), ("certified", dt, "auto"), ("reused", dt, "auto"),
+                               ("eigsh", dt, "lanczos")):
+            if key != "reused":
+                model._spectrum_cache = {}
+            t = time.perf_counter()
+            info = S.check_time_step(model, model.x0, step, estimate=how)
+            times.setdefault(key, []).append((time.perf_counter() - t, info["stability_estimate"]))
+    run = float(np.median(runs))
     ratio = 2.0 / bound / dt * 0.9
-    for key, (w, how) in times.items():
+    for key, rows in times.items():
+        w = float(np.median([r[0] for r in rows]))
         res.add(f"stability_check_{name}_{key}", w / run, "of a 100-step run", None, None,
-                f"{w * 1000:.1f} ms ({how}) against {run * 1000:.0f} ms for {STEPS} steps; the bound accepts steps up "
-                f"to {ratio:.2f} x the limit", target=("<=", 0.10, "value") if key != "lanczos" else None)
+                f"{w * 1000:.1f} ms ({rows[-1][1]}) against {run * 1000:.0f} ms for {STEPS} steps; the bound accepts "
+                f"steps up to {ratio:.2f} x the limit; dt = 0.9 x the limit",
+                target=("<=", 0.10, "value") if key in ("bound", "certified", "reused") else None)
 
 
 def api_overhead(res, quick):
@@ -225,7 +234,7 @@ def haptic_rate(res, quick):
     pts = model.mesh.points
     tool = np.flatnonzero((pts[:, 2] > pts[:, 2].max() - 1e-9) & (np.hypot(pts[:, 0], pts[:, 1]) < 0.01))
     n = 1000 if quick else 5000
-    walls = []
+    walls, rtfs = [], []
     for _ in range(3):
         sim = Simulator(model, dt=dt, damping=20.0)
         sim.prescribe(tool, [[0.0, 0, 0, 0], [0.05, 0, 0, -1e-3]])
@@ -234,13 +243,16 @@ def haptic_rate(res, quick):
             sim.step()
             force = sim.reaction[tool].sum(axis=0)
         walls.append(time.perf_counter() - t)
-        rtf = sim.real_time_factor
+        rtfs.append(sim.real_time_factor)
     w = min(walls)
+    loop = n * dt / w  # simulated time over the loop's wall time: the steps and the force reads
     res.add("stepping_haptic_10k", n / w, "steps/s", None, None,
             f"{s} springs, tool of {len(tool)} nodes on a path, its force read after every step (last {force[2]:.3g} N); "
-            f"dt = {dt * 1e6:.1f} us, real-time factor {rtf:.2f} (target >= 1)", target=(">=", 1000.0, "value"))
-    res.add("stepping_haptic_10k_real_time_factor", rtf, "simulated / wall time", None, None,
-            f"{s} springs, one step per call, force read every step", target=(">=", 1.0, "value"))
+            f"dt = {dt * 1e6:.1f} us, real-time factor {loop:.2f} with the force reads (target >= 1), best of 3",
+            target=(">=", 1000.0, "value"))
+    res.add("stepping_haptic_10k_real_time_factor", loop, "simulated / wall time", None, None,
+            f"{s} springs, one step per call, the tool's force read after every step, best of 3 (the steps "
+            f"alone, Simulator.real_time_factor: {max(rtfs):.2f})", target=(">=", 1.0, "value"))
 
 
 def jax_reset(res, quick):
@@ -285,7 +297,7 @@ def run(res, quick: bool):
     for name, build in cases:
         print(f"[stepping] {name} ...", flush=True)
         model, dt = throughput(res, name, build, quick)
-        if name in ("lloyd_122k", "lloyd_945k"):
+        if name in ("lloyd_122k", "lloyd_945k", "golec_95k", "golec_740k"):
             stability_share(res, name, model, dt)
     api_overhead(res, quick)
     jax_reset(res, quick)

@@ -116,14 +116,14 @@ def _spring_prep(x, conn, k, L0, isq, coef, shift_rows):
 
 
 @njit(cache=True, nogil=True)
-def _spring_matvec(conn, coef, isq, v, out):
-    """``out += D K D v`` for springs prepared by :func:`_spring_prep` (``D = diag(isq)``)."""
+def _spring_matvec(conn, coef, u, out):
+    """``out += K u`` for springs prepared by :func:`_spring_prep`."""
     for s in range(conn.shape[0]):
         a = 3 * conn[s, 0]
         b = 3 * conn[s, 1]
-        u0 = isq[b] * v[b] - isq[a] * v[a]
-        u1 = isq[b + 1] * v[b + 1] - isq[a + 1] * v[a + 1]
-        u2 = isq[b + 2] * v[b + 2] - isq[a + 2] * v[a + 2]
+        u0 = u[b] - u[a]
+        u1 = u[b + 1] - u[a + 1]
+        u2 = u[b + 2] - u[a + 2]
         n0 = coef[s, 0]
         n1 = coef[s, 1]
         n2 = coef[s, 2]
@@ -132,12 +132,12 @@ def _spring_matvec(conn, coef, isq, v, out):
         f0 = t * n0 + c * u0
         f1 = t * n1 + c * u1
         f2 = t * n2 + c * u2
-        out[a] -= isq[a] * f0
-        out[a + 1] -= isq[a + 1] * f1
-        out[a + 2] -= isq[a + 2] * f2
-        out[b] += isq[b] * f0
-        out[b + 1] += isq[b + 1] * f1
-        out[b + 2] += isq[b + 2] * f2
+        out[a] -= f0
+        out[a + 1] -= f1
+        out[a + 2] -= f2
+        out[b] += f0
+        out[b + 1] += f1
+        out[b + 2] += f2
 
 
 def _scaled_operator(problem, x, load, free):
@@ -177,10 +177,12 @@ def _scaled_operator(problem, x, load, free):
                 break
             prepared.append((conn, coef))
         if ok:
-            def matvec(v):
+            def matvec(v):  # D K D v
+                u = isq * v
                 out = np.zeros(v.size)
                 for conn, coef in prepared:
-                    _spring_matvec(conn, coef, isq, v, out)
+                    _spring_matvec(conn, coef, u, out)
+                out *= isq
                 return out
 
             return matvec, m.size, float(shift_rows.max()) if shift_rows.size else 0.0
