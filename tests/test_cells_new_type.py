@@ -11,9 +11,9 @@ import textwrap
 
 import numpy as np
 import pytest
-
 import test_cells
 from cell_helpers import example_mesh
+
 from msslib import mesh as M
 from msslib.mesh import cells
 

@@ -211,7 +211,7 @@ def test_refinement_is_nested_and_keeps_the_volume_and_the_facet_groups():
     assert len(fine.node_groups["top"]) == 5 * 5
     # the same nodes as the wedge grid of four times the resolution
     grid = M.wedge_grid(2.0, 1.0, 3.0, 4, 4, 4)
-    key = lambda p: np.round(p, 12).tolist()  # noqa: E731
+    key = lambda p: np.round(p, 12).tolist()
     assert sorted(key(fine.points)) == sorted(key(grid.points))
 
 
@@ -263,7 +263,12 @@ def test_the_triangles_and_quads_of_a_wedge_file_are_node_groups(tmp_path):
 
 def test_the_result_writer_names_the_wedge_volume_shape(tmp_path):
     from msslib.results.conventions import VOLUME_SHAPES
-    from msslib.results.netcdf import make_dataset, mesh_from_result, read_result, write_result
+    from msslib.results.netcdf import (
+        make_dataset,
+        mesh_from_result,
+        read_result,
+        write_result,
+    )
 
     mesh = _box(1, 1, 1)
     ds = make_dataset(mesh, np.zeros((mesh.n_nodes, 3)), model="fem_linear", E=1e4, nu=0.3)

@@ -16,7 +16,6 @@ import numpy as np
 from . import cells as _cells
 from .cells import RegistryView as _RegistryView
 
-
 #: cell type -> (dimension, nodes per cell), of every type of the registry (:mod:`msslib.mesh.cells`)
 CELL_TYPES = _RegistryView(lambda c: (c.dim, c.nodes), "cell type -> (dimension, nodes per cell)")
 

@@ -13,7 +13,14 @@ from typing import NamedTuple
 import numpy as np
 
 from . import cells as _cells
-from .core import LOCAL_EDGES, COINCIDENT_POLICIES, COINCIDENT_RTOL, Mesh, _compact, _fmt_point
+from .core import (
+    COINCIDENT_POLICIES,
+    COINCIDENT_RTOL,
+    LOCAL_EDGES,
+    Mesh,
+    _compact,
+    _fmt_point,
+)
 from .geometry import cell_measures
 from .groups import _renumbered_groups
 from .topology import facet_connected_cells

@@ -22,11 +22,10 @@ from __future__ import annotations
 import importlib
 import itertools
 import pkgutil
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cache, lru_cache
 from types import ModuleType
-from typing import Callable
 
 import numpy as np
 
@@ -247,7 +246,7 @@ LINE = Refinement(((0,), (1,), (0, 1)), np.array([[0, 2], [2, 1]]))
 # --------------------------------------------------------------------------------------------
 
 
-@lru_cache(maxsize=None)
+@cache
 def modules() -> tuple[ModuleType, ...]:
     """The cell modules of this package (those declaring ``CELL``), ordered by their ``RANK``, then
     by name."""
@@ -261,7 +260,7 @@ def modules() -> tuple[ModuleType, ...]:
     return tuple(sorted(found, key=lambda m: (getattr(m, "RANK", 100), m.__name__)))
 
 
-@lru_cache(maxsize=None)
+@cache
 def _registry() -> tuple[tuple[str, CellType], ...]:
     out: dict[str, CellType] = {}
     for module in modules():
