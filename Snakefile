@@ -250,6 +250,24 @@ if not QUICK:
 
     ruleorder: study_baudet_cantilever_floor > study
 
+    # the Baudet L-block's Q1 reference at n = 48 (265 k dofs): 3.6 GB, 37 s per solve; the experiment solves
+    # it once, study l_block_load twice (line load, face traction), study structural once (beside Q2
+    # 12x12x36 for the sheared beam, 2.4 GB)
+    use rule study as study_baudet_l_block_reference with:
+        wildcard_constraints:
+            paper="baudet",
+            name="l_block_load|structural",
+        resources:
+            mem_mb=6000,
+
+    ruleorder: study_baudet_l_block_reference > study
+
+    use rule experiment_baudet_l_block as experiment_baudet_l_block_dense with:
+        resources:
+            mem_mb=6000,
+
+    ruleorder: experiment_baudet_l_block_dense > experiment_baudet_l_block
+
 
 rule figure:
     """A figure script of experiments/<paper>/figures/ (one that computes or draws something of its own)."""
