@@ -98,7 +98,8 @@ def test_dynamic_case_records_the_models_stability_limit():
 def test_cantilever_front_runs_baudet_under_the_element_reading():
     path = ROOT / "experiments" / "performance" / "scenes" / "cantilever.yaml"
     raw = yaml.safe_load(path.read_text())
-    assert front._reading(raw, "baudet_cube") == "element" and front._reading(raw, "golec_cube") == ""
+    names = ["baudet_cube", "baudet_cube_linear", "golec_cube", "golec_cube_linear", "fem_linear", "fem_neohookean"]
+    assert front.readings(raw, names) == ["element", "element", "", "", "", ""]
     terms = prepare(load_scene(at_level(raw, 1, "baudet_cube"), base_dir=path.parent)).model.terms
     assert any(isinstance(t, ElementBaudetCorrection) for t in terms)
     assert not any(isinstance(t, BaudetCorrection) for t in terms)
