@@ -15,8 +15,11 @@ Displacements, forces and reactions are ``(n_nodes, dim)`` arrays. Internally th
 node ``a``, component ``i`` is ``a * dim + i`` (interleaved by node).
 
 Elements: triangle P1 (``ElementTriP1``), quad Q1 (``ElementQuad1``), tetra P1 (``ElementTetP1``),
-hexahedron Q1 (``ElementHex1``). Quadrature: one point for simplices (exact for the constant
-strains and for the linear load integrands), 2x2 / 2x2x2 Gauss for Q1.
+hexahedron Q1 (``ElementHex1``), wedge (``ElementWedge1``); each cell type's elements, node
+permutation and quadrature are its cell module's (:mod:`msslib.mesh.cells`). Quadrature: one point
+for simplices (exact for the constant strains and for the linear load integrands), 2x2 / 2x2x2
+Gauss for Q1, and for the wedge a 6-point rule of msslib's own (scikit-fem 12.0.2's wedge
+weights sum to half the reference volume).
 
 Assembly: scikit-fem provides the meshes, reference mappings, quadrature and basis functions.
 :func:`element_stiffness` and ``solve_linear(..., assembly="skfem")`` assemble with a scikit-fem
@@ -44,6 +47,8 @@ Node orders (checked against the volumes of a unit square/box in the tests):
 * triangle, tetra, quad: scikit-fem accepts the VTK order as is (``MeshTri`` sorts the node
   indices of each triangle, which does not change P1 results; ``MeshQuad1`` numbers its corners
   counter-clockwise 0-1-2-3 like VTK).
+* wedge: ``MeshWedge1``'s reference triangle turns the other way than VTK's (whose first
+  triangle's normal points out of the cell): ``skfem_cells = vtk_cells[:, [0, 2, 1, 3, 5, 4]]``.
 * hexahedron: ``MeshHex1`` numbers the corners of the unit cube
   (0,0,0), (0,0,1), (0,1,0), (1,0,0), (0,1,1), (1,0,1), (1,1,0), (1,1,1); the VTK order is
   (0,0,0), (1,0,0), (1,1,0), (0,1,0), (0,0,1), (1,0,1), (1,1,1), (0,1,1). Hence
