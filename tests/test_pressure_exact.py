@@ -157,3 +157,23 @@ def test_sphere_orders_on_a_third_mesh():
         e, _ = _sphere_errors(2, nu, sizes)
         assert np.all(_slopes(e) > 1.8)  # measured 2.06, 1.97 (0.3)
         assert e[-1] < 5e-3  # measured 3.7e-3 (0.3), 3.9e-3 (0.4999)
+
+
+def test_study_models_exact_on_their_elements_agree_with_linear_fem_under_pressure():
+    """The study's two paths meet: Delingette's triangle and Kikuuwe's tetrahedron reproduce the
+    linear element's stiffness, so their scene runs under the dead pressure (the mass-spring
+    pressure load on a facet group) give linear FEM's displacements (msslib.fem pressures on the
+    same facets) to round-off, with the same errors against the exact solution."""
+    from experiments.stability import pressure_exact as study
+
+    for mesh, model, u_exact in (
+            (exact.quarter_annulus(A, B, 4), "delingette_triangle", partial(study.plane_stress_cylinder, nu=0.3)),
+            (exact.sphere_octant(A, B, 0.4), "kikuuwe_tetrahedron",
+             partial(exact.sphere_displacement, a=A, b=B, p=study.P, E=study.E, nu=0.3))):
+        inner = exact.inner_wall(mesh, A)
+        u_mss = study.mss_run(model, mesh, inner, 0.3)
+        u_fem = study.fem_run(1, mesh, inner, 0.3)
+        assert np.abs(u_mss - u_fem).max() < 1e-9 * np.abs(u_fem).max()
+        err, _ = study.errors(u_fem, mesh, u_exact)
+        err_q, _ = study.errors(study.fem_run(2, mesh, inner, 0.3), mesh, u_exact)
+        assert 0.01 < err < 0.5 and err_q < 0.5 * err  # measured 7.3 % / 0.65 % (cylinder), 24 % / 7.8 % (sphere)
