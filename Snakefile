@@ -268,6 +268,13 @@ if not QUICK:
 
     ruleorder: experiment_baudet_l_block_dense > experiment_baudet_l_block
 
+    # the sheared beam's Q1 24x24x72 reference: 1.9 GB, 19 s, at the default's edge
+    use rule experiment_baudet_shear_beam as experiment_baudet_shear_beam_dense with:
+        resources:
+            mem_mb=4000,
+
+    ruleorder: experiment_baudet_shear_beam_dense > experiment_baudet_shear_beam
+
 
 rule figure:
     """A figure script of experiments/<paper>/figures/ (one that computes or draws something of its own)."""
