@@ -35,6 +35,15 @@ def cell(r):
     return ", ".join(parts) or str(r.outcome.values)[:60]
 
 
+def _readings(d):
+    """The sentence naming the reading of Baudet's correction of each column that has one."""
+    if "reading" not in d:
+        return ""
+    named = [f"{m}: {r} reading" for m, r in zip(d.model.values, d.reading.values) if str(r)]
+    return (" Baudet's correction force: " + "; ".join(named) + " (element: each cube from the forces it receives "
+            "from outside; boundary: from the loaded surface).") if named else ""
+
+
 def main():
     a = script.args(__doc__)
     d = read_result(INPUTS[0])
@@ -45,7 +54,7 @@ def main():
              "unloaded: maximum displacement over edge length; slender_beam: tip deflection over Euler-Bernoulli's, "
              "minus 1); *V/V0*: volume ratio. Explicit steps over the stability limit of the model at rest are "
              "refused; the table shows where the divergence detector stops them when the scene asks to run anyway "
-             "(allow_unstable).", "",
+             "(allow_unstable)." + _readings(d), "",
              "| case | " + " | ".join(models) + " |", "|---" * (len(models) + 1) + "|"]
     for c in d.case.values:
         lines.append(f"| {c} | " + " | ".join(cell(d.sel(case=c, model=m)) for m in models) + " |")
