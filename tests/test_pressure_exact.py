@@ -177,3 +177,21 @@ def test_study_models_exact_on_their_elements_agree_with_linear_fem_under_pressu
         err, _ = study.errors(u_fem, mesh, u_exact)
         err_q, _ = study.errors(study.fem_run(2, mesh, inner, 0.3), mesh, u_exact)
         assert 0.01 < err < 0.5 and err_q < 0.5 * err  # measured 7.3 % / 0.65 % (cylinder), 24 % / 7.8 % (sphere)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("body", ["triangle", "quad", "tetra"])
+def test_equal_pressure_inside_and_outside_compresses_uniformly_to_round_off(body, order):
+    """The same pressure on the inner and outer walls (the faceted ones of the mesh) and symmetry
+    supports: the exact solution of the discrete body is the uniform compression
+    u = -p (1 + nu)(1 - 2 nu) / E x (plane strain) or -p (1 - 2 nu) / E x (3D), which linear and
+    quadratic elements represent: every node's displacement to round-off, whatever the mesh."""
+    nu = 0.3
+    mesh = exact.sphere_octant(A, B, 0.5) if body == "tetra" else exact.quarter_annulus(A, B, 3, body)
+    walls = [(exact.inner_wall(mesh, A), P, False), (exact.inner_wall(mesh, B), P, True)]
+    r = solve_linear(mesh, E, nu, fixed=exact.symmetry_supports(mesh), plane="strain", order=order,
+                     volumetric=RULES[order], pressures=walls)
+    factor = (1 + nu) * (1 - 2 * nu) if mesh.dim == 2 else (1 - 2 * nu)
+    want = -P * factor / E * mesh.points
+    assert np.abs(r.displacement - want).max() < 1e-12 * np.abs(want).max()
+    assert np.abs(r.dof_displacement + P * factor / E * r.dof_points).max() < 1e-12 * np.abs(want).max()
