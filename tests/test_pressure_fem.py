@@ -126,12 +126,14 @@ def test_linear_solve_of_a_pressed_block_is_uniaxial_compression():
     ("follow", "pressures[0]: follow must be True (follower) or False (dead), got 'yes'"),
     ("shape", "pressures[0]: facets must be node ids of shape (k, 2)"),
     ("ids", "pressures[0]: facets: node ids must lie in 0..15, got 16"),
+    ("twice", "pressures[0]: facet of nodes [12, 13] is listed twice; give each loaded facet once"),
 ])
 def test_bad_pressures_are_refused_in_one_line(bad, message):
     mesh, top, fixed = _block()
     entry = {"nan": (top, float("nan"), True), "empty": (np.zeros((0, 2), int), 1.0, True),
              "inner": (np.array([[5, 6]]), 1.0, True), "follow": (top, 1.0, "yes"),
-             "shape": (top.ravel(), 1.0, True), "ids": (np.array([[15, 16]]), 1.0, True)}[bad]
+             "shape": (top.ravel(), 1.0, True), "ids": (np.array([[15, 16]]), 1.0, True),
+             "twice": (np.vstack([top, top[:1][:, ::-1]]), 1.0, False)}[bad]
     for solve in (solve_linear, solve_nonlinear):
         with pytest.raises(ValueError) as info:
             solve(mesh, 1.0, 0.3, fixed=fixed, pressures=[entry])

@@ -35,7 +35,8 @@ for _i, _j, _k in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
 def check_pressures(pressures, mesh) -> list:
     """``pressures`` as a list of ``(facets (k, nf) int64, p float, follow bool)``; ValueError in one
     line naming the argument, the value and what is allowed for a malformed entry, an empty facet
-    array, a non-finite pressure, or facets that are not boundary facets of ``mesh``."""
+    array, a non-finite pressure, facets that are not boundary facets of ``mesh`` or a facet listed
+    twice."""
     from msslib.mesh import boundary_facets
 
     try:
@@ -76,10 +77,15 @@ def check_pressures(pressures, mesh) -> list:
             raise ValueError(f"pressures[{n}]: facets: node ids must lie in 0..{mesh.n_nodes - 1}, got {bad}")
         if boundary is None:
             boundary = {tuple(sorted(r)) for r in boundary_facets(mesh).tolist()}
+        seen = set()
         for r in facets.tolist():
-            if tuple(sorted(r)) not in boundary:
+            key = tuple(sorted(r))
+            if key not in boundary:
                 raise ValueError(f"pressures[{n}]: facet of nodes {r} is not a boundary facet of the mesh; a pressure "
                                  "acts on boundary facets only (msslib.mesh.boundary_facets)")
+            if key in seen:  # it would carry the pressure twice
+                raise ValueError(f"pressures[{n}]: facet of nodes {r} is listed twice; give each loaded facet once")
+            seen.add(key)
         out.append((facets, pv, bool(follow)))
     return out
 
