@@ -172,3 +172,11 @@ def _interior_facet(mesh):
             if facet_cell_counts(mesh, cell[local][None])[0] == 2:
                 return cell[local]
     raise AssertionError("no interior facet")
+
+
+def test_a_linear_solve_reads_a_follower_pressure_on_the_rest_surface_as_linear_fem_does():
+    linear = {"type": "static", "linear": True}
+    follower = run_scene(load_scene(hollow_scene(pressure=2000.0, solver=linear)), progress=False)
+    dead = run_scene(load_scene(hollow_scene(pressure=2000.0, follow=False, solver=linear)), progress=False)
+    np.testing.assert_allclose(follower.displacement.values, dead.displacement.values, rtol=1e-10, atol=1e-15)
+    assert np.abs(dead.displacement.values).max() > 1e-3

@@ -96,6 +96,8 @@ def _solve_mss_static(setup: Setup, report):
 def _solve_mss_linear(setup: Setup):
     """One sparse solve with the model's stiffness (Hessian) at rest: the linearised MSS, by the
     solver layer of :mod:`msslib.solvers` (the policy of every solve, as linear FEM's)."""
+    import scipy.sparse as sp
+
     from msslib.fem.newton import SOLVER, linear_solve
 
     model, t0 = setup.model, time.perf_counter()
@@ -103,8 +105,14 @@ def _solve_mss_linear(setup: Setup):
     du, free = x - model.x0, model.free
     K, f = model.stiffness(model.x0, 1.0), model.force(model.x0, 1.0)
     K = K.tocsr()
+    # linear theory, as linear FEM: a follower pressure acts on the rest surface, without its load stiffness
+    followers = [t for t in model.terms if getattr(t, "follow", False)]
+    for t in followers:
+        rows, cols = t.hessian_pattern()
+        K = (K - sp.csr_matrix((t.hessian_values(model.x0), (rows, cols)), shape=K.shape)).tocsr()
+    symmetric = all(t.symmetric for t in model.terms if t not in followers)
     du[free], how = linear_solve(K, f[free] - K[free][:, ~free] @ du[~free], free, model.x0.reshape(-1, model.dim),
-                                 model.dim, symmetric=bool(getattr(model, "symmetric", True)))
+                                 model.dim, symmetric=symmetric)
     reaction = np.where(free, 0.0, K @ du - f).reshape(-1, model.dim)  # of the linearised forces
     stats = {"type": "static", "linear": True, "wall_time": time.perf_counter() - t0,
              "solver": f"one solve with the stiffness at rest, {SOLVER}: {how}"}
