@@ -233,3 +233,16 @@ def test_a_follower_load_past_its_limit_stops_at_the_load_factor_reached_and_say
     reached = float(message.split("last converged load factor ")[1].split(",")[0])
     assert 0.49 < reached < 0.5 and info.value.load <= 0.5 + 1e-12
     assert "\n" not in message
+
+
+def test_copies_keep_the_reading():
+    import copy
+    import pickle
+
+    mesh = MESHES["hexahedron"]()
+    facets = M.boundary_facets(mesh)[:3]
+    x = _moved(mesh).ravel()
+    for term in (Pressure(mesh, facets, 50.0, follow=False), Pressure(mesh, facets, 50.0)):
+        for other in (copy.deepcopy(term), pickle.loads(pickle.dumps(term))):
+            assert type(other) is type(term) and other.follow == term.follow
+            np.testing.assert_array_equal(other.gradient(x), term.gradient(x))

@@ -198,8 +198,11 @@ class Pressure(ExternalForce):
     export_label = "pressure"
     follow = False
 
-    def __new__(cls, mesh=None, facets=None, pressure=0.0, follow=True, thickness=1.0, name=""):
-        if cls is Pressure and follow:
+    def __new__(cls, *args, **kwargs):
+        # Pressure(...) with follow (default True) makes the follower reading; a copy (no arguments)
+        # keeps its class
+        follow = args[3] if len(args) > 3 else kwargs.get("follow", True)
+        if cls is Pressure and (args or kwargs) and follow:
             cls = FollowerPressure
         return super().__new__(cls)
 
