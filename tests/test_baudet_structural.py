@@ -66,3 +66,23 @@ def test_eq10_axis_is_zero_on_eq10_and_relative_when_scaled():
     tip, largest = S.eq10_axis(stiff)
     assert tip == pytest.approx(-0.1, rel=1e-12)  # 10 % too small at the tip, signed
     assert largest == pytest.approx(0.1, rel=1e-12)  # the tip holds the largest deflection
+
+
+def test_loaded_edge_nodes_of_the_l_block():
+    """At n = 8 (cubes of 0.5 m) the six loaded edges hold 2 x (9 + 5 + 5) nodes, and every node the
+    line load of make_l_block acts on is among them."""
+    from experiments.baudet import make_l_block as LB
+    from msslib.scene import load_scene
+    from msslib.scene.prepare import prepare
+
+    sc, base = S.scene("l_block", "fem_linear", 8)
+    setup = prepare(load_scene(sc, base_dir=base))
+    X = setup.mesh.points
+    on = S.loaded_edge_nodes(X)
+    assert on.sum() == 2 * (9 + 5 + 5)
+    loaded = np.zeros(len(X), bool)
+    for load in LB.loads(8):
+        lo, hi = (np.array(p) for p in load["select"]["box"])
+        loaded |= np.all((X >= lo - 1e-9) & (X <= hi + 1e-9), axis=1)
+    assert loaded.sum() == 2 * (8 + 5 + 4)  # the base nodes of the two edges reaching z = 0 carry no force
+    assert np.all(on[loaded])

@@ -109,6 +109,14 @@ def eq10_axis(ds):
     return float(d[-1]), float(np.abs(d).max())
 
 
+def loaded_edge_nodes(X):
+    """Mask of the L-block nodes ``X`` (n_nodes, 3) on the six vertical edges the line load acts on."""
+    on = np.zeros(len(X), bool)
+    for x, y, z0, z1 in LB.EDGES:
+        on |= np.isclose(X[:, 0], x) & np.isclose(X[:, 1], y) & (X[:, 2] >= z0 - 1e-9) & (X[:, 2] <= z1 + 1e-9)
+    return on
+
+
 def solve(name, order, mesh):
     """(rest positions of the mesh's nodes, their displacements, the FEM result, wall time) of a Q1
     or Q2 solve of the experiment's scene."""
@@ -161,9 +169,7 @@ def main():
     mss8 = run("l_block", {"type": "baudet_cube", "correction": "element"}, 8)
     X8 = mss8["rest_position"].transpose("node", "axis").values
     u8 = mss8["displacement"].transpose("node", "axis").values
-    on_edge = np.zeros(len(X8), bool)
-    for x, y, z0, z1 in LB.EDGES:
-        on_edge |= np.isclose(X8[:, 0], x) & np.isclose(X8[:, 1], y) & (X8[:, 2] >= z0 - 1e-9) & (X8[:, 2] <= z1 + 1e-9)
+    on_edge = loaded_edge_nodes(X8)
     lref = {}
     for n in l_refs:
         X, _, res, tw = solve("l_block", 1, n)
