@@ -318,3 +318,17 @@ def test_follower_work_equals_pressure_times_cavity_volume_change_in_3d():
         gaps.append(abs(work - pdv) / pdv)
     assert gaps[0] < 2e-2
     assert gaps[1] < 0.3 * gaps[0]  # second order in the increment
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_newton_converges_quadratically_with_the_follower_load_stiffness(order):
+    """A block pressed by a follower pressure, one load step: with the load stiffness in the
+    tangent, Newton's residuals fall quadratically (r_k+1 <= r_k^2 in units of the load, measured
+    0.16 r_k^2 with quadratic elements)."""
+    mesh, top, fixed = _block()
+    r = solve_nonlinear(mesh, 1.0, 0.3, fixed=fixed, plane="strain", law="neohookean", steps=1, tol=1e-13,
+                        order=order, pressures=[(top, 0.2, True)])
+    res = r.stats["residuals"][0]
+    pairs = [(a, b) for a, b in zip(res[:-1], res[1:]) if 1e-7 < a < 0.5]
+    assert len(pairs) >= 2
+    assert all(b < a**2 for a, b in pairs), res
