@@ -186,6 +186,8 @@ class Simulator:
             stepper = Integrator(self.model, x, v, method=self._options["method"], **kw, **self._implicit)
         stepper.t = t
         stepper.n_taken = n_taken
+        if self.engine == "network":  # a follower pressure reads the current positions
+            stepper.drive_reads_state = any(e[2] for e in self._pressures.values())
         holder.append(stepper)
         self._stepper = stepper
         self._apply(t, stepper.x, stepper, plan, True)

@@ -164,8 +164,26 @@ class NetworkStepper(Integrator):
             self._replay()
         self.stats["n_steps"] = max(self.stats["n_steps"], self.n_taken)
 
+    # whether the drive reads positions of free dofs (a follower pressure does): then it must run
+    # after the update; the Simulator says so when it builds the stepper
+    drive_reads_state = True
+
     def _one(self, h, t_step):
         """One step without the detector: advance, move the driven dofs, evaluate."""
+        if self.drive is not None and not self.drive_reads_state and not self.others:
+            # the drive writes only dofs that no update moves (w = 0) and reads none that it does:
+            # it runs first, and the update and the force pass run in one kernel call
+            before = (self._fixed_positions(), self.load, self.extra)
+            self.drive(t_step, self.x)
+            self.note_input(before[0], self._fixed_positions(), before[1], before[2])
+            self._update_external()
+            rowptr, ib, kl = self.layout
+            fused_steps(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self.x_ref,
+                        self.react, self.mon, 1)
+            self.stats["n_force_evals"] += 1
+            self.n_taken += 1
+            self.t = t_step
+            return
         fused_advance(self.R, self.v, self.F, self.w, self.damp, h)
         if self.drive is not None:
             before = (self._fixed_positions(), self.load, self.extra)
