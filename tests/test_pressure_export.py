@@ -53,6 +53,7 @@ def test_every_format_carries_a_dead_pressure(tmp_path):
     doc = json.loads(text.json_text(exp))
     entry = next(t for t in doc["terms"] if t.get("table") == "pressure_1")
     assert entry["follow"] is False and entry["pressure"] == P and entry["scales_with_load"] is True
+    assert entry["energy"] == "-f . x (f: the nodal forces at rest, table pressure_1_forces)"
     # the surface loads table keeps the traction only
     assert np.abs(exp.loads[:, 2]).sum() == pytest.approx(5.0 * 2.0)
     # VTU: point data pressure_1 (N, load factor 1)
@@ -78,6 +79,8 @@ def test_a_follower_pressure_is_in_the_tables_and_named_where_it_cannot_be_carri
     exp = export.build(_scene(True))
     tables = exp.tables()
     np.testing.assert_array_equal(tables["pressure_1"]["follow"], 1)
+    entry = next(t for t in json.loads(text.json_text(exp))["terms"] if t.get("table") == "pressure_1")
+    assert entry["follow"] is True and entry["energy"] is None and entry["conservative"] is False
     for fmt in ("vtu", "mjcf", "sofa"):
         notes = export.not_carried(exp, fmt)
         assert any("follower pressure 300 Pa on 2 facets (table pressure_1" in n for n in notes), (fmt, notes)

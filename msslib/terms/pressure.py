@@ -196,6 +196,7 @@ class Pressure(ExternalForce):
 
     kind = "external"
     export_label = "pressure"
+    export_energy = "-f . x (f: the nodal forces at rest, table PRESSURE_forces)"
     follow = False
 
     def __new__(cls, *args, **kwargs):
@@ -226,7 +227,8 @@ class Pressure(ExternalForce):
 
     def export_entry(self) -> dict:
         entry = super().export_entry()
-        entry.update(follow=bool(self.follow), pressure=self.pressure, count=self.export_count())
+        entry.update(follow=bool(self.follow), pressure=self.pressure, count=self.export_count(),
+                     energy=None if self.export_energy is None else self.export_energy.replace("PRESSURE", self.export_name))
         return entry
 
     def export_tables(self, mesh) -> list[Table]:
@@ -264,6 +266,7 @@ class FollowerPressure(Pressure, ElementTerm):
     follow = True
     conservative = False
     symmetric = False
+    export_energy = None  # non-conservative on an open surface
     export_formats = ("csv", "json")
 
     def __init__(self, mesh, facets, pressure, follow=True, thickness: float = 1.0, name: str = ""):
