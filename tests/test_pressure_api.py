@@ -144,3 +144,26 @@ def test_apply_pressure_refusals_change_nothing(facets, pressure, message):
     assert sim.t == before[1]
     sim.step(1)  # still steps with no pressure on it
     assert np.abs(sim.displacement).max() == 0.0
+
+
+def test_apply_pressure_in_2d_takes_the_thickness():
+    mesh = M.quad_grid(1.0, 1.0, 2, 2)
+    setup = msslib.build_model("lloyd_square", mesh, msslib.Material(1.0e4, 1.0 / 3.0, density=1000.0),
+                               fixed={"plane": ["y", 0.0]}, thickness=0.1)
+    sim = msslib.Simulator(setup, dt=1e-3)
+    ref = msslib.Simulator(setup, dt=1e-3)
+    assert sim.engine == "generic"
+    edges = M.boundary_facets(mesh)
+    top = edges[np.all(np.isclose(mesh.points[edges][:, :, 1], 1.0), axis=1)]
+    sim.apply_pressure(top, 50.0, follow=False, thickness=0.1)
+    f = pressure_nodal_forces(mesh.points, top, 50.0, thickness=0.1)
+    np.testing.assert_allclose(f.sum(axis=0), [0.0, -50.0 * 0.1 * 1.0], atol=1e-14)
+    for node in np.flatnonzero(np.any(f != 0, axis=1)):
+        ref.apply_force([node], f[node])
+    sim.step(20)
+    ref.step(20)
+    np.testing.assert_array_equal(sim.x, ref.x)
+    with pytest.raises(ValueError, match=r"^thickness must be a finite thickness > 0 \(m\), on a 2D mesh only, got -1"):
+        sim.apply_pressure(top, 50.0, thickness=-1.0)
+    with pytest.raises(ValueError, match=r"^follow must be True or False, got 1"):
+        sim.apply_pressure(top, 50.0, follow=1)

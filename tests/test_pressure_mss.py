@@ -246,3 +246,20 @@ def test_copies_keep_the_reading():
         for other in (copy.deepcopy(term), pickle.loads(pickle.dumps(term))):
             assert type(other) is type(term) and other.follow == term.follow
             np.testing.assert_array_equal(other.gradient(x), term.gradient(x))
+
+
+@pytest.mark.parametrize("kind", ["tetra", "hexahedron"])
+def test_follower_work_on_a_closed_surface_is_minus_p_times_the_volume_change(kind):
+    # along the straight path x0 -> x1 the forces are quadratic in the path parameter, so two Gauss
+    # points integrate their work exactly; the volumes come from the cells (exact for both cell types)
+    mesh = MESHES[kind]()
+    facets = M.boundary_facets(mesh)
+    x0, x1 = mesh.points, _moved(mesh, 7, 0.1)
+    p = 1.7e3
+    work = 0.0
+    for s, w in zip(*np.polynomial.legendre.leggauss(2)):
+        x = x0 + 0.5 * (1 + s) * (x1 - x0)
+        work += 0.5 * w * float(np.sum(pressure_nodal_forces(x, facets, p) * (x1 - x0)))
+    dv = _volume(mesh, x1.ravel()) - _volume(mesh, x0.ravel())
+    assert abs(dv) > 1e-3
+    assert work == pytest.approx(-p * dv, rel=1e-12)
