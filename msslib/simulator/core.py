@@ -62,8 +62,9 @@ class Simulator:
     applied) at rest, with the schemes of :func:`msslib.solvers.integrate`: ``method`` is
     ``"symplectic_euler"`` (default), ``"velocity_verlet"`` or ``"implicit_euler"``, ``damping``
     ``alpha`` or ``(alpha, beta)`` (None: the model's).  The explicit schemes check ``dt`` against
-    the stability limit once, when the simulator is built (a cheap safe bound first, Lanczos only
-    when the step exceeds it, see :func:`msslib.solvers.check_time_step`), and every step runs
+    the stability limit once, when the simulator is built (a cheap safe bound first, a certified
+    short Lanczos run or the Lanczos estimate only when the step exceeds it, see
+    :func:`msslib.solvers.check_time_step`), and every step runs
     the divergence checks of :func:`~msslib.solvers.integrate` (``allow_unstable``, ``blowup``).
 
     Loads, changeable between steps (each value a constant, a callable of time, or a table of

@@ -213,9 +213,10 @@ def _omega_allowed(dt, method, alpha, beta, hi) -> float | None:
 
 def certified_omega_max(matvec, n: int, shift: float, omega_target: float, seed: int) -> tuple[float | None, int]:
     """Try to certify ``omega_max <= omega_target`` for the symmetric ``A`` of product
-    ``matvec`` (size ``n``; ``A + shift I`` positive semidefinite) by a short Lanczos run from a random start: ``(omega, steps)`` with
-    ``omega`` an upper bound of ``sqrt(lambda_max(A))`` at most ``omega_target``, or None when
-    :data:`_CERT_MAX_STEPS` steps cannot certify it.
+    ``matvec`` (size ``n``; ``A + shift I`` positive semidefinite) by a short Lanczos run from a
+    random start: ``(omega, steps)`` with ``omega`` an upper bound of ``sqrt(lambda_max(A))`` at
+    most ``omega_target``, or None when :data:`_CERT_MAX_STEPS` steps cannot certify it (or a
+    Ritz value already exceeds the target: the step is over the limit).
 
     After ``k`` steps (full reorthogonalisation) the largest Ritz value ``theta_k`` of
     ``B = A + shift I`` never exceeds ``lambda_max(B)``, and from a start drawn uniformly on the
