@@ -57,7 +57,7 @@ def _eq10(L):
 
 
 def test_eq10_axis_is_zero_on_eq10_and_relative_when_scaled():
-    ds, L = _beam(lambda x: 0 * x)
+    _, L = _beam(lambda x: 0 * x)
     w = _eq10(L)
     exact, _ = _beam(w)
     tip, largest = S.eq10_axis(exact)
