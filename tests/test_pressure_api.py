@@ -31,15 +31,16 @@ def test_every_mss_model_takes_a_pressure_equal_to_the_traction_minus_p_n(name):
     top = _top(mesh)
     p = 40.0
     kw = {"thickness": 0.2} if mesh.dim == 2 else {}
+    base = {"plane": [top[0], float(mesh.points[:, -1].min())]}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        dead = msslib.build_model(name, mesh, msslib.Material(1.0e4, 0.3), fixed={"plane": [top[0], float(mesh.points[:, -1].min())]},
+        dead = msslib.build_model(name, mesh, msslib.Material(1.0e4, 0.3), fixed=base,
                                   loads={"type": "pressure", "select": {"plane": top}, "pressure": p, "follow": False},
                                   **kw)
-        traction = msslib.build_model(name, mesh, msslib.Material(1.0e4, 0.3), fixed={"plane": [top[0], float(mesh.points[:, -1].min())]},
+        traction = msslib.build_model(name, mesh, msslib.Material(1.0e4, 0.3), fixed=base,
                                       loads={"type": "traction", "select": {"plane": top},
                                              "traction": [0.0] * (mesh.dim - 1) + [-p]}, **kw)
-        follower = msslib.build_model(name, mesh, msslib.Material(1.0e4, 0.3), fixed={"plane": [top[0], float(mesh.points[:, -1].min())]},
+        follower = msslib.build_model(name, mesh, msslib.Material(1.0e4, 0.3), fixed=base,
                                       loads={"type": "pressure", "select": {"plane": top}, "pressure": p}, **kw)
     np.testing.assert_allclose(dead.model.external_force(1.0), traction.model.external_force(1.0), atol=1e-12)
     assert len(dead.pressures) == 1 and dead.pressures[0][2] is False and follower.pressures[0][2] is True

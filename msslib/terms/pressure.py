@@ -227,8 +227,8 @@ class Pressure(ExternalForce):
 
     def export_entry(self) -> dict:
         entry = super().export_entry()
-        entry.update(follow=bool(self.follow), pressure=self.pressure, count=self.export_count(),
-                     energy=None if self.export_energy is None else self.export_energy.replace("PRESSURE", self.export_name))
+        energy = None if self.export_energy is None else self.export_energy.replace("PRESSURE", self.export_name)
+        entry.update(follow=bool(self.follow), pressure=self.pressure, count=self.export_count(), energy=energy)
         return entry
 
     def export_tables(self, mesh) -> list[Table]:
