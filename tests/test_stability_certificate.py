@@ -1,7 +1,8 @@
 """The certified short Lanczos run of the stability check: the step it accepts is never above the
-exact limit (dense eigenvalues) on every mass-spring model of the registry, on each of its cells, with springs run without a matrix
-and other terms assembled, at rest and prestressed; a step over the limit is refused; steps at
-0.99 of the limit it certifies stay bounded where steps just over the exact limit blow up."""
+exact limit (dense eigenvalues) on every mass-spring model of the registry, on each of its cells,
+with springs run without a matrix and other terms assembled, at rest and prestressed; a step over
+the limit is refused; steps at 0.99 of the limit it certifies stay bounded where steps just over
+the exact limit blow up."""
 
 import numpy as np
 import pytest
