@@ -164,7 +164,7 @@ def test_study_models_exact_on_their_elements_agree_with_linear_fem_under_pressu
     linear element's stiffness, so their scene runs under the dead pressure (the mass-spring
     pressure load on a facet group) give linear FEM's displacements (msslib.fem pressures on the
     same facets) to round-off, with the same errors against the exact solution."""
-    from experiments.stability import pressure_exact as study
+    from experiments.performance.studies import pressure_exact as study
 
     for mesh, model, u_exact in (
             (exact.quarter_annulus(A, B, 4), "delingette_triangle", partial(study.plane_stress_cylinder, nu=0.3)),
@@ -195,3 +195,28 @@ def test_equal_pressure_inside_and_outside_compresses_uniformly_to_round_off(bod
     want = -P * factor / E * mesh.points
     assert np.abs(r.displacement - want).max() < 1e-12 * np.abs(want).max()
     assert np.abs(r.dof_displacement + P * factor / E * r.dof_points).max() < 1e-12 * np.abs(want).max()
+
+
+def test_study_summary_reads_the_finest_level_and_the_order_from_synthetic_errors():
+    """The study's summary on made-up rows whose rms error is C h^2 (cylinder: h = 1 / n; sphere: h
+    the size): the order read is 2, the finest level's error is the finest mesh's, and a model that
+    does not run on a case is NaN there."""
+    from experiments.performance.studies import pressure_exact as study
+
+    rows = []
+    for n, nodes in ((4, 50), (8, 170), (16, 600)):
+        rows.append({"problem": "cylinder", "cells": "quad", "level": float(n), "model": "a", "nu": 0.3,
+                     "n_nodes": nodes, "error_max": 3.0 / n ** 2, "error_rms": 1.0 / n ** 2,
+                     "error_max_vs_fem": 0.0, "outcome": "ok"})
+    for h, nodes in ((0.4, 80), (0.2, 400)):
+        rows.append({"problem": "sphere", "cells": "tetra", "level": h, "model": "b", "nu": 0.3, "n_nodes": nodes,
+                     "error_max": 5 * h, "error_rms": h ** 3, "error_max_vs_fem": 0.0, "outcome": "ok"})
+    s = study.summary(rows)
+    cases, models = s["coords"]["case"], s["coords"]["model"]
+    rate = s["data"]["rate"][1]
+    finest = s["data"]["finest_error_max"][1]
+    i, j = cases.index("cylinder_quad"), models.index("a")
+    assert rate[i, j, 0] == pytest.approx(2.0) and finest[i, j, 0] == pytest.approx(3.0 / 256)
+    i, j = cases.index("sphere_tetra"), models.index("b")
+    assert rate[i, j, 0] == pytest.approx(3.0) and finest[i, j, 0] == pytest.approx(1.0)
+    assert np.isnan(rate[i, models.index("a"), 0])

@@ -15,13 +15,13 @@ displacements (``error_rms``), both at the mesh's nodes, and the largest nodal d
 quadratic reference on the same mesh over its largest displacement (``error_max_vs_fem``); a model that refuses the mesh or does
 not converge gets NaN and its reason in ``outcome``.
 
-``python -m experiments.stability.pressure_exact --out F.nc [--quick]`` writes a NetCDF dataset
-(dimension ``run``: problem, cells, level, n_nodes, model, nu, the errors, outcome).
+``python -m experiments.performance.studies.pressure_exact --out F.nc [--quick]`` writes a NetCDF dataset
+(dimension ``run``: problem, cells, level, n_nodes, run_model, run_nu, the errors, outcome; and the
+finest level's errors and the observed orders per ``case``, ``model`` and ``nu``: :func:`summary`).
 """
 
 from __future__ import annotations
 
-import argparse
 import sys
 from dataclasses import replace
 from functools import partial
@@ -29,7 +29,7 @@ from functools import partial
 import numpy as np
 
 A, B, P, E = 1.0, 2.0, 1.0e3, 1.0e6
-NUS = (0.3, 0.49)
+NUS = (0.3, 0.49, 0.4999)
 LEVELS = {"cylinder": (4, 8, 16), "sphere": (0.4, 0.2)}
 QUICK = {"cylinder": (4, 8), "sphere": (0.4,)}
 
@@ -122,28 +122,69 @@ def study(quick: bool = False, log=print) -> list[dict]:
     return rows
 
 
-def write(rows: list[dict], path: str) -> None:
+def summary(rows: list[dict]) -> dict:
+    """Per ``case`` (problem and cells), ``model`` and ``nu``: the finest level's ``finest_error_max``
+    and ``finest_error_rms``, its ``finest_error_vs_fem`` (against the quadratic reference on the same
+    mesh), and the observed order ``rate`` of the root-mean-square error between the two finest levels
+    (``log(e_coarse / e_fine) / log(h_coarse / h_fine)``); NaN where a model does not run on a case."""
+    cases = sorted({f"{r['problem']}_{r['cells']}" for r in rows})
+    models = list(dict.fromkeys(r["model"] for r in rows))
+    nus = sorted({r["nu"] for r in rows})
+    shape = (len(cases), len(models), len(nus))
+    out = {k: np.full(shape, np.nan) for k in ("finest_error_max", "finest_error_rms", "finest_error_vs_fem", "rate")}
+    for i, case in enumerate(cases):
+        for j, model in enumerate(models):
+            for k, nu in enumerate(nus):
+                own = [r for r in rows if f"{r['problem']}_{r['cells']}" == case and r["model"] == model
+                       and r["nu"] == nu]
+                if not own:
+                    continue
+                # the level is cells through the wall (cylinder: finer is larger) or a size (sphere: finer is smaller)
+                own.sort(key=lambda r: r["n_nodes"])
+                fine = own[-1]
+                out["finest_error_max"][i, j, k] = fine["error_max"]
+                out["finest_error_rms"][i, j, k] = fine["error_rms"]
+                out["finest_error_vs_fem"][i, j, k] = fine["error_max_vs_fem"]
+                if len(own) >= 2:
+                    coarse = own[-2]
+                    h_ratio = (fine["level"] / coarse["level"] if fine["problem"] == "cylinder"
+                               else coarse["level"] / fine["level"])
+                    out["rate"][i, j, k] = np.log(coarse["error_rms"] / fine["error_rms"]) / np.log(h_ratio)
+    return {"coords": {"case": cases, "model": models, "nu": np.array(nus)},
+            "data": {k: (("case", "model", "nu"), v) for k, v in out.items()}}
+
+
+def write(rows: list[dict], path: str, quick: bool = False) -> None:
+    """Write the rows (dimension ``run``) and their :func:`summary` (dimensions ``case``, ``model``,
+    ``nu``) as one NetCDF dataset, atomically."""
     import xarray as xr
 
-    data = {key: ("run", np.array([r[key] for r in rows])) for key in rows[0]}
-    ds = xr.Dataset(data)
+    from msslib.results import write_result
+
+    # the runs' model and nu are named run_model and run_nu (model and nu are the summary's coordinates)
+    data = {(f"run_{key}" if key in ("model", "nu") else key): ("run", np.array([r[key] for r in rows]))
+            for key in rows[0]}
+    s = summary(rows)
+    data.update(s["data"])
+    ds = xr.Dataset(data, coords=s["coords"])
     ds.attrs.update(description="nodal displacement errors against the exact thick-cylinder (plane stress) and "
                                 "thick-sphere solutions under internal pressure", E=E, pressure=P, inner_radius=A,
                     outer_radius=B)
-    ds.to_netcdf(path)
+    if quick:
+        ds.attrs["quick"] = 1
+    write_result(path, ds)
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m experiments.stability.pressure_exact", description=__doc__.split("\n")[0])
-    parser.add_argument("--out", required=True, help="the NetCDF file to write")
-    parser.add_argument("--quick", action="store_true", help="coarse levels only")
-    args = parser.parse_args(argv)
     import warnings
 
+    from experiments import script
+
+    a = script.args(__doc__, argv)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        rows = study(args.quick)
-    write(rows, args.out)
+        rows = study(a.quick)
+    write(rows, a.out, a.quick)
     return 0
 
 
