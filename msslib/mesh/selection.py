@@ -109,8 +109,8 @@ def select_nodes(path, mesh, sel, default_tol, group=None):
               f"{np.round(hi, 6).tolist()})")
 
 
-def loaded_facets(path, mesh, sel, default_tol, cache):
-    """The facets a traction acts on: the facets of a facet group (each must be a boundary facet),
+def loaded_facets(path, mesh, sel, default_tol, cache, load: str = "traction"):
+    """The facets a ``load`` (a traction or a pressure: the word its refusals use) acts on: the facets of a facet group (each must be a boundary facet),
     the boundary facets of the cells of a cell group, else the boundary facets whose nodes are all
     selected; with plane and/or box, only those whose nodes are all in them too."""
     if "boundary" not in cache:
@@ -129,7 +129,7 @@ def loaded_facets(path, mesh, sel, default_tol, cache):
                 centroid = np.round(mesh.points[f].mean(axis=0), 6).tolist()
                 _fail(f"{path}.group", f"{len(bad)} of the {len(members)} facets of group {sel['group']!r} are not on "
                       f"the boundary of the mesh: the facet of nodes {f.tolist()} at {centroid} {where}; allowed: a "
-                      f"traction on boundary facets")
+                      f"{load} on boundary facets")
             candidates = members
         elif kind == "cells":
             candidates = candidates[np.isin(facet_cell, members)]

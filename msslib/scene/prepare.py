@@ -137,7 +137,7 @@ def prepare(scene: Scene) -> Setup:
             nodes = select_nodes(f"{p}.select", mesh, load["select"], default_tol)
             surface[nodes] += total / len(nodes)
         elif load["type"] == "pressure":
-            loaded = loaded_facets(f"{p}.select", mesh, load["select"], default_tol, facet_cache)
+            loaded = loaded_facets(f"{p}.select", mesh, load["select"], default_tol, facet_cache, "pressure")
             pressures.append((_outward(mesh, loaded, facet_cache), float(load["pressure"]), bool(load["follow"])))
         else:
             from msslib.terms import Traction

@@ -396,7 +396,7 @@ class Simulator:
             raise ValueError(f"follow must be True or False, got {follow!r}")
         if isinstance(facets, dict):
             size = float(np.linalg.norm(np.ptp(mesh.points, axis=0))) if mesh.n_nodes else 1.0
-            facets = loaded_facets("facets", mesh, facets, max(1e-8 * size, 1e-15), {})
+            facets = loaded_facets("facets", mesh, facets, max(1e-8 * size, 1e-15), {}, "pressure")
         found = outward_facets(mesh, facets)
         t = _finite(thickness, "thickness", "a finite thickness > 0 (m)")
         if t <= 0 or (self.dim == 3 and t != 1.0):
