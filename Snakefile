@@ -20,6 +20,7 @@
 
 import hashlib
 import json
+import re
 from pathlib import Path
 
 import yaml
@@ -214,11 +215,24 @@ def shared(wc):
     return sorted(str(p) for p in Path("experiments", wc.paper).glob("*.py")) + ["experiments/script.py"]
 
 
+def study_sources(wc):
+    """What a study reads beyond its own script: the other studies of its paper it imports
+    (``from experiments.<paper>.studies.<name> import ...``) and the paper's mesh files
+    (experiments/<paper>/meshes/), so that editing either reruns it."""
+    text = Path("experiments", wc.paper, "studies", f"{wc.name}.py").read_text(encoding="utf-8")
+    imported = re.findall(rf"experiments\.{wc.paper}\.studies\.(\w+)", text)
+    found = [f"experiments/{wc.paper}/studies/{n}.py" for n in sorted(set(imported)) if n != wc.name]
+    meshes = Path("experiments", wc.paper, "meshes")
+    return [f for f in found if Path(f).is_file()] + (sorted(str(p) for p in meshes.iterdir() if p.is_file())
+                                                       if meshes.is_dir() else [])
+
+
 rule study:
     """A sweep that does not fit cases x models (e.g. error against strain or nu)."""
     input:
         script="experiments/{paper}/studies/{name}.py",
         shared=shared,
+        sources=study_sources,
         # a study may run the paper's experiment files (e.g. over a load range): edits rerun it
         experiments=lambda wc: sorted(str(p) for p in Path("experiments", wc.paper).glob("*.yaml")),
         code=MSSLIB,
