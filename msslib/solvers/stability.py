@@ -563,9 +563,10 @@ def _lanczos_omega(problem, x, load, rows) -> tuple[float, bool]:
 
 
 def _certified(problem, x, load, rows, dt, method, alpha, beta, bound):
-    """``(omega, origin)`` from a Lanczos estimate kept for this state (eigsh's, or a certified
-    bound that covers ``dt``), else from :func:`certified_omega_max` when it certifies ``dt``
-    (kept), else None (the caller asks eigsh)."""
+    """``(omega, origin)`` from an estimate kept for this state (eigsh's, or a certified or
+    Collatz-Wielandt bound that covers ``dt``), else from :func:`collatz_wielandt_bound` or
+    :func:`certified_omega_max` when one of them accepts ``dt`` (kept), else None (the caller
+    asks eigsh)."""
     key = _spectrum_key(x, load, rows)
     cache = getattr(problem, "_spectrum_cache", None) or {}
     if key in cache:
