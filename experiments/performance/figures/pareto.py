@@ -10,7 +10,7 @@ from experiments import plotting
 from msslib.results import read_result
 from experiments import script
 
-SCENES = ["cantilever", "cylinder", "membrane"]
+SCENES = ["cantilever", "cantilever on tetrahedra", "cylinder", "membrane"]
 INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 MARKERS = "osD^v<>p"
 
@@ -27,8 +27,8 @@ def _style(name, k):
 
 def main():
     a = script.args(__doc__)
-    fig = plotting.figure(figsize=(14, 6.6))
-    axes = fig.subplots(1, 3)
+    fig = plotting.figure(figsize=(14, 13.2))
+    axes = fig.subplots(2, 2).ravel()
     for ax, scene, path in zip(axes, SCENES, INPUTS):
         f = read_result(path)
         T, Y = [], []

@@ -11,7 +11,7 @@ from msslib.results import read_result, write_text
 from msslib.planning import pareto
 from experiments import script
 
-SCENES = ["cantilever", "cylinder", "membrane"]
+SCENES = ["cantilever", "cantilever on tetrahedra", "cylinder", "membrane"]
 INPUTS = script.inputs(__file__)  # the list in inputs.yaml beside this script
 
 
