@@ -73,10 +73,14 @@ def _problem_class():
             # a follower pressure's load stiffness is not symmetric in general: LU, never Cholesky/CG
             self.symmetric = not self.followers
 
+        def force(self, u, load=1.0):
+            self.state = u  # the last state evaluated: after a converged load step, its solution
+            return self._force(u, load)
+
         def _follower(self, u):
             return sum((load.forces(u) for load in self.followers), np.zeros(self.n_dof))
 
-        def force(self, u, load=1.0):
+        def _force(self, u, load=1.0):
             f = super().force(u, load)
             return f + load * self._follower(u) if self.followers and load != 0.0 else f
 
@@ -95,7 +99,7 @@ def _problem_class():
 
 def newton_solve(internal, f_ext, constrained, prescribed, points, *, steps: int, tol: float, max_iter: int,
                  max_halvings: int, progress: Callable[[int, int], None] | None = None, linear_solver="auto",
-                 initial=None, followers=()):
+                 initial=None, followers=(), check=None):
     """Solve ``f_int(u) = f_ext`` from ``u = 0`` by :func:`msslib.solvers.static_solve` (Newton
     without line search, ``steps`` load increments each halved at most ``max_halvings`` times in a
     row, the convergence test of the mass-spring models) with the linear solver chosen by the
@@ -103,7 +107,9 @@ def newton_solve(internal, f_ext, constrained, prescribed, points, *, steps: int
     ``initial``: the first iterate (all dofs, flat; default zero). ``followers``: loads at load
     factor 1 with ``forces(u)`` and ``stiffness(u)`` (``d forces / d u``), e.g.
     :class:`msslib.fem.pressure.FacetPressure`, scaled by the load factor; with any, the tangent
-    is treated as non-symmetric.
+    is treated as non-symmetric. ``check(u, load)``: called with the solution of every converged
+    load increment (all dofs, flat) and its load factor, before the next increment; it may raise
+    to stop the solve (e.g. on an inverted element).
     Returns ``(u, stats)`` as :func:`msslib.solvers.displacement.solve_displacement`."""
     from msslib.solvers import static_solve
 
@@ -111,6 +117,8 @@ def newton_solve(internal, f_ext, constrained, prescribed, points, *, steps: int
     reported = [1]
 
     def on_load_step(_count, lam):
+        if check is not None:
+            check(problem.state, lam)
         while progress is not None and reported[0] <= steps and lam >= reported[0] / steps - 1e-12:
             progress(reported[0], steps)
             reported[0] += 1

@@ -242,6 +242,42 @@ def _parts(mesh, geo, lam_c, mu_c, volumetric, plane):
     return [(geo, q(geo, zero), q(geo, mu_c)), (red, q(red, lam_c), q(red, zero))]
 
 
+def _min_jacobian(geometries, u_dofs) -> tuple[float, int, int]:
+    """``(det F, cell, n_cells)``: the smallest ``det F = det(I + grad u)`` over the quadrature points
+    of every geometry in ``geometries`` (2D: of the in-plane gradient, whose sign is that of the 3D
+    ``det F`` as ``F33 > 0``) at the dof displacements ``u_dofs`` ``(n_scalar, dim)``, the cell
+    where it lies and how many cells have a quadrature point with ``det F <= 0``."""
+    worst, cell, bad = np.inf, -1, None
+    for g in geometries:
+        H = g.displacement_gradient(u_dofs)
+        F = np.moveaxis(H, (0, 1), (-2, -1)) + np.eye(g.dim)
+        J = np.linalg.det(F).reshape(F.shape[0], -1)  # (m, q)
+        Jmin = np.where(np.isnan(J), -np.inf, J).min(axis=1)
+        bad = Jmin <= 0.0 if bad is None else bad | (Jmin <= 0.0)
+        k = int(np.argmin(Jmin))
+        if Jmin[k] < worst:
+            worst, cell = float(Jmin[k]), k
+    return worst, cell, int(bad.sum())
+
+
+def _check_inversion(parts, u_dofs, load, reached, law) -> None:
+    """Raise :class:`msslib.errors.UnphysicalStateError` in one line when the equilibrium found at
+    load factor ``load`` has ``det F <= 0`` at a quadrature point of any part of the energy."""
+    from msslib.errors import UnphysicalStateError
+
+    J, cell, n_bad = _min_jacobian([g for g, _, _ in parts], u_dofs)
+    if J > 0.0:
+        return
+    why = ("the St Venant-Kirchhoff law has no inversion barrier: a smaller load, more supports or "
+           "law='neohookean'") if law == "svk" else "a smaller load or more supports"
+    exc = UnphysicalStateError(
+        f"msslib.fem.solve_nonlinear: the equilibrium found at load factor {float(load):.6g} inverts element {cell} "
+        f"(det F = {J:.4g} at a quadrature point; {n_bad} element(s) with det F <= 0); det F > 0 is required at every "
+        f"quadrature point ({why}); load factor reached with every det F > 0: {float(reached):.6g}")
+    exc.load, exc.load_reached, exc.cell, exc.det_F = float(load), float(reached), cell, J
+    raise exc
+
+
 def _result(geo, u, reaction, energy, stats) -> FemResult:
     """The result at the mesh's nodes (reactions of higher-order dofs carried to them)."""
     d, n = geo.dim, geo.mesh.n_nodes
@@ -312,7 +348,13 @@ def solve_nonlinear(
     listed in ``stats``). A failed increment (no convergence in ``max_iter`` iterations, or an
     inverted element) is halved, at most ``max_halvings`` times in a row and never below
     ``1 / (steps * 2**max_halvings)``; then :class:`msslib.errors.ConvergenceError` (a
-    RuntimeError) names the step and the residual.
+    RuntimeError) names the step and the residual. Every converged increment's solution is
+    checked for inversion, for every law: ``det F > 0`` at every quadrature point (of each
+    quadrature rule of the energy), else :class:`msslib.errors.UnphysicalStateError` (a
+    RuntimeError) says in one line the load factor of that solution, the element, its ``det F``
+    and the last load factor reached without inversion (attributes ``load``, ``load_reached``,
+    ``cell``, ``det_F``): St Venant-Kirchhoff, whose energy depends on ``F^T F`` only, has
+    equilibria with inverted elements under strong compression, which are no answer.
     ``initial``: None, or a displacement ``(n_nodes, dim)`` at the mesh's nodes (a guess of the
     solution, e.g. a coarser mesh's at these nodes) from whose linear interpolant at every dof
     Newton starts, with ``steps = 1`` only (ValueError otherwise).
@@ -401,9 +443,15 @@ def solve_nonlinear(
             K = sp.csr_matrix((data, indices, indptr), shape=(geo.n_dofs, geo.n_dofs))
         return fint, K, energy, (fabs if tangent else None)
 
+    reached = [0.0]  # the last load factor whose solution inverts no element
+
+    def admissible(u, load):
+        _check_inversion(parts, u.reshape(-1, d), load, reached[0], law)
+        reached[0] = load
+
     u, newton = newton_solve(internal, f_ext, cons, presc, geo.points, steps=steps, tol=tol, max_iter=max_iter,
                              max_halvings=max_halvings, progress=progress, linear_solver=linear_solver,
-                             initial=x0, followers=followers)
+                             initial=x0, followers=followers, check=admissible)
     fint, _, energy, _ = internal(u, tangent=False)
     r = fint - f_ext - sum((load.forces(u) for load in followers), np.zeros_like(f_ext))
     reaction = np.where(cons, r, 0.0)
