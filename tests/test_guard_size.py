@@ -188,9 +188,9 @@ def test_refined_mesh_file_over_the_limit_refused_before_refining(tmp_path, monk
     d["geometry"] = {"file": "m.vtu", "refine": 6}
     scene = load_scene(d, base_dir=tmp_path)
     _refine_must_not_run(monkeypatch)
-    # 20 nodes x 8^6 = 5.24e+06 nodes x 32 kB (MSS, 3D) + 0.7 GB = 168 GB
+    # 20 nodes x 8^6 = 5.24e+06 nodes x 32 kB (MSS, 3D) + 0.8 GB = 169 GB
     with pytest.raises(ResourceError, match=r"scene\.geometry\.file \(m\.vtu\) refined 6 times \(refine: 6\): "
-                                            r"5\.24e\+06 nodes would need about 168 GB, over the limit of 1 GB"):
+                                            r"5\.24e\+06 nodes would need about 169 GB, over the limit of 1 GB"):
         prepare(scene)
 
 
