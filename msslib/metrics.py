@@ -37,6 +37,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .mesh import Mesh
+from .mesh import cells as _cells
 
 __all__ = [
     "DisplacementError",
@@ -266,35 +267,13 @@ def bulk_modulus(volume0, volume, pressure):
 # --------------------------------------------------------------------------------------------------
 # volumes
 
-_GAUSS = np.array([-1.0, 1.0]) / np.sqrt(3.0)
-# reference coordinates of the hexahedron's nodes (meshio/VTK order) on [-1, 1]^3
-_HEX_REF = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
-                     [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]], dtype=float)
-
-
-def _hex_shape_gradients() -> np.ndarray:
-    """``(8 Gauss points, 8 nodes, 3)`` gradients of the trilinear shape functions."""
-    q = np.array(np.meshgrid(_GAUSS, _GAUSS, _GAUSS, indexing="ij")).reshape(3, -1).T  # (8, 3)
-    s = 1.0 + q[:, None, :] * _HEX_REF[None, :, :]  # (q, node, 3): 1 + xi_k * xi_k^node
-    grad = np.empty((len(q), 8, 3))
-    for k in range(3):
-        others = [j for j in range(3) if j != k]
-        grad[:, :, k] = _HEX_REF[None, :, k] * s[:, :, others[0]] * s[:, :, others[1]] / 8.0
-    return grad
-
-
-_HEX_DN = _hex_shape_gradients()
-
-
 def cell_volumes(mesh: Mesh, displacement=None) -> np.ndarray:
     """Signed measure of every cell (area in 2D, volume in 3D) of the (deformed) mesh.
 
-    Positive for cells in the orientation of :mod:`msslib.mesh`, negative for inverted ones.
-    Triangles and tetrahedra: the determinant formula. Quads: the shoelace formula, which is the
-    exact area of the bilinear quad (its edges are straight). Hexahedra: the exact volume of the
-    trilinear map, ``integral of det J`` over the reference cube by 2x2x2 Gauss quadrature, exact
-    because ``det J`` has degree at most 2 in each reference coordinate (each column of ``J`` does
-    not depend on its own coordinate and is at most linear in the others).
+    Positive for cells in the orientation of :mod:`msslib.mesh`, negative for inverted ones.  The
+    measure of each cell type is its cell module's (:mod:`msslib.mesh.cells`): exact for every
+    type (the determinant formula for simplices, ``det J`` integrated exactly for quads,
+    hexahedra and wedges).
     """
     x = mesh.points
     if displacement is not None:
@@ -302,19 +281,7 @@ def cell_volumes(mesh: Mesh, displacement=None) -> np.ndarray:
         if u.shape != x.shape:
             raise ValueError(f"displacement must have shape {x.shape}, got {u.shape}")
         x = x + u
-    c = x[mesh.cells]  # (m, nodes, dim)
-    if mesh.cell_type == "triangle":
-        a, b = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
-        return 0.5 * (a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-    if mesh.cell_type == "quad":
-        d1, d2 = c[:, 2] - c[:, 0], c[:, 3] - c[:, 1]
-        return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
-    if mesh.cell_type == "tetra":
-        return np.linalg.det(c[:, 1:] - c[:, :1]) / 6.0
-    if mesh.cell_type == "hexahedron":
-        J = np.einsum("mni,qnj->mqij", c, _HEX_DN)  # J[m, q, i, j] = dx_i / dxi_j
-        return np.linalg.det(J).sum(axis=1)  # Gauss weights are all 1
-    raise ValueError(f"unsupported cell_type {mesh.cell_type!r}")
+    return _cells.get(mesh.cell_type).measure(x[mesh.cells])
 
 
 def mesh_volume(mesh: Mesh, displacement=None) -> float:

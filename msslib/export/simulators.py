@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from msslib.errors import MsslibWarning
+from msslib.mesh import cells as _cells
 from msslib.export.model import AXES, MssExport, _pad3, _safe_name, _version, not_carried
 
 __all__ = ["SOFA_COMPONENTS", "SOFA_TARGET", "MJCF_SAFETY", "MJCF_ARENA_BYTES_PER_ELEMENT", "MJCF_ARENA_MIN",
@@ -70,7 +71,6 @@ SOFA_COMPONENTS = {
     "ConstantForceField": {"plugin": "Sofa.Component.MechanicalLoad", "attributes": ("name", "indices", "forces"),
                            "source": _SRC + "MechanicalLoad/src/sofa/component/mechanicalload/ConstantForceField.inl"},
 }
-_SOFA_CELLS = {"triangle": "triangles", "quad": "quads", "tetra": "tetrahedra", "hexahedron": "hexahedra"}
 
 
 # --------------------------------------------------------------------------------------------
@@ -340,8 +340,12 @@ def sofa_text(exp: MssExport) -> str:
           threshold="1e-30")
     mesh = exp.setup.mesh
     topo = {"name": "topology", "position": _vec(exp.points.ravel())}
-    if mesh.cell_type in _SOFA_CELLS:
-        topo[_SOFA_CELLS[mesh.cell_type]] = _ints(mesh.cells.ravel())
+    sofa_cells = _cells.get(mesh.cell_type).sofa
+    if sofa_cells is not None:
+        topo[sofa_cells] = _ints(mesh.cells.ravel())
+    else:
+        node.append(ET.Comment(f" the topology lists no cells: this export writes no {mesh.cell_type} cells for SOFA; "
+                               f"the springs below carry the whole model "))
     _sofa(node, "MeshTopology", **topo)
     template = f"Vec{dim}d"
     node.append(ET.Comment(" position: rest positions moved by the prescribed displacements (load factor 1) "))

@@ -85,7 +85,8 @@ class CellType:
     points to bound ``det J`` of the type from below).  ``face_diagonals``: node pairs across the
     quadrilateral faces (of the cell itself for a 2D quad); ``inner_diagonals``: pairs across the
     cell (both None where there are none).  ``vtk_id``: the VTK cell type number; ``meshio``: the
-    name meshio gives it; ``volume_shape``: the UGRID volume shape of a 3D type.
+    name meshio gives it; ``volume_shape``: the UGRID volume shape of a 3D type; ``sofa``: the
+    list of SOFA's ``MeshTopology`` that holds cells of the type (None: the SOFA export lists none).
     ``example``: a small mesh of the type for tests and examples, ``(generator, arguments)``: a
     generator of :mod:`msslib.mesh` (its name) or a function of the cell module returning a
     :class:`~msslib.mesh.Mesh`, and its keyword arguments (lengths in metres, as floats, about 1
@@ -113,6 +114,7 @@ class CellType:
     inner_diagonals: np.ndarray | None = None
     description: str = field(default="")
     example: tuple = ()
+    sofa: str | None = None
 
     def __post_init__(self):
         reference = np.asarray(self.reference, dtype=float)

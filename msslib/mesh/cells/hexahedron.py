@@ -48,7 +48,7 @@ CELL = CellType(
                       vtk_to_skfem=(0, 4, 3, 1, 7, 5, 2, 6)),
     quadratic=FemElement("MeshHex1", "ElementHex2", "Q2 hexahedra", intorder=4, reduced_intorder=3,
                          vtk_to_skfem=(0, 4, 3, 1, 7, 5, 2, 6)),
-    vtk_id=12, meshio="hexahedron", volume_shape="hexahedron",
+    vtk_id=12, meshio="hexahedron", sofa="hexahedra", volume_shape="hexahedron",
     face_diagonals=np.array(_FACES)[:, [[0, 2], [1, 3]]].reshape(-1, 2),
     inner_diagonals=[[0, 6], [1, 7], [2, 4], [3, 5]],
     example=("hex_grid", {"lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 2, "ny": 2, "nz": 2}),

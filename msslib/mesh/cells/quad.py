@@ -30,7 +30,7 @@ CELL = CellType(
     refinement=lattice_refinement((_CORNERS + 1) / 2),
     linear=FemElement("MeshQuad1", "ElementQuad1", "Q1 quadrilaterals with full 2x2 integration", intorder=2),
     quadratic=FemElement("MeshQuad1", "ElementQuad2", "Q2 quadrilaterals", intorder=4, reduced_intorder=3),
-    vtk_id=9, meshio="quad",
+    vtk_id=9, meshio="quad", sofa="quads",
     face_diagonals=[[0, 2], [1, 3]],
     example=("quad_grid", {"lx": 3.0, "ly": 2.0, "nx": 3, "ny": 2}),
 )

@@ -38,6 +38,6 @@ CELL = CellType(
     refinement=_refinement(),
     linear=FemElement("MeshTet1", "ElementTetP1", "P1 tetrahedra", intorder=1),
     quadratic=FemElement("MeshTet1", "ElementTetP2", "P2 tetrahedra", intorder=2, reduced_intorder=1),
-    vtk_id=10, meshio="tetra", volume_shape="tetrahedron", simplex=True,
+    vtk_id=10, meshio="tetra", sofa="tetrahedra", volume_shape="tetrahedron", simplex=True,
     example=("tet_grid", {"lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 2, "ny": 2, "nz": 2}),
 )

@@ -27,6 +27,6 @@ CELL = CellType(
                           np.array([[0, 3, 5], [3, 1, 4], [5, 4, 2], [3, 4, 5]]), reorient=(0, 2, 1)),
     linear=FemElement("MeshTri1", "ElementTriP1", "P1 triangles", intorder=1),
     quadratic=FemElement("MeshTri1", "ElementTriP2", "P2 triangles", intorder=2, reduced_intorder=1),
-    vtk_id=5, meshio="triangle", simplex=True,
+    vtk_id=5, meshio="triangle", sofa="triangles", simplex=True,
     example=("triangle_grid_equilateral", {"width": 3.0, "height": 2.0, "n": 3}),
 )
