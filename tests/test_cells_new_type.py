@@ -40,7 +40,7 @@ def _variants(refinement):
     return dataclasses.replace(refinement, virtual=virtual)
 
 
-def _example(lx, ly, lz, nx, ny, nz):
+def scratch_tetra_grid(lx, ly, lz, nx, ny, nz):
     from msslib import mesh as M
 
     grid = M.tet_grid(lx, ly, lz, nx, ny, nz)
@@ -54,7 +54,7 @@ CELL = dataclasses.replace(
     gradients=lambda p: tetra.CELL.gradients(p)[:, _ORDER],
     linear=dataclasses.replace(tetra.CELL.linear, vtk_to_skfem=None),
     quadratic=dataclasses.replace(tetra.CELL.quadratic, vtk_to_skfem=None),
-    example=(_example, {"lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 2, "ny": 2, "nz": 2}),
+    example=(scratch_tetra_grid, {"lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 2, "ny": 2, "nz": 2}),
 )
 '''
 
@@ -92,6 +92,25 @@ def test_every_cell_test_passes_on_the_new_cell_type(scratch, tmp_path):
         test_cells.test_the_fem_elements_integrate_the_volume_and_a_uniform_strain_exactly(scratch, order)
     test_cells.test_the_quality_check_is_one_at_rest_and_negative_inside_out(scratch)
     test_cells.test_a_mesh_goes_through_a_vtu_file_and_a_result(scratch, tmp_path)
+
+
+def test_a_scene_runs_on_the_new_cell_type_from_its_own_generator(scratch):
+    """The generator of the new type's example is a scene generator with no edit of msslib.scene: a
+    linear FEM scene on it gives the same displacements as on the tetrahedra it renumbers."""
+    from msslib.scene import GENERATORS
+    from msslib.scene.run import run_scene
+
+    assert GENERATORS["scratch_tetra_grid"] == 3
+    args = {"lx": 1.0, "ly": 1.0, "lz": 2.0, "nx": 1, "ny": 1, "nz": 2}
+    scene = {"materials": [{"E": 1e6, "nu": 0.3, "density": 1000.0}], "model": "fem_linear",
+             "boundary": [{"select": {"box": [[-1, -1, -1], [2, 2, 0.01]]}, "fix": "all"}],
+             "loads": [{"type": "gravity", "g": [0.0, 0.0, -9.81]}], "solver": {"type": "static"}}
+    new = run_scene({"geometry": {"generator": "scratch_tetra_grid", "args": args}, **scene}, progress=False)
+    old = run_scene({"geometry": {"generator": "tet_grid", "args": args}, **scene}, progress=False)
+    assert new["cells"].attrs["cell_type"] == scratch and old["cells"].attrs["cell_type"] == "tetra"
+    assert float(new["displacement"].min()) < 0
+    np.testing.assert_allclose(new["displacement"].values, old["displacement"].values, rtol=1e-10,
+                               atol=1e-12 * float(abs(old["displacement"]).max()))
 
 
 def test_a_wrong_table_of_the_new_cell_type_is_caught(scratch, monkeypatch):

@@ -301,6 +301,29 @@ def test_a_scene_on_a_wedge_mesh_file_solves_with_linear_fem(tmp_path):
     assert ds["cells"].attrs["cell_type"] == "wedge" and float(ds["displacement"].min()) < 0
 
 
+def test_a_scene_names_the_wedge_grid_generator_declared_by_the_cell_module(tmp_path):
+    """wedge_grid is a scene generator because the wedge module declares it (its example's generator);
+    the generated scene solves like the same mesh read from a file."""
+    from msslib.scene import GENERATORS
+    from msslib.scene.run import run_scene
+
+    assert GENERATORS["wedge_grid"] == 3 and "wedge_grid" in WEDGE.mesh_generators
+    scene = _scene(tmp_path)
+    scene["geometry"] = {"generator": "wedge_grid", "args": {"lx": 2.0, "ly": 1.0, "lz": 3.0, "nx": 1, "ny": 1, "nz": 2}}
+    generated = run_scene(scene, progress=False)
+    from_file = run_scene(_scene(tmp_path), progress=False)
+    assert generated["cells"].attrs["cell_type"] == "wedge"
+    np.testing.assert_array_equal(generated["displacement"].values, from_file["displacement"].values)
+    # its size is known before it is built: a grid of 2.7e10 nodes is refused by the memory check
+    scene["geometry"]["args"].update(nx=3000, ny=3000, nz=3000)
+    with pytest.raises(ValueError, match=r"^scene.geometry \(wedge_grid with .*\): 2.7e\+10 nodes would need about"):
+        run_scene(scene, progress=False)
+    scene["geometry"]["args"]["nw"] = 1
+    with pytest.raises(ValueError, match=r"^scene.geometry.args.nw: unknown argument of wedge_grid; expected one of "
+                                         r"lx, ly, lz, nx, ny, nz, origin"):
+        run_scene(scene, progress=False)
+
+
 def test_a_traction_on_a_wedge_mesh_is_refused_in_one_line(tmp_path, capsys):
     from msslib.cli import main as cli
 

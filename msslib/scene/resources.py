@@ -82,9 +82,9 @@ def generated_mesh_size(generator: str, args: dict) -> tuple[float, float, int]:
         if generator == "hexagon_equilateral":
             r = float(a["n_rings"])
             return 3 * r * (r + 1) + 1, 6 * r * r, 2
-        if generator in ("hex_grid", "tet_grid"):
+        if generator in ("hex_grid", "tet_grid", "wedge_grid"):
             nx, ny, nz = float(a["nx"]), float(a["ny"]), float(a["nz"])
-            per_cube = 1 if generator == "hex_grid" else float(a.get("scheme", 6))
+            per_cube = {"hex_grid": 1, "wedge_grid": 2}.get(generator) or float(a.get("scheme", 6))
             return (nx + 1) * (ny + 1) * (nz + 1), per_cube * nx * ny * nz, 3
         if generator == "l_block_hex":
             n = float(a["n"])

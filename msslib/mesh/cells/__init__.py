@@ -30,7 +30,7 @@ from types import ModuleType
 import numpy as np
 
 __all__ = ["CellType", "FemElement", "Refinement", "RegistryView", "LINE", "registry", "get", "names", "facet_type",
-           "refinement_of", "lattice_refinement", "simplex_gradients", "tensor_gradients", "measure_by_quadrature"]
+           "refinement_of", "generators", "GeneratorView", "lattice_refinement", "simplex_gradients", "tensor_gradients", "measure_by_quadrature"]
 
 
 @dataclass(frozen=True)
@@ -91,6 +91,9 @@ class CellType:
     generator of :mod:`msslib.mesh` (its name) or a function of the cell module returning a
     :class:`~msslib.mesh.Mesh`, and its keyword arguments (lengths in metres, as floats, about 1
     m; the registry-wide tests build it, scaled where they need another size).
+    ``generators``: further mesh generators of the type, each a name in :mod:`msslib.mesh` or a
+    function of the cell module; with the example's generator they are :attr:`mesh_generators`,
+    which a scene may name (``geometry: {generator: ..., args: ...}``).
     """
 
     name: str
@@ -115,6 +118,7 @@ class CellType:
     description: str = field(default="")
     example: tuple = ()
     sofa: str | None = None
+    generators: tuple = ()
 
     def __post_init__(self):
         reference = np.asarray(self.reference, dtype=float)
@@ -156,6 +160,19 @@ class CellType:
     def facets_by_type(self) -> dict[str, np.ndarray]:
         """Facet type -> :meth:`facets` of that type, in the order of the first face of each."""
         return {k: self.facets(k) for k in dict.fromkeys(self.facet_types)}
+
+    @property
+    def mesh_generators(self) -> dict[str, Callable]:
+        """Generator name -> function of the mesh generators of the type: the example's generator
+        and :attr:`generators`, a name resolved in :mod:`msslib.mesh`, a function named by its
+        ``__name__``."""
+        out = {}
+        for g in (*self.example[:1], *self.generators):
+            if callable(g):
+                out[g.__name__] = g
+            else:
+                out[str(g)] = getattr(importlib.import_module("msslib.mesh"), str(g))
+        return out
 
     @property
     def single_facet_type(self) -> str | None:
@@ -324,6 +341,47 @@ class RegistryView(Mapping):
 
     def __repr__(self):
         return repr(dict(self))
+
+
+def generators() -> dict[str, tuple[Callable, int]]:
+    """Mesh generator name -> ``(function, dimension)`` of the generators declared by the cell
+    types (:attr:`CellType.mesh_generators`), read at each call."""
+    out = {}
+    for _, cell in _registry():
+        for name, function in cell.mesh_generators.items():
+            out.setdefault(name, (function, cell.dim))
+    return out
+
+
+class GeneratorView(Mapping):
+    """Generator name -> dimension: the generators of ``fixed`` (a name -> dimension mapping of
+    :mod:`msslib.mesh`'s generators not tied to one cell module) and those the cell types declare
+    (:func:`generators`), read at each access, so a new cell type's generator is seen with no edit."""
+
+    def __init__(self, fixed: Mapping, doc: str = ""):
+        self._fixed, self.__doc__ = dict(fixed), doc
+
+    def _table(self) -> dict[str, int]:
+        return {**self._fixed, **{name: dim for name, (_, dim) in generators().items() if name not in self._fixed}}
+
+    def __getitem__(self, name):
+        return self._table()[name]
+
+    def __iter__(self):
+        return iter(self._table())
+
+    def __len__(self):
+        return len(self._table())
+
+    def __repr__(self):
+        return repr(self._table())
+
+    def function(self, name: str) -> Callable:
+        """The generator ``name``: a cell type's, or else the function of :mod:`msslib.mesh`."""
+        declared = generators()
+        if name in declared:
+            return declared[name][0]
+        return getattr(importlib.import_module("msslib.mesh"), name)
 
 
 def refinement_of(kind: str) -> Refinement:
