@@ -36,8 +36,9 @@ rules on simplices, 3x3(x3) Gauss on Q2), the references of the speed-against-er
 nu = 1/2 displacement-only elements lock (linear ones by a factor of 10 on a clamped cube at
 nu = 0.4999; quadratic ones by a few per cent that shrink slowly under refinement);
 ``volumetric="reduced"`` integrates the volumetric part of the energy (the ``lambda`` terms) with
-one point on quadratic simplices and 2x2(x2) points on Q2: on simplices the penalty form of the
-inf-sup stable P2-P0 pair, on Q2 the classical selective reduced integration, so it does not lock.
+one point on quadratic simplices (the cell mean of the displacement gradient) and 2x2(x2) points
+on Q2: on simplices the penalty form of the inf-sup stable P2-P0 pair, on Q2 the classical
+selective reduced integration, so it does not lock.
 It is chosen over a mixed u-p formulation because it keeps one displacement field (the same
 Newton, solver and laws) and over reduced integration of linear elements because that leaves P1
 simplices locked.
@@ -65,6 +66,14 @@ facet forms on the element's own facets (quadratic ones with ``order=2``); a fol
 adds its non-symmetric load stiffness to Newton's tangent (:mod:`~msslib.fem.pressure`). The
 closed-form solutions they are verified against (thick-walled cylinder and sphere) are in
 :mod:`~msslib.fem.exact`.
+Curved boundaries (``curved=((facets, project), ...)`` of both solves, ``order=2`` only): the
+quadratic nodes of boundary facets known to lie on a surface are placed on it by ``project``
+(isoparametric elements, :func:`~msslib.fem.space.curved_mesh`), so the quadratic element keeps
+its third order in L2 on a curved body; by default every side is straight (a mesh does not say
+which surface its facets approximate), which caps that order at 2 there.
+Every converged increment of a finite-strain solve is checked for inverted elements
+(``det F > 0`` at every quadrature point, for every law), else
+:class:`msslib.errors.UnphysicalStateError` names the load factor, the element and ``det F``.
 
 Modules: :mod:`~msslib.fem.materials` (Lame constants, per-cell materials, the finite-strain
 laws), :mod:`~msslib.fem.space` (scikit-fem conversion, the element basis of either order,

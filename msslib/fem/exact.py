@@ -11,8 +11,11 @@ Both are modelled on a symmetric part: :func:`quarter_annulus` (a mapped structu
 triangles or quads, ``n`` cells through the wall and ``2 n`` around) and :func:`sphere_octant`
 (gmsh tetrahedra of size ``h``), each with its normal displacements held on the symmetry planes
 (:func:`symmetry_supports`) and the pressure on the inner wall (:func:`inner_wall`).  Their curved
-walls are approximated by straight facets whose nodes lie on the circle or sphere; the quadratic
-elements keep these straight sides, so the boundary is represented to ``O(h^2)``.
+walls are approximated by straight facets whose nodes lie on the circle or sphere, an ``O(h^2)``
+approximation of the boundary which caps quadratic elements at order 2 in L2; with
+``curved=curved_walls(mesh, a, b)`` (:func:`curved_walls`) the FEM solves place the quadratic
+elements' mid-side nodes of both walls on the circles or spheres (isoparametric elements,
+boundary to ``O(h^3)``) and the quadratic element converges at order 3.
 """
 
 from __future__ import annotations
@@ -85,17 +88,33 @@ def inner_wall(mesh: Mesh, a: float) -> np.ndarray:
     return bf[np.isclose(np.linalg.norm(mesh.points[bf], axis=-1), a, rtol=1e-9).all(axis=1)]
 
 
+def onto_radius(radius: float):
+    """The function ``X (k, dim) -> X radius / |X|``: the closest point of the circle or sphere of
+    ``radius`` about the origin (a ``project`` of the FEM solves' ``curved``)."""
+    def project(X):
+        X = np.asarray(X, dtype=float)
+        return X * (radius / np.linalg.norm(X, axis=-1))[..., None]
+    return project
+
+
+def curved_walls(mesh: Mesh, a: float, b: float) -> list:
+    """``curved`` of the FEM solves for the walls at radii ``a`` and ``b``: their boundary facets
+    (:func:`inner_wall`) with :func:`onto_radius` of each."""
+    return [(inner_wall(mesh, r), onto_radius(r)) for r in (a, b)]
+
+
 def symmetry_supports(mesh: Mesh) -> np.ndarray:
     """``fixed (n_nodes, dim)``: the displacement normal to each coordinate plane held on it."""
     return np.isclose(mesh.points, 0.0, rtol=0.0, atol=1e-12 * np.abs(mesh.points).max())
 
 
-def l2_error(result, mesh: Mesh, order: int, exact) -> float:
+def l2_error(result, mesh: Mesh, order: int, exact, curved=()) -> float:
     """``||u_h - u|| / ||u||`` in L2 over the mesh of the FEM ``result`` (its every dof, element
-    ``order``) against ``exact(X)`` at the quadrature points of the stiffness."""
+    ``order``, the ``curved`` facets it was solved with) against ``exact(X)`` at the quadrature
+    points of the stiffness."""
     from msslib.fem.space import _Geometry
 
-    geo = _Geometry(mesh, order)
+    geo = _Geometry(mesh, order, curved=curved)
     uh = np.einsum("amq,ami->mqi", geo.phi, result.dof_displacement[geo.nodes])
     X = np.moveaxis(np.asarray(geo.basis.mapping.F(geo.basis.quadrature[0])), 0, -1)
     u = exact(X)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -75,6 +76,7 @@ def solve_linear(
     volumetric: str = "full",
     quadrature: str = "full",
     pressures=(),
+    curved=(),
 ) -> FemResult:
     """Small-strain isotropic linear elasticity on ``mesh``.
 
@@ -108,6 +110,16 @@ def solve_linear(
     positive pushes into the body: traction ``-p n``) and ``follow``; integrated on the element's
     facets (quadratic ones with order 2, see :mod:`msslib.fem.pressure`). In small strain the
     current surface is the reference one, so ``follow`` has no effect here.
+
+    ``curved``: pairs ``(facets, project)`` of boundary facets (node ids, as for ``pressures``) that
+    lie on a known curved surface and a function ``project`` mapping points ``(k, dim)`` onto it;
+    with ``order=2`` the quadratic nodes of those facets are placed at ``project`` of their
+    straight-sided places (isoparametric elements, :func:`msslib.fem.space.curved_mesh`), so that
+    the body's curved walls are represented to ``O(h^3)`` and the quadratic element converges at
+    its order on it (3 in L2, checked on the thick-walled cylinder and sphere of
+    :mod:`msslib.fem.exact`, whose :func:`~msslib.fem.exact.curved_walls` gives the pairs). Default:
+    none, every side straight (the mesh alone does not say which surface its facets approximate).
+    ``dof_points`` and the pressures then lie on the curved sides. ValueError for ``order=1``.
     """
     from msslib.fem.newton import SOLVER
     from msslib.fem.pressure import check_pressures, facet_pressures
@@ -121,7 +133,7 @@ def solve_linear(
     if order == 1:
         warn_locking(mesh, nu_c, plane)
     lam_c, mu_c = lame(E_c, nu_c, plane if mesh.dim == 2 else None)
-    geo = _Geometry(mesh, order)
+    geo = _Geometry(mesh, order, curved=curved)
     w = thickness if mesh.dim == 2 else 1.0
     if assembly == "skfem" and (order != 1 or volumetric != "full"):
         raise ValueError("assembly='skfem' is for linear elements (order=1) with volumetric='full'")
@@ -220,6 +232,27 @@ _REDUCED_INTORDER = RegistryView(lambda c: c.quadratic.reduced_intorder, "cell t
 VOLUMETRIC = ("full", "reduced")
 
 
+def _reduced_geometry(mesh, curved=()):
+    """The quadratic space at the reduced rule of the volumetric term. Where that rule is of degree
+    1 (P2 simplices): one point per cell carrying the cell's mean shape-function gradients and its
+    measure, so that the volumetric term sees the cell mean of the displacement gradient (the
+    penalty form of P2-P0). On a straight-sided simplex the gradients are linear and their mean is
+    their value at the centroid, i.e. the one-point rule; on a curved one (``curved``) the mean is
+    integrated exactly, which a one-point rule would not do. (scikit-fem's triangle rules have 3
+    points at every degree below 3, so an ``intorder`` of 1 would leave P2 triangles fully
+    integrated, and locking.) Else scikit-fem's rule of that degree (2x2(x2) Gauss on Q2)."""
+    k = _REDUCED_INTORDER[mesh.cell_type]
+    if k > 1:
+        return _Geometry(mesh, 2, intorder=k, curved=curved)
+    full = _Geometry(mesh, 2, curved=curved)
+    mean = copy.copy(full)
+    volume = full.dx.sum(axis=1, keepdims=True)  # (m, 1)
+    mean.dx = volume
+    mean.dphi = np.einsum("aJmq,mq->aJm", full.dphi, full.dx)[..., None] / volume
+    mean.phi = np.einsum("amq,mq->am", full.phi, full.dx)[..., None] / volume
+    return mean
+
+
 def _parts(mesh, geo, lam_c, mu_c, volumetric, plane):
     """``(geometry, lam_q, mu_q)`` of the terms of the energy: the whole law at full quadrature,
     or with ``volumetric="reduced"`` the shear part (``lam = 0``) at full quadrature and the
@@ -237,7 +270,7 @@ def _parts(mesh, geo, lam_c, mu_c, volumetric, plane):
                          "stop the locking of simplices")
     if plane == "stress":
         raise ValueError("volumetric='reduced' is for 3D and plane strain: plane stress does not lock")
-    red = _Geometry(mesh, 2, intorder=_REDUCED_INTORDER[mesh.cell_type])
+    red = _reduced_geometry(mesh, geo.curved)
     zero = np.zeros_like(np.asarray(lam_c, dtype=float))
     return [(geo, q(geo, zero), q(geo, mu_c)), (red, q(red, lam_c), q(red, zero))]
 
@@ -329,6 +362,7 @@ def solve_nonlinear(
     volumetric: str = "full",
     initial=None,
     pressures=(),
+    curved=(),
 ) -> FemResult:
     """Geometrically non-linear (total Lagrangian) reference solution with dead loads and pressures.
 
@@ -372,7 +406,8 @@ def solve_nonlinear(
     forces). ``follow=True``: normal to the current surface (:mod:`msslib.fem.pressure`); its
     force enters the residual and its load stiffness the tangent, which is then not symmetric
     (solved by LU, never by Cholesky or CG). ``strain_energy`` is the internal energy; ``reaction``
-    includes the pressure forces at the solution.
+    includes the pressure forces at the solution. ``curved``: curved boundary facets of quadratic
+    elements, as in :func:`solve_linear`.
     """
     from msslib.fem.newton import NEWTON, newton_solve
     from msslib.fem.pressure import check_pressures, facet_pressures
@@ -392,7 +427,7 @@ def solve_nonlinear(
     if order == 1:
         warn_locking(mesh, nu_c, plane)
     lam_c, mu_c = lame(E_c, nu_c)  # 3D constants; plane stress handled inside the law
-    geo = _Geometry(mesh, order)
+    geo = _Geometry(mesh, order, curved=curved)
     w = thickness if d == 2 else 1.0
     x0 = None
     if initial is not None:

@@ -70,7 +70,7 @@ class _Geometry:
     order 1): prescribed nodal values are carried to every dof by it, and dof forces back to the
     nodes by its transpose (which keeps their sum)."""
 
-    def __init__(self, mesh: Mesh, order: int = 1, intorder: int | None = None, quadrature=None):
+    def __init__(self, mesh: Mesh, order: int = 1, intorder: int | None = None, quadrature=None, curved=()):
         import skfem
 
         if order not in ORDERS:
@@ -80,6 +80,15 @@ class _Geometry:
         self.dim = mesh.dim
         element = element_of(mesh.cell_type, order)
         self.skmesh, elem1 = to_skfem(mesh)
+        # ``curved``: pairs (boundary facets, project): the quadratic dofs of those facets moved onto
+        # the surface by ``project`` (isoparametric elements, see curved_mesh)
+        self.curved = check_curved(curved, mesh, order)
+        if self.curved:
+            self.skmesh = curved_mesh(self.skmesh, self.curved)
+            if intorder is None and quadrature is None and mesh.cell_type in ("triangle", "tetra"):
+                # on a curved simplex grad(phi) dx = adj(J) grad_ref(phi) dxi is of degree d: a rule of
+                # that degree integrates a constant stress's forces exactly (the patch test)
+                intorder = max(element.intorder, mesh.dim)
         self.elem = elem1 if order == 1 else getattr(skfem, element.element)()
         # ``quadrature``: an explicit rule ``(points (dim, q), weights (q,))`` on the reference cell
         # (scikit-fem takes at least 2 points per direction from ``intorder``); without one, the
@@ -118,6 +127,10 @@ class _Geometry:
             vals = local[j].ravel()
             keep = vals != 0.0
             self.interp = sp.csr_matrix((vals[keep], (rows[keep], cols[keep])), shape=(self.n_scalar, mesh.n_nodes))
+
+    def facet_ids(self, facets) -> np.ndarray:
+        """scikit-fem's facet numbers of ``facets`` (node ids, ``(k, nodes per facet)``)."""
+        return _facet_ids(self.skmesh, facets)
 
     def to_ours(self, v_sk: np.ndarray) -> np.ndarray:
         """A scalar vector in scikit-fem's dof numbering, in ours."""
@@ -172,6 +185,81 @@ class _Geometry:
         w = thickness if d == 2 else 1.0
         fe = np.einsum("amq,mq,mi->mai", self.phi, self.dx, b) * w  # (m, nb, d)
         return self.assemble_vector(fe.reshape(m, -1)).reshape(-1, d)
+
+
+#: the scikit-fem mesh of each linear one whose quadratic (mid-side, face and cell) nodes are its own
+_QUADRATIC_MESH = {"MeshTri1": "MeshTri2", "MeshQuad1": "MeshQuad2", "MeshTet1": "MeshTet2", "MeshHex1": "MeshHex2"}
+
+
+def _facet_ids(skmesh, facets) -> np.ndarray:
+    index = {tuple(sorted(r)): i for i, r in enumerate(np.asarray(skmesh.facets).T.tolist())}
+    try:
+        return np.array([index[tuple(sorted(r))] for r in np.asarray(facets).tolist()], dtype=np.int64)
+    except KeyError as exc:
+        raise ValueError(f"a facet of nodes {list(exc.args[0])} is no facet of the mesh") from None
+
+
+def check_curved(curved, mesh: Mesh, order: int) -> tuple:
+    """``curved`` as a tuple of ``(facets (k, nf) int64, project)``; ValueError in one line for an
+    entry that is no pair of boundary facets and a callable, or for linear elements (``order=1``:
+    their facets are straight)."""
+    from msslib.mesh import boundary_facets
+
+    try:
+        items = list(curved)
+    except TypeError:
+        raise ValueError(f"curved must be a sequence of (facets, project) pairs, got {type(curved).__name__}") from None
+    if not items:
+        return ()
+    if order != 2:
+        raise ValueError(f"curved: only quadratic elements (order=2) place nodes on a curved surface, got order={order!r}")
+    boundary = {tuple(sorted(r)) for r in boundary_facets(mesh).tolist()}
+    out = []
+    for n, item in enumerate(items):
+        if not isinstance(item, (tuple, list)) or len(item) != 2 or not callable(item[1]):
+            got = (f"project of type {type(item[1]).__name__}" if isinstance(item, (tuple, list)) and len(item) == 2
+                   else f"a {type(item).__name__}" + (f" of length {len(item)}" if isinstance(item, (tuple, list)) else ""))
+            raise ValueError(f"curved[{n}] must be a pair (facets, project) with project a function of points "
+                             f"(k, dim) -> (k, dim), got {got}")
+        facets = np.asarray(item[0])
+        if facets.ndim != 2 or facets.dtype.kind not in "iu" or facets.shape[0] == 0:
+            raise ValueError(f"curved[{n}]: facets must be a non-empty array of node ids (k, nodes per facet), got "
+                             f"shape {facets.shape} ({facets.dtype})")
+        for r in facets.tolist():
+            if tuple(sorted(r)) not in boundary:
+                raise ValueError(f"curved[{n}]: facet of nodes {r} is not a boundary facet of the mesh; only boundary "
+                                 "facets lie on a surface (msslib.mesh.boundary_facets)")
+        out.append((facets.astype(np.int64), item[1]))
+    return tuple(out)
+
+
+def curved_mesh(skmesh, curved):
+    """The quadratic scikit-fem mesh (``MeshTri2``, ``MeshQuad2``, ``MeshTet2``, ``MeshHex2``) of
+    the linear ``skmesh`` with the quadratic nodes of each ``(facets, project)`` of ``curved``
+    (their mid-side nodes and, on quadrilateral facets, the face centres) placed at
+    ``project(points)`` (``(k, dim) -> (k, dim)``, e.g. the closest point of a circle or sphere);
+    the mesh's own nodes stay where they are, every other quadratic node on its straight side.
+    Elements on it are isoparametric: their sides follow the surface to ``O(h^3)`` instead of the
+    ``O(h^2)`` of straight sides, which is what the quadratic element needs for its third order
+    in L2 on a curved body."""
+    import dataclasses
+
+    import skfem
+
+    quadratic = getattr(skfem, _QUADRATIC_MESH[type(skmesh).__name__])
+    m2 = quadratic.from_mesh(skmesh)
+    n_vertices = skmesh.p.shape[1]
+    doflocs = np.array(m2.doflocs)
+    for n, (facets, project) in enumerate(curved):
+        dofs = np.unique(np.asarray(m2.dofs.get_facet_dofs(_facet_ids(m2, facets))).ravel())
+        dofs = dofs[dofs >= n_vertices]
+        moved = np.asarray(project(doflocs[:, dofs].T.copy()), dtype=float)
+        if moved.shape != (dofs.size, m2.dim()) or not np.all(np.isfinite(moved)):
+            raise ValueError(f"curved[{n}]: project must map points (k, {m2.dim()}) to finite points of the same shape, "
+                             f"got shape {moved.shape}" + ("" if moved.shape != (dofs.size, m2.dim()) else
+                                                           " with non-finite values"))
+        doflocs[:, dofs] = moved.T
+    return dataclasses.replace(m2, doflocs=doflocs)
 
 
 def _linear_stiffness(geo: _Geometry, lam_c: np.ndarray, mu_c: np.ndarray) -> sp.csr_matrix:
