@@ -246,19 +246,33 @@ def test_a_wedge_mesh_round_trips_through_vtu_and_meshio_reads_wedges(tmp_path):
     np.testing.assert_array_equal(back.points, mesh.points)
 
 
-def test_the_triangles_and_quads_of_a_wedge_file_are_node_groups(tmp_path):
+def _wedge_file(tmp_path):
+    """A gmsh 2 file of two wedges with groups 7 (two triangles), 8 (two quads) and 9 (a triangle
+    and a quad)."""
     mesh = _box(1, 1, 1)
     by_type = M.boundary_facets_by_type(mesh)
-    tri, quad = by_type["triangle"][0][:1], by_type["quad"][0][:1]
-    cells_ = [("wedge", mesh.cells), ("triangle", tri), ("quad", quad)]
-    data = {"gmsh:physical": [np.zeros(2, int), np.full(1, 7), np.full(1, 8)],
-            "gmsh:geometrical": [np.zeros(2, int), np.ones(1, int), np.ones(1, int)]}
+    tri, quad = by_type["triangle"][0][:2], by_type["quad"][0][:2]
+    cells_ = [("wedge", mesh.cells), ("triangle", tri[:2]), ("quad", quad[:2]), ("triangle", tri[:1]),
+              ("quad", quad[:1])]
+    data = {"gmsh:physical": [np.zeros(2, int), np.full(2, 7), np.full(2, 8), np.full(1, 9), np.full(1, 9)],
+            "gmsh:geometrical": [np.zeros(2, int), np.ones(2, int), np.ones(2, int), np.full(1, 2), np.full(1, 2)]}
     meshio.write(tmp_path / "w.msh", meshio.Mesh(mesh.points, cells_, cell_data=data), file_format="gmsh22",
                  binary=False)
-    back = M.read(tmp_path / "w.msh")
-    assert back.cell_type == "wedge" and back.n_cells == 2 and not back.facet_groups
-    np.testing.assert_array_equal(back.node_groups["7"], np.sort(tri[0]))
-    np.testing.assert_array_equal(back.node_groups["8"], np.sort(quad[0]))
+    return tri, quad
+
+
+def test_the_triangles_and_quads_of_a_wedge_file_are_facet_groups(tmp_path):
+    from msslib.errors import MsslibWarning
+
+    tri, quad = _wedge_file(tmp_path)
+    with pytest.warns(MsslibWarning, match=r"facet group '9' has facets of several types \(quad, triangle\): read "
+                                           r"as a node group \(a facet group holds facets of one type\)"):
+        back = M.read(tmp_path / "w.msh")
+    assert back.cell_type == "wedge" and back.n_cells == 2 and sorted(back.facet_groups) == ["7", "8"]
+    np.testing.assert_array_equal(back.facet_groups["7"], tri)
+    np.testing.assert_array_equal(back.facet_groups["8"], quad)
+    assert sorted(back.node_groups) == ["9"]
+    np.testing.assert_array_equal(back.node_groups["9"], np.union1d(tri[0], quad[0]))
 
 
 def test_the_result_writer_names_the_wedge_volume_shape(tmp_path):
@@ -324,16 +338,52 @@ def test_a_scene_names_the_wedge_grid_generator_declared_by_the_cell_module(tmp_
         run_scene(scene, progress=False)
 
 
-def test_a_traction_on_a_wedge_mesh_is_refused_in_one_line(tmp_path, capsys):
-    from msslib.cli import main as cli
+def _surface_loads(scene):
+    from msslib.scene import load_scene, prepare
 
+    return prepare(load_scene(scene)).surface_forces
+
+
+def _area(facet_points):
+    """Area of a planar triangle or of a planar quad (half the cross product of its diagonals)."""
+    p = np.asarray(facet_points, dtype=float)
+    if len(p) == 3:
+        return 0.5 * np.linalg.norm(np.cross(p[1] - p[0], p[2] - p[0]))
+    return 0.5 * np.linalg.norm(np.cross(p[2] - p[0], p[3] - p[1]))
+
+
+def test_a_traction_on_a_wedge_mesh_acts_on_its_triangles_and_quads(tmp_path):
+    """A traction on the whole surface of the 2 x 1 x 3 box (triangles on top and bottom, quads on
+    the sides; 22 m^2) is balanced by the support: the reaction is -traction x 22 m^2; on the side
+    x = 2 (quads, 3 m^2) and on the top z = 3 (triangles, 2 m^2) the loads are those areas'."""
+    from msslib.scene.run import run_scene
+
+    t = np.array([0.0, 0.0, -1e3])
     scene = _scene(tmp_path)
-    scene["loads"] = [{"type": "traction", "select": {"plane": ["z", 3.0]}, "traction": [0.0, 0.0, -1e3]}]
-    (tmp_path / "t.yaml").write_text(yaml.safe_dump(scene))
-    assert cli(["run", str(tmp_path / "t.yaml"), "--out", str(tmp_path / "t.nc"), "--quiet"]) == 1
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "wedge cells have facets of several types" in err, err
-    assert not (tmp_path / "t.nc").exists()
+    scene["loads"] = [{"type": "traction", "select": {"box": [[-1, -1, -1], [3, 2, 4]]}, "traction": t.tolist()}]
+    ds = run_scene(scene, progress=False)
+    np.testing.assert_allclose(ds["reaction_force"].sum(dim="node").values, -22.0 * t, rtol=1e-12, atol=1e-12 * 22e3)
+    for select, area in (({"plane": ["x", 2.0]}, 3.0), ({"plane": ["z", 3.0]}, 2.0)):
+        scene["loads"] = [{"type": "traction", "select": select, "traction": t.tolist()}]
+        np.testing.assert_allclose(_surface_loads(scene).sum(axis=0), area * t, rtol=1e-13)
+
+
+def test_a_traction_on_facet_groups_of_a_wedge_file(tmp_path):
+    """Each facet group of a wedge file carries its own traction, on its nodes only: a group of two
+    triangles, a group of two quads."""
+    tri, quad = _wedge_file(tmp_path)
+    points = M.wedge_grid(2.0, 1.0, 3.0, 1, 1, 1).points
+    scene = _scene(tmp_path)
+    scene["geometry"] = {"file": str(tmp_path / "w.msh")}
+    scene["boundary"] = [{"select": {"plane": ["z", 0.0]}, "fix": "all"}]
+    t = np.array([1e3, 0.0, 0.0])
+    for group, facets in (("7", tri), ("8", quad)):
+        scene["loads"] = [{"type": "traction", "select": {"group": group}, "traction": t.tolist()}]
+        with pytest.warns(Warning, match="facet group '9'"):
+            surface = _surface_loads(scene)
+        area = sum(_area(points[f]) for f in facets)
+        np.testing.assert_allclose(surface.sum(axis=0), area * t, rtol=1e-13)
+        np.testing.assert_array_equal(np.flatnonzero(np.abs(surface).sum(axis=1)), np.unique(facets))
 
 
 def test_plan_refuses_a_wedge_mesh_in_one_line(tmp_path, capsys):

@@ -142,10 +142,11 @@ def read(path, material_key: str = "material", coincident_nodes: str = "merge",
     file without elements is an error naming it.  Also meshio's
     ``cell_sets`` (gmsh 4 named groups, Abaqus ELSET, ...; sets named ``gmsh:...`` are meshio's bookkeeping and are
     skipped) become ``cell_groups`` for elements of the chosen cell type, ``facet_groups`` for
-    elements of its facet type (lines in 2D, triangles for tetra, quads for hexahedron cells) and
-    ``node_groups`` (the nodes of the elements) for other lower-dimensional elements (gmsh
-    physical points and curves of a 3D mesh, triangles of a hexahedron mesh, the triangles and
-    quads of a wedge mesh, whose facets are of two types); meshio's
+    elements of its facet types (lines in 2D, triangles for tetra, quads for hexahedron cells,
+    triangles and quads for wedge cells: a group of one type each; a group holding both is read
+    as a node group, with a :class:`msslib.errors.MsslibWarning`) and ``node_groups`` (the
+    nodes of the elements) for other lower-dimensional elements (gmsh physical points and curves
+    of a 3D mesh, triangles of a hexahedron mesh); meshio's
     ``point_sets`` (Abaqus NSET, Exodus node sets) become ``node_groups``.  A group of the same
     name from both sources is their union.  Groups of different dimensions with one name (a
     physical surface and a physical volume both called ``body``) are kept apart, one group of each
@@ -347,9 +348,8 @@ _TOPOLOGICAL_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle
                     "quad9": 2, "polygon": 2, "tetra": 3, "tetra10": 3, "hexahedron": 3, "hexahedron20": 3,
                     "hexahedron27": 3, "wedge": 3, "pyramid": 3}
 
-#: the element type of the facets of each cell type (None for a type with facets of several types,
-#: whose facet elements in a file become node groups)
-_FACET_TYPE = _RegistryView(lambda c: c.single_facet_type, "cell type -> its facet type")
+#: the element types of the facets of each cell type (a wedge has triangles and quads)
+_FACET_TYPES = _RegistryView(lambda c: frozenset(c.facet_types), "cell type -> its facet types")
 
 
 def _block_dim(cell_type: str) -> int | None:
@@ -440,7 +440,7 @@ def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray, physical_nam
         elif bdim is None or bdim >= dim:
             continue  # another cell type of the same or a higher dimension: not in the mesh
         else:
-            target = facets_acc if (bdim == dim - 1 and block.type == _FACET_TYPE[cell_type]) else nodes_acc
+            target = facets_acc if (bdim == dim - 1 and block.type in _FACET_TYPES[cell_type]) else nodes_acc
         members = [(names.get((d, t), str(t)), idx) for d, t, idx in physical_members(k, bdim, n)]
         for name, per_block in cell_sets.items():
             if k < len(per_block) and per_block[k] is not None and len(per_block[k]):
@@ -472,6 +472,13 @@ def _file_groups(m, cell_type: str, blocks: list, used: np.ndarray, physical_nam
         return pos
 
     facet_groups, node_groups = {}, {}
+    for name, parts in list(facets_acc.items()):
+        if len({p.shape[1] for p in parts}) > 1:  # a group of facets holds facets of one type
+            notes.append(f"facet group {name!r} has facets of several types "
+                         f"({', '.join(sorted({_cells.facet_type(p.shape[1], dim) for p in parts}))}): read as a node group "
+                         f"(a facet group holds facets of one type)")
+            nodes_acc.setdefault(name, []).extend(p.ravel() for p in parts)
+            del facets_acc[name]
     for name, parts in facets_acc.items():
         facets = to_mesh_nodes("facet", name, np.concatenate(parts))
         if facets is not None:

@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 
 from msslib import mesh as _mesh
+from msslib.mesh import cells as _cells
 
 AXES = ("x", "y", "z")
 
@@ -112,10 +113,21 @@ def select_nodes(path, mesh, sel, default_tol, group=None):
 def loaded_facets(path, mesh, sel, default_tol, cache, load: str = "traction"):
     """The facets a ``load`` (a traction or a pressure: the word its refusals use) acts on: the facets of a facet group (each must be a boundary facet),
     the boundary facets of the cells of a cell group, else the boundary facets whose nodes are all
-    selected; with plane and/or box, only those whose nodes are all in them too."""
-    if "boundary" not in cache:
-        cache["boundary"] = _mesh.boundary_facets(mesh, return_cells=True)
-    candidates, facet_cell = cache["boundary"]
+    selected; with plane and/or box, only those whose nodes are all in them too.  A ``(k, nodes)``
+    array: for a cell type with facets of one type (else the ValueError of
+    :func:`msslib.mesh.boundary_facets`; see :func:`loaded_facets_by_type`)."""
+    if _cells.get(mesh.cell_type).single_facet_type is None:
+        _mesh.boundary_facets(mesh)  # raises: facets of several types
+    (facets,) = loaded_facets_by_type(path, mesh, sel, default_tol, cache, load).values()
+    return facets
+
+
+def loaded_facets_by_type(path, mesh, sel, default_tol, cache, load: str = "traction") -> dict:
+    """:func:`loaded_facets` of any cell type, by facet type: facet type -> ``(k, nodes)`` facets,
+    the types with no loaded facet left out (a wedge mesh's triangles and quads)."""
+    if "boundary_by_type" not in cache:
+        cache["boundary_by_type"] = _mesh.boundary_facets_by_type(mesh)
+    by_type = dict(cache["boundary_by_type"])
     group = None
     if "group" in sel:
         group = _group_members(f"{path}.group", mesh, sel["group"])
@@ -130,14 +142,18 @@ def loaded_facets(path, mesh, sel, default_tol, cache, load: str = "traction"):
                 _fail(f"{path}.group", f"{len(bad)} of the {len(members)} facets of group {sel['group']!r} are not on "
                       f"the boundary of the mesh: the facet of nodes {f.tolist()} at {centroid} {where}; allowed: a "
                       f"{load} on boundary facets")
-            candidates = members
+            by_type = {_cells.facet_type(members.shape[1], mesh.dim): (members, None)}
         elif kind == "cells":
-            candidates = candidates[np.isin(facet_cell, members)]
+            by_type = {k: (c[np.isin(fc, members)], None) for k, (c, fc) in by_type.items()}
     nodes = select_nodes(path, mesh, sel, default_tol, group)
     selected = np.zeros(mesh.n_nodes, dtype=bool)
     selected[nodes] = True
-    on = selected[candidates].all(axis=1) if len(candidates) else np.zeros(0, dtype=bool)
-    if not on.any():
+    out = {}
+    for k, (candidates, _) in by_type.items():
+        on = selected[candidates].all(axis=1) if len(candidates) else np.zeros(0, dtype=bool)
+        if on.any():
+            out[k] = candidates[on]
+    if not out:
         of = f" of group {sel['group']!r}" if "group" in sel else ""
         _fail(path, f"no boundary facet{of} has all its nodes selected ({len(nodes)} node(s) selected)")
-    return candidates[on]
+    return out

@@ -13,7 +13,7 @@ import numpy as np
 from msslib import mesh as _mesh
 from msslib import models as _models
 from msslib.scene.schema import Scene
-from msslib.mesh.selection import loaded_facets, select_nodes
+from msslib.mesh.selection import loaded_facets, loaded_facets_by_type, select_nodes
 from msslib.scene.selection import _build_mesh, _check_dim
 from msslib.scene.validate import AXES, _fail
 
@@ -143,8 +143,9 @@ def prepare(scene: Scene) -> Setup:
             from msslib.terms import Traction
 
             traction = _check_dim(f"{p}.traction", load["traction"], dim)
-            loaded = loaded_facets(f"{p}.select", mesh, load["select"], default_tol, facet_cache)
-            surface += Traction(mesh, loaded, traction, thickness if dim == 2 else 1.0).nodal
+            # per facet type (a wedge mesh's triangles and quads)
+            for loaded in loaded_facets_by_type(f"{p}.select", mesh, load["select"], default_tol, facet_cache).values():
+                surface += Traction(mesh, loaded, traction, thickness if dim == 2 else 1.0).nodal
     from msslib.hints import check_load_scale  # a load far above E (E in MPa, loads in Pa) is refused
 
     check_load_scale(mesh, scene.loads, [m.E for m in scene.materials], cell_density, thickness, fixed.any())
