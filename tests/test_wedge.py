@@ -386,6 +386,20 @@ def test_a_traction_on_facet_groups_of_a_wedge_file(tmp_path):
         np.testing.assert_array_equal(np.flatnonzero(np.abs(surface).sum(axis=1)), np.unique(facets))
 
 
+def test_a_pressure_on_a_wedge_mesh_is_refused_in_one_line_naming_it(tmp_path, capsys):
+    from msslib.cli import main as cli
+
+    scene = _scene(tmp_path)
+    scene["loads"] = [{"type": "pressure", "select": {"plane": ["z", 3.0]}, "pressure": 1e3}]
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(scene))
+    assert cli(["run", str(tmp_path / "p.yaml"), "--out", str(tmp_path / "p.nc"), "--quiet"]) == 1
+    err = capsys.readouterr().err
+    assert err == ("msslib: error: scene.loads[0].select: a pressure on wedge cells, whose facets are of several types "
+                   "(quad, triangle), is not supported; allowed: a pressure on meshes of triangle, quad, tetra, "
+                   "hexahedron cells\n"), err
+    assert not (tmp_path / "p.nc").exists()
+
+
 def test_plan_refuses_a_wedge_mesh_in_one_line(tmp_path, capsys):
     from msslib.cli import main as cli
 

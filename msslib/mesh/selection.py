@@ -114,10 +114,13 @@ def loaded_facets(path, mesh, sel, default_tol, cache, load: str = "traction"):
     """The facets a ``load`` (a traction or a pressure: the word its refusals use) acts on: the facets of a facet group (each must be a boundary facet),
     the boundary facets of the cells of a cell group, else the boundary facets whose nodes are all
     selected; with plane and/or box, only those whose nodes are all in them too.  A ``(k, nodes)``
-    array: for a cell type with facets of one type (else the ValueError of
-    :func:`msslib.mesh.boundary_facets`; see :func:`loaded_facets_by_type`)."""
-    if _cells.get(mesh.cell_type).single_facet_type is None:
-        _mesh.boundary_facets(mesh)  # raises: facets of several types
+    array, for a cell type with facets of one type (a ValueError naming the ``load`` for others;
+    see :func:`loaded_facets_by_type`)."""
+    kinds = _cells.get(mesh.cell_type).facet_types
+    if len(set(kinds)) > 1:
+        one = ", ".join(n for n, c in _cells.registry().items() if c.single_facet_type is not None)
+        _fail(path, f"a {load} on {mesh.cell_type} cells, whose facets are of several types "
+              f"({', '.join(sorted(set(kinds)))}), is not supported; allowed: a {load} on meshes of {one} cells")
     (facets,) = loaded_facets_by_type(path, mesh, sel, default_tol, cache, load).values()
     return facets
 
