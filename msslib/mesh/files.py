@@ -343,16 +343,19 @@ def _check_duplicate_cells(path: Path, cells: np.ndarray, cell_type: str, repeat
                          f"duplicate cell(s)); allowed: each cell once ({hint})")
 
 
-#: topological dimension of meshio cell types that may carry groups (others are looked up in meshio)
-_TOPOLOGICAL_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2, "quad8": 2,
-                    "quad9": 2, "polygon": 2, "tetra": 3, "tetra10": 3, "hexahedron": 3, "hexahedron20": 3,
-                    "hexahedron27": 3, "wedge": 3, "pyramid": 3}
+#: topological dimension of meshio cell types that are no cell type of the registry and may carry
+#: groups (the registry's own types have their dimension; others are looked up in meshio)
+_TOPOLOGICAL_DIM = {"vertex": 0, "line": 1, "line3": 1, "triangle6": 2, "quad8": 2, "quad9": 2, "polygon": 2,
+                    "tetra10": 3, "hexahedron20": 3, "hexahedron27": 3, "pyramid": 3}
 
 #: the element types of the facets of each cell type (a wedge has triangles and quads)
 _FACET_TYPES = _RegistryView(lambda c: frozenset(c.facet_types), "cell type -> its facet types")
 
 
 def _block_dim(cell_type: str) -> int | None:
+    for cell in _cells.registry().values():
+        if cell.meshio == cell_type:
+            return cell.dim
     if cell_type in _TOPOLOGICAL_DIM:
         return _TOPOLOGICAL_DIM[cell_type]
     try:
