@@ -53,7 +53,7 @@ CELL = dataclasses.replace(
     flip=(0, 2, 1, 3), refinement=_variants(tetra.CELL.refinement),
     gradients=lambda p: tetra.CELL.gradients(p)[:, _ORDER],
     linear=dataclasses.replace(tetra.CELL.linear, vtk_to_skfem=None),
-    quadratic=dataclasses.replace(tetra.CELL.quadratic, vtk_to_skfem=None),
+    quadratic=dataclasses.replace(tetra.CELL.quadratic, vtk_to_skfem=None), generators=(),
     example=(scratch_tetra_grid, {"lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 2, "ny": 2, "nz": 2}),
 )
 '''

@@ -68,3 +68,16 @@ def _write(tmp_path, scene):
     path = tmp_path / "w.yaml"
     path.write_text(yaml.safe_dump(scene, sort_keys=False))
     return path
+
+
+def test_the_scene_generators_are_the_cell_types(monkeypatch):
+    """scene.GENERATORS is read from the cell modules: each generator with its type's dimension, and
+    a generator a module no longer declares is gone."""
+    from msslib.scene import GENERATORS
+
+    assert GENERATORS["triangle_grid_right"] == 2 and GENERATORS["cone_mesh"] == 3 and GENERATORS["wedge_grid"] == 3
+    before = len(GENERATORS)
+    tetra = dataclasses.replace(cells.get("tetra"), generators=("l_block_tet",))
+    table = tuple((n, tetra if n == "tetra" else c) for n, c in cells._registry())
+    monkeypatch.setattr(cells, "_registry", lambda: table)
+    assert "cone_mesh" not in GENERATORS and GENERATORS["l_block_tet"] == 3 and len(GENERATORS) == before - 3

@@ -40,8 +40,8 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     ``generator`` names one of :data:`GENERATORS` (``quad_grid``, ``triangle_grid_equilateral``,
     ``hexagon_equilateral``, ``triangle_grid_right``, ``hex_grid``, ``tet_grid``,
     ``l_block_hex``, ``polygon_mesh``, ``cylinder_mesh``, ``cylinder_with_hole_mesh``,
-    ``cone_mesh``, ``l_block_tet``, and the generators the cell types declare, such as
-    ``wedge_grid``) and ``args`` its keyword arguments (see :mod:`msslib.mesh`;
+    ``cone_mesh``, ``l_block_tet``, ``wedge_grid``: the generators the cell types declare, read
+    from :mod:`msslib.mesh.cells`) and ``args`` its keyword arguments (see :mod:`msslib.mesh`;
     unknown or missing arguments are errors).  ``file`` is a mesh file read by
     :func:`msslib.mesh.read`, relative to the directory of the scene file (or of ``base_dir`` for a
     scene given as a dict); an integer cell data array ``material`` becomes the material index.

@@ -21,15 +21,11 @@ from msslib.scene.validate import (
     _list, _mapping, _number, _parse_yaml, _selection, _show, _string, _vector,
 )
 
-GENERATORS = _mesh.cells.GeneratorView({
-    "quad_grid": 2, "triangle_grid_equilateral": 2, "hexagon_equilateral": 2, "triangle_grid_right": 2,
-    "polygon_mesh": 2, "hex_grid": 3, "tet_grid": 3, "l_block_hex": 3, "cylinder_mesh": 3,
-    "cylinder_with_hole_mesh": 3, "cone_mesh": 3, "l_block_tet": 3,
-}, "Mesh generators a scene may name, with their dimension: these of msslib.mesh, and those the cell types "
-   "declare (msslib.mesh.cells: each cell type's example generator and its generators), read at each access.")
-"""Mesh generators a scene may name, with their dimension: these of :mod:`msslib.mesh`, and those
-the cell types declare (:attr:`msslib.mesh.cells.CellType.mesh_generators`, ``wedge_grid``
-among them), read at each access."""
+GENERATORS = _mesh.cells.GeneratorView({}, "Mesh generators a scene may name, with their dimension: those the cell "
+                                       "types declare (msslib.mesh.cells), read at each access.")
+"""Mesh generators a scene may name, with their dimension: those the cell types declare
+(:attr:`msslib.mesh.cells.CellType.mesh_generators`: ``quad_grid``, ``tet_grid``, ``wedge_grid``,
+...), read from the registry at each access, so a new cell type's generators need no edit here."""
 
 #: MSS model name -> (cell type, internal terms it can build), from the registry of msslib.models
 MSS_MODELS = {name: (spec.cell_type, spec.terms) for name, spec in _models.registry().items() if spec.kind == "mss"}

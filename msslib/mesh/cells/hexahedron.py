@@ -52,4 +52,5 @@ CELL = CellType(
     face_diagonals=np.array(_FACES)[:, [[0, 2], [1, 3]]].reshape(-1, 2),
     inner_diagonals=[[0, 6], [1, 7], [2, 4], [3, 5]],
     example=("hex_grid", {"lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 2, "ny": 2, "nz": 2}),
+    generators=("l_block_hex",),
 )

@@ -40,4 +40,5 @@ CELL = CellType(
     quadratic=FemElement("MeshTet1", "ElementTetP2", "P2 tetrahedra", intorder=2, reduced_intorder=1),
     vtk_id=10, meshio="tetra", sofa="tetrahedra", volume_shape="tetrahedron", simplex=True,
     example=("tet_grid", {"lx": 1.0, "ly": 1.0, "lz": 1.0, "nx": 2, "ny": 2, "nz": 2}),
+    generators=("l_block_tet", "cylinder_mesh", "cylinder_with_hole_mesh", "cone_mesh"),
 )

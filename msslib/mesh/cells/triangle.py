@@ -29,4 +29,5 @@ CELL = CellType(
     quadratic=FemElement("MeshTri1", "ElementTriP2", "P2 triangles", intorder=2, reduced_intorder=1),
     vtk_id=5, meshio="triangle", sofa="triangles", simplex=True,
     example=("triangle_grid_equilateral", {"width": 3.0, "height": 2.0, "n": 3}),
+    generators=("triangle_grid_right", "hexagon_equilateral", "polygon_mesh"),
 )
