@@ -355,3 +355,21 @@ def test_reduced_volumetric_rule_of_p2_simplices_is_one_point_on_straight_sides(
     assert reduced.dx.shape == (m, 1)
     assert abs(K - K1).max() < 1e-12 * abs(K1).max()
     assert abs(K - _linear_stiffness(_Geometry(mesh, 2), lam, zero)).max() > 1e-3 * abs(K1).max()
+
+
+def test_finite_strain_solve_on_curved_walls_tends_to_the_linear_one_at_small_pressure():
+    """solve_nonlinear takes the same curved walls: at a pressure of 1e-6 E its solution is the
+    linear one to O(p^2) (relative 1e-6), and the inversion check passes."""
+    from msslib.fem import solve_nonlinear
+
+    mesh = exact.quarter_annulus(A, B, 3, "triangle")
+    walls = exact.curved_walls(mesh, A, B)
+    p = 1e-6 * E
+    kw = dict(fixed=exact.symmetry_supports(mesh), plane="strain", order=2, volumetric="reduced", curved=walls,
+              pressures=[(exact.inner_wall(mesh, A), p, True)])
+    lin = solve_linear(mesh, E, 0.3, **kw)
+    for law in ("svk", "neohookean"):
+        r = solve_nonlinear(mesh, E, 0.3, law=law, steps=1, **kw)
+        scale = np.abs(lin.dof_displacement).max()
+        assert np.abs(r.dof_displacement - lin.dof_displacement).max() < 1e-5 * scale
+        assert np.array_equal(r.dof_points, lin.dof_points)
