@@ -6,7 +6,9 @@ body whose linear-elastic solution is known in closed form (:mod:`msslib.fem.exa
   triangles or quads (``n`` cells through the wall, ``2 n`` around), symmetry supports;
 * ``sphere``: the thick sphere (radii 1 and 2) on a gmsh octant of tetrahedra of size ``h``.
 
-Every run is small strain: the mass-spring models by the scene's linear static solve (one solve
+The quadratic reference runs twice: with straight-sided elements, as on a user's mesh
+(``fem_quadratic``), and with the quadratic nodes of both walls on their circle or sphere
+(``fem_quadratic_curved``, isoparametric).  Every run is small strain: the mass-spring models by the scene's linear static solve (one solve
 with the stiffness at rest) of a dead pressure on the inner wall (the scene's ``pressure`` load on
 the mesh's facet group ``inner``), the FEM ones by :func:`msslib.fem.solve_linear` on the same
 facets.  The error is the largest nodal displacement error over the largest exact nodal
@@ -83,12 +85,14 @@ def mss_run(model: str, mesh, inner, nu: float):
     return np.asarray(ds["displacement"].values).reshape(mesh.n_nodes, mesh.dim)
 
 
-def fem_run(order: int, mesh, inner, nu: float):
+def fem_run(order: int, mesh, inner, nu: float, curved: bool = False):
+    """FEM of ``order`` on the mesh; ``curved``: the quadratic nodes of both walls on their circle or
+    sphere (isoparametric), else straight-sided elements as on a user's mesh."""
     from msslib.fem import exact, solve_linear
 
     r = solve_linear(mesh, E, nu, fixed=exact.symmetry_supports(mesh), order=order, plane="stress",
                      volumetric="reduced" if order == 2 and mesh.dim == 3 else "full", linear_solver="direct",
-                     pressures=[(inner, P, False)])
+                     pressures=[(inner, P, False)], curved=exact.curved_walls(mesh, A, B) if curved else ())
     return r.displacement
 
 
@@ -100,7 +104,8 @@ def study(quick: bool = False, log=print) -> list[dict]:
         inner = exact.inner_wall(mesh, A)
         for nu in NUS:
             u_exact = exact_of(nu)
-            runs = [("fem_quadratic", partial(fem_run, 2)), ("fem_linear_p1", partial(fem_run, 1))]
+            runs = [("fem_quadratic", partial(fem_run, 2)), ("fem_quadratic_curved", partial(fem_run, 2, curved=True)),
+                    ("fem_linear_p1", partial(fem_run, 1))]
             runs += [(m, partial(mss_run, m)) for m in models_for(cells)]
             reference = None
             for name, run in runs:

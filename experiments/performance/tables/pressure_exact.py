@@ -28,7 +28,8 @@ def main():
              "the largest nodal displacement error against the exact linear-elastic solution, relative to the largest "
              "exact displacement, on the finest mesh of each case; in brackets the observed order of the root-mean-square "
              "error between the two finest meshes. *fem_quadratic*: the project's quadratic reference (reduced "
-             "volumetric rule in 3D); *fem_linear_p1*: linear FEM. A dash: the model does not run on those cells."), "",
+             "volumetric rule in 3D), straight-sided as on a user's mesh; *fem_quadratic_curved*: the same with the "
+             "quadratic nodes of both walls on their circle or sphere; *fem_linear_p1*: linear FEM. A dash: the model does not run on those cells."), "",
              "| case | model | " + " | ".join(f"nu = {nu:g}" for nu in nus) + " |", "|---|---" + "|---" * len(nus) + "|"]
     for case in d.case.values:
         for model in d.model.values:
