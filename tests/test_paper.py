@@ -325,6 +325,22 @@ def test_false_claim_on_quick_results_is_marked(tmp_path):
     assert "Negative." + paper.QUICK_MARK in text
 
 
+def test_a_division_by_zero_fails_the_build_but_is_marked_in_the_quick_build(tmp_path):
+    """A quick build may run a reference on the model's own mesh (an error of exactly 0): a ratio
+    over it is "n/a (quick build)" and a claim on it is marked, never met; in a full build the
+    division by zero fails the build."""
+    source = make_paper(tmp_path, "r = {{expr [results/demo.nc E_error level=eps10] / "
+                                  "([results/demo.nc E_error level=eps10] * 0)}}\n"
+                                  "{{claim [results/demo.nc E_error level=eps10] / ([results/demo.nc E_error "
+                                  "level=eps10] * 0) > 1 | Large.}}\n")
+    with pytest.raises(ValueError, match="division by zero"):
+        paper.fill(source, tmp_path / "paper" / "build" / "paper.md")
+    _mark_quick(tmp_path)
+    text = paper.fill(source, tmp_path / "paper" / "build" / "paper.md").read_text(encoding="utf-8")
+    assert f"r = {paper.QUICK_NA}" in text
+    assert "Large." + paper.QUICK_MARK in text
+
+
 def test_values_and_claims_read_derived_facts_from_json(tmp_path):
     """``[paper/derivations.json MODULE.checks.NAME]``: a number the derivation computed; a missing
     key, a non-number and a false claim on it fail with one line."""
