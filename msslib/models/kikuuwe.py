@@ -110,69 +110,6 @@ class TetrahedronEdges(EdgeQuadraticEnergy):
 
 @njit_cached
 def _edge_state(x, conn, Q, L2, m, d, D, s):
-    for e in range(3):
-        a, b = conn[m, EDGES[e, 0]], conn[m, EDGES[e, 1]]
-        d[e, 0] = x[2 * b] - x[2 * a]
-        d[e, 1] = x[2 * b + 1] - x[2 * a + 1]
-        D[e] = d[e, 0] * d[e, 0] + d[e, 1] * d[e, 1] - L2[m, e]
-    for e in range(3):
-        s[e] = Q[m, e, 0] * D[0] + Q[m, e, 1] * D[1] + Q[m, e, 2] * D[2]
-
-
-@njit_cached
-def _edges_energy(x, conn, Q, L2):
-    d, D, s = np.empty((3, 2)), np.empty(3), np.empty(3)
-    w = 0.0
-    for m in range(conn.shape[0]):
-        _edge_state(x, conn, Q, L2, m, d, D, s)
-        w += 0.25 * (D[0] * s[0] + D[1] * s[1] + D[2] * s[2])
-    return w
-
-
-@njit_cached
-def _edges_gradient(x, conn, Q, L2, g):
-    d, D, s = np.empty((3, 2)), np.empty(3), np.empty(3)
-    for m in range(conn.shape[0]):
-        _edge_state(x, conn, Q, L2, m, d, D, s)
-        for e in range(3):
-            a, b = conn[m, EDGES[e, 0]], conn[m, EDGES[e, 1]]
-            for k in range(2):
-                g[2 * b + k] += s[e] * d[e, k]
-                g[2 * a + k] -= s[e] * d[e, k]
-
-
-@njit_cached
-def _edges_hessian(x, conn, Q, L2, out):
-    d, D, s = np.empty((3, 2)), np.empty(3), np.empty(3)
-    J = np.zeros((3, 6))
-    for m in range(conn.shape[0]):
-        _edge_state(x, conn, Q, L2, m, d, D, s)
-        J[:] = 0.0
-        for e in range(3):
-            a, b = EDGES[e, 0], EDGES[e, 1]
-            for k in range(2):
-                J[e, 2 * b + k] = 2.0 * d[e, k]
-                J[e, 2 * a + k] = -2.0 * d[e, k]
-        base = 36 * m
-        for i in range(6):
-            for j in range(6):
-                h = 0.0
-                for e in range(3):
-                    for f in range(3):
-                        h += J[e, i] * Q[m, e, f] * J[f, j]
-                out[base + 6 * i + j] = 0.5 * h
-        for e in range(3):
-            a, b = EDGES[e, 0], EDGES[e, 1]
-            for k in range(2):
-                out[base + 6 * (2 * a + k) + 2 * a + k] += s[e]
-                out[base + 6 * (2 * b + k) + 2 * b + k] += s[e]
-                out[base + 6 * (2 * a + k) + 2 * b + k] -= s[e]
-                out[base + 6 * (2 * b + k) + 2 * a + k] -= s[e]
-
-
-
-@njit_cached
-def _edge_state(x, conn, Q, L2, m, d, D, s):
     for e in range(6):
         a, b = conn[m, EDGES[e, 0]], conn[m, EDGES[e, 1]]
         D[e] = -L2[m, e]
