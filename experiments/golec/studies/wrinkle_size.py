@@ -29,7 +29,7 @@ import numpy as np
 import xarray as xr
 
 from experiments import script
-from experiments.golec.studies.wrinkles import min_eigen, relax
+from experiments.golec.studies.wrinkles import min_eigen, wrinkled
 from msslib.experiment import load_experiment, scene_of
 from msslib.results import write_result
 from msslib.scene import load_scene, prepare
@@ -67,10 +67,7 @@ def main(argv=None):
         out["min_eigenvalue"][i] = lam
         xw = x
         if lam < 0:
-            a = np.ptp(mesh.points[mesh.cells[0]], axis=0).min()
-            xp = x.copy()
-            xp[model.free] += 0.01 * a * vec / np.abs(vec).max()
-            xw, _ = relax(model, xp)
+            xw, _ = wrinkled(model, mesh, x, vec)
             out["energy_drop"][i] = model.energy(x, 1.0) - model.energy(xw, 1.0)
         out["wrinkle_static"][i] = np.linalg.norm((xw - x).reshape(-1, 3), axis=1).max()
         print(f"[{time.perf_counter() - t0:6.1f} s] gravity x{f:g}: deflection {out['deflection'][i] * 1e3:.2f} mm, "
