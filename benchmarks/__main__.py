@@ -44,7 +44,7 @@ def main(argv=None):
                                                            "reference"]
     if not args.only:  # the GPU figures of the JAX backend, when JAX sees a GPU
         try:
-            from msslib.explicit.jax_backend import has_gpu
+            from msslib.stepping.jax_backend import has_gpu
 
             if has_gpu():
                 sections.append("gpu")

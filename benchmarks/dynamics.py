@@ -1,6 +1,6 @@
 """5: Golec's 1,000-element sample (10 x 10 x 10 cubes) for 10 s of simulated time.
 
-Scheme: explicit symplectic Euler (the scheme of ``solvers.integrate(method="symplectic_euler")``)
+Scheme: explicit symplectic Euler (the scheme of ``msslib.stepping.integrate(method="symplectic_euler")``)
 with mass-proportional damping, at 0.9 x the stability limit 2/omega_max, every step in numba.
 Explicit because with a diagonal mass matrix a step costs one force evaluation (20-70 us here),
 while any implicit step needs a sparse solve of ~3,600 dofs (>= 1 ms with SuperLU/banded
@@ -8,7 +8,7 @@ Cholesky, even with the factorisation reused) and would have to take > 30x longe
 
 Three kernels, same scheme and physics:
 
-* :class:`msslib.explicit.LatticeExplicit`, structured-lattice kernels (structure-of-arrays
+* :class:`msslib.stepping.LatticeExplicit`, structured-lattice kernels (structure-of-arrays
   state, springs grouped by the 13 lattice directions as shifted contiguous slices, hexahedron
   volume term over the cell slots, all loops SIMD-vectorised), with the forces in single
   precision (the state and the update in double) -- the figure with the target -- and in double
@@ -36,7 +36,7 @@ from msslib import system as MD
 from msslib import solvers as S
 from msslib import terms as T
 from msslib.terms import loops
-from msslib.explicit import LatticeExplicit
+from msslib.stepping import LatticeExplicit
 
 
 @njit(cache=True, nogil=True)
@@ -142,7 +142,7 @@ def run(res, quick: bool):
 
     common = (f"{t_end:g} s simulated, nu = 0.3, E = 20 kPa, 1 cm cubes, gravity, alpha = {alpha:g}/s, {n_steps} "
               f"steps of {h:.3g} s (0.9 x dt_crit), symplectic Euler, structured-lattice SIMD kernels "
-              f"(msslib.explicit.lattice), 1 thread")
+              f"(msslib.stepping.lattice), 1 thread")
     spread = {p: f"median of {len(w)} (min {min(w):.3g} s, max {max(w):.3g} s)" for p, w in walls.items()}
     res.add("golec_sample_explicit_wall", wall["single"], "s", paper / wall["single"],
             "Golec et al. 2.88 s per 10 s on 8 cores",

@@ -4,9 +4,9 @@
 Cases (symplectic Euler at 0.9 of the stability limit given by the cheap Gershgorin bound, mass-
 proportional damping, gravity, bottom face clamped, fp64):
 
-* generic: :class:`msslib.explicit.jax_backend.JaxNetwork` on the springs of a Golec lattice of
+* generic: :class:`msslib.stepping.jax_backend.JaxNetwork` on the springs of a Golec lattice of
   n^3 cubes (run as a general network: gather + segment_sum), >= 10 M springs when JAX sees a GPU;
-* lattice: :class:`msslib.explicit.jax_backend.JaxLattice` on the same kind of lattice with
+* lattice: :class:`msslib.stepping.jax_backend.JaxLattice` on the same kind of lattice with
   Golec's hexahedron volume term (nu = 0.3), the stencil of shifted slices;
 * scene: a Lloyd tetrahedral network of about 10 k springs (gmsh cylinder), steps per second of
   one fused call of 1,000 steps and of one step per call.
@@ -142,7 +142,7 @@ def report(rows, name, springs, steps, wall, cpu_rate, target, note=""):
 def generic_case(rows, n, min_wall):
     """The springs of a Golec lattice (nu = 1/4: the volume term vanishes) as a general network,
     given as arrays (no Model: its sparsity pattern is not needed)."""
-    from msslib.explicit.jax_backend import CpuNetwork, JaxNetwork
+    from msslib.stepping.jax_backend import CpuNetwork, JaxNetwork
 
     mesh, conn, k, L0, _ = golec_arrays(n, 0.25)
     masses, fixed = _support(mesh)
@@ -164,8 +164,8 @@ def generic_case(rows, n, min_wall):
 
 
 def lattice_case(rows, n, min_wall):
-    from msslib.explicit import LatticeExplicit
-    from msslib.explicit.jax_backend import JaxLattice
+    from msslib.stepping import LatticeExplicit
+    from msslib.stepping.jax_backend import JaxLattice
     from msslib import solvers as S
 
     model = golec_lattice(n, 0.3, True)
@@ -189,7 +189,7 @@ def lattice_case(rows, n, min_wall):
 def scene_case(rows, min_wall):
     import msslib
     from msslib import mesh as M
-    from msslib.explicit.jax_backend import CpuNetwork, JaxNetwork
+    from msslib.stepping.jax_backend import CpuNetwork, JaxNetwork
 
     mesh = M.cylinder_mesh(0.05, 0.2, 0.01)
     model = msslib.build_model("lloyd_tetrahedron", mesh, msslib.Material(E, 0.25, density=RHO),
@@ -231,7 +231,7 @@ def main(argv=None):
 
     numba.set_num_threads(1)
     _limits = threadpool_limits(1)  # noqa: F841 - the numba/BLAS baseline on one core
-    from msslib.explicit.jax_backend import available, has_gpu
+    from msslib.stepping.jax_backend import available, has_gpu
 
     t0 = time.perf_counter()
     ok, reason = available()

@@ -98,7 +98,7 @@ def _band_threads(res):
 
     raw = _scene("cylinder", 2, "lloyd_tetrahedron")
     model = prepare(load_scene(raw, base_dir=SCENES)).model
-    ctx = S.context._solver_context(model, model.x0, model.free)
+    ctx = S.context.linear_solve_context(model, model.x0, model.free)
     A = sp.csr_matrix(S.submatrices.submatrix(model.stiffness(model.x0, 0.0), model.free))
     A.sort_indices()
     plan = S.direct._band_plan(A, ctx)

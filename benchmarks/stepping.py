@@ -3,7 +3,7 @@
 Same networks (msslib's constants, masses, fixed nodes and gravity), same scheme (symplectic
 Euler, undamped, 0.9 of the stability limit), one core, N steps from rest:
 
-* msslib's network engine (:class:`msslib.simulator.Simulator`, fused spring kernel, N steps in
+* msslib's network engine (:class:`msslib.stepping.Simulator`, fused spring kernel, N steps in
   one call), on the mesh's node order and on the nodes renumbered by reverse Cuthill-McKee
   (:func:`msslib.mesh.reorder_nodes`); msslib's generic engine (NumPy step, any model);
 * a plain NVIDIA Warp kernel on its CPU device (one thread per spring with atomic adds, then one
@@ -29,7 +29,7 @@ import numpy as np
 import msslib
 from msslib import mesh as M
 from msslib import solvers as S
-from msslib.simulator import Simulator
+from msslib.stepping import Simulator
 
 STEPS = 100
 
@@ -266,7 +266,7 @@ def jax_reset(res, quick):
     model = lloyd_network(0.0085)
     s = len(_springs(model)[0])
     dt = 0.9 * S.explicit_stability_limit(model, model.x0)
-    from msslib.explicit.jax_backend import network as jax_network
+    from msslib.stepping.jax_backend import network as jax_network
 
     jax_network._compiled.cache_clear()  # a first build compiles: what every reset() cost before the cache
     t = time.perf_counter()

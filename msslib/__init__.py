@@ -36,7 +36,7 @@ The API (names are imported on first use: ``import msslib`` loads neither numba 
     ``.vtu``: the final state; ``.pvd``: every saved state as a ParaView time series
     (:mod:`msslib.results.paraview`).
 ``Simulator(model, *, dt, method="symplectic_euler", damping=None, load=1.0, engine="auto")``
-    Step a model in time (:mod:`msslib.simulator`): ``step(n)``, loads changed between steps
+    Step a model in time (:mod:`msslib.stepping`): ``step(n)``, loads changed between steps
     (``set_load``, ``apply_force``, ``prescribe`` a tool's path), ``x``, ``v``, ``reaction`` read
     without copies, ``reset()``, ``real_time_factor``.
 ``run_scene(scene_or_path, progress=True) -> xarray.Dataset``, ``load_scene(path_or_dict)``
@@ -68,7 +68,7 @@ _LAZY = {
     "load_scene": "msslib.scene",
     "run_scene": "msslib.scene",
     "read_result": "msslib.results",
-    "Simulator": "msslib.simulator",
+    "Simulator": "msslib.stepping",
 }
 
 __all__ = ["__version__", *_LAZY]

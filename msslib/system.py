@@ -105,7 +105,7 @@ class Model:
         load factor ``load`` the fixed dofs sit at ``x0 + load * prescribed``.  Default zero.
     masses : ``(n_nodes,)`` node masses (kg); default the lumped masses of unit density (and unit
         thickness in 2D), :func:`msslib.mesh.lumped_masses`.
-    damping : default damping of :func:`msslib.solvers.integrate` (scalar alpha or (alpha, beta)).
+    damping : default damping of :func:`msslib.stepping.integrate` (scalar alpha or (alpha, beta)).
 
     Force convention: ``force(x, load) = -sum_t s_t grad_t(x)`` with ``s_t = load`` for the terms
     that scale with the load (external loads, Baudet's correction) and 1 otherwise;

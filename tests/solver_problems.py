@@ -146,7 +146,7 @@ def lattice_system(n=8):
     from msslib.system import Model
     from msslib.models.golec import golec_cube_springs
     from msslib.solvers.amg import _rigid_body_modes
-    from msslib.solvers.context import _solver_context
+    from msslib.solvers.context import linear_solve_context
     from msslib.solvers.submatrices import _submatrix_bsr
 
     mesh = M.hex_grid(0.01 * n, 0.01 * n, 0.01 * n, n, n, n)
@@ -154,7 +154,7 @@ def lattice_system(n=8):
     fixed[mesh.points[:, 2] < 1e-12] = True
     model = Model(mesh, golec_cube_springs(mesh, [(1e4, 0.3)], 1.0), fixed=fixed)
     x = model.x0 + 2e-4 * np.random.default_rng(7).standard_normal(model.n_dof)
-    ctx = _solver_context(model, x, model.free)
+    ctx = linear_solve_context(model, x, model.free)
     A = _submatrix_bsr(model.stiffness(x), ctx["node_free"], 3)
     A.sort_indices()
     return A, _rigid_body_modes(ctx["coords"], 3), ctx

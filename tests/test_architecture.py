@@ -157,10 +157,17 @@ def test_no_module_is_named_like_a_sibling_package():
     assert not clashes, clashes
 
 
-def test_the_simulator_does_not_import_the_scene_layer():
-    """Node selection lives with the mesh (``msslib.mesh.selection``): the stepping code imports
-    nothing of ``msslib.scene`` (the scene builds on the simulator, not the other way)."""
+def test_the_stepping_package_does_not_import_the_layers_above_it():
+    """Time stepping has one home, ``msslib.stepping``; it builds on the solvers, terms and mesh
+    and imports nothing of the scene, planning, comparison, export or command-line layers (node
+    selection lives with the mesh, ``msslib.mesh.selection``); and the solvers below it import
+    nothing of it (no arrow running back up)."""
     mods = _modules()
-    bad = [(m, d) for m, p in mods.items() if m.startswith(("msslib.simulator", "msslib.explicit"))
-           for d in _imports(m, p, mods) if d.startswith("msslib.scene")]
+    above = ("msslib.scene", "msslib.planning", "msslib.compare", "msslib.export", "msslib.cli", "msslib.experiment",
+             "msslib.api")
+    bad = [(m, d) for m, p in mods.items() if m.startswith("msslib.stepping")
+           for d in _imports(m, p, mods) if d.startswith(above)]
+    bad += [(m, d) for m, p in mods.items() if m.startswith(("msslib.solvers", "msslib.terms", "msslib.mesh"))
+            for d in _imports(m, p, mods) if d.startswith("msslib.stepping")]
     assert not bad, bad
+    assert not any(m.startswith(("msslib.simulator", "msslib.explicit")) for m in mods)  # the old homes are gone

@@ -19,7 +19,8 @@ from msslib.terms.baudet import (
 from msslib.metrics import mean_displacement_gradient
 from msslib.models.baudet import element_correction
 from msslib.scene import load_scene, prepare
-from msslib.solvers import integrate, static_solve
+from msslib.solvers import static_solve
+from msslib.stepping import integrate
 
 E0, A0 = 1.0e3, 0.1
 

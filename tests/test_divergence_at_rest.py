@@ -8,7 +8,7 @@ import pytest
 import msslib
 from msslib import mesh as M
 from msslib.errors import DivergenceError
-from msslib.simulator import Simulator
+from msslib.stepping import Simulator
 from msslib.solvers import explicit_stability_limit
 
 

@@ -1,4 +1,4 @@
-"""msslib.explicit.lattice: lattice kernels give the model's forces and integrate's trajectories."""
+"""msslib.stepping.lattice: lattice kernels give the model's forces and integrate's trajectories."""
 
 from __future__ import annotations
 
@@ -11,8 +11,9 @@ from msslib.models.lloyd import lloyd_tet_springs
 from msslib import mesh as M
 from msslib import system as MD
 from msslib import solvers as S
+from msslib.stepping import integrate
 from msslib import terms as T
-from msslib.explicit.lattice import LatticeExplicit, lattice_index
+from msslib.stepping.lattice import LatticeExplicit, lattice_index
 from msslib.generated import kernels as K
 
 
@@ -107,7 +108,7 @@ def test_forces_equal_model_irregular_lattice():
 def _compare_trajectory(model, x0, v0, h, n_steps, alpha, save_every):
     fast = LatticeExplicit(model)
     xf, vf, saved = fast.run(x0, v0, h, n_steps, alpha, save_every)
-    ref = S.integrate(model, x0, v0, dt=h, t_end=n_steps * h, method="symplectic_euler", damping=alpha,
+    ref = integrate(model, x0, v0, dt=h, t_end=n_steps * h, method="symplectic_euler", damping=alpha,
                       save_every=save_every)
     assert ref.stats["n_steps"] == n_steps
     assert saved.shape == (n_steps // save_every, model.n_dof)

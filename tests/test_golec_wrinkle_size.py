@@ -9,7 +9,7 @@ import pytest
 
 from experiments.golec.studies.wrinkle_size import DAMPING, DT, setup_of
 from experiments.golec.studies.wrinkles import min_eigen, relax
-from msslib.simulator import Simulator
+from msslib.stepping import Simulator
 from msslib.solvers import static_solve
 
 

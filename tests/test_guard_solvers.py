@@ -16,9 +16,10 @@ from msslib import cli, fem
 from msslib import mesh as M
 from msslib import system as MD
 from msslib import solvers as S
+from msslib.stepping import integrate
 from msslib import terms as T
 from msslib.errors import StabilityError
-from msslib.explicit import LatticeExplicit
+from msslib.stepping import LatticeExplicit
 from msslib.scene import load_scene, prepare, run_scene
 
 E0, RHO, G = 1.0e6, 1000.0, 9.81
@@ -57,7 +58,7 @@ def test_step_over_limit_is_refused_with_both_numbers(method, factor):
     limit = S.explicit_stability_limit(model, model.x0)
     dt = factor * limit
     with pytest.raises(StabilityError) as info:
-        S.integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=100 * dt, method=method, damping=0.0)
+        integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=100 * dt, method=method, damping=0.0)
     msg = str(info.value)
     assert _number_after("dt =", msg) == pytest.approx(dt, rel=1e-6)
     assert _number_after("the explicit stability limit", msg) == pytest.approx(limit, rel=1e-6)
@@ -70,14 +71,14 @@ def test_step_over_limit_is_refused_with_both_numbers(method, factor):
 def test_step_below_limit_runs_and_records_the_limit(method):
     model = cantilever()
     limit = S.explicit_stability_limit(model, model.x0)
-    res = S.integrate(model, model.x0, np.zeros(model.n_dof), dt=0.9 * limit, t_end=400 * limit, method=method,
+    res = integrate(model, model.x0, np.zeros(model.n_dof), dt=0.9 * limit, t_end=400 * limit, method=method,
                       damping=0.0, save_every=50)
     assert res.stats["stability_limit"] == pytest.approx(limit, rel=1e-12)
     assert res.stats["dt_over_limit"] == pytest.approx(0.9, rel=1e-12)
     assert res.stats["omega_max"] == pytest.approx(2.0 / limit, rel=1e-12)
     assert np.isfinite(res.x).all()
     # implicit Euler has no limit
-    imp = S.integrate(model, model.x0, np.zeros(model.n_dof), dt=3 * limit, t_end=30 * limit, method="implicit_euler")
+    imp = integrate(model, model.x0, np.zeros(model.n_dof), dt=3 * limit, t_end=30 * limit, method="implicit_euler")
     assert imp.stats["stability_limit"] is None
 
 
@@ -141,11 +142,11 @@ def test_damped_limit_is_the_step_where_the_scheme_turns_unstable(method, dampin
     if method == "symplectic_euler":
         c = alpha + beta * omega**2
         assert limit == pytest.approx((np.sqrt(c * c + 4 * omega**2) - c) / omega**2, rel=1e-12)
-    stable = S.integrate(prob, x0, v0, dt=0.999 * limit, t_end=3000 * limit, method=method)
+    stable = integrate(prob, x0, v0, dt=0.999 * limit, t_end=3000 * limit, method=method)
     u = np.abs(stable.x[:, 0] - 1.0)  # bounded (no growth from the first half to the second)
     assert u[1500:].max() <= 1.01 * u[:1500].max() and np.isfinite(u).all()
     with pytest.raises(S.DivergenceError):
-        S.integrate(prob, x0, v0, dt=1.01 * limit, t_end=3000 * limit, method=method, allow_unstable=True)
+        integrate(prob, x0, v0, dt=1.01 * limit, t_end=3000 * limit, method=method, allow_unstable=True)
 
 
 # --------------------------------------------------------------------------------------------
@@ -161,7 +162,7 @@ def test_allow_unstable_runs_and_is_stopped_early(method, factor, max_steps):
     u_static = static_deflection(model)
     dt = factor * limit
     with pytest.raises(S.DivergenceError) as info:
-        S.integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=1000 * dt, method=method, damping=0.0,
+        integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=1000 * dt, method=method, damping=0.0,
                     allow_unstable=True)
     err = info.value
     assert err.quantity == "growth" and err.step <= max_steps
@@ -184,7 +185,7 @@ def test_physical_runs_do_not_trip_the_detector(method, damping):
     u_static = static_deflection(model)
     limit = S.check_time_step(model, model.x0, 1e-9, method=method, damping=damping)["stability_limit"]
     dt = 0.95 * limit
-    res = S.integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=2000 * dt, method=method,
+    res = integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=2000 * dt, method=method,
                       damping=damping, save_every=100)
     umax = np.abs(res.x - model.x0).max()
     assert u_static < umax <= 2.5 * u_static  # a suddenly applied load overshoots to ~2x the static
@@ -205,12 +206,12 @@ def test_baudet_correction_run_does_not_trip_the_detector(method):
     model = MD.Model(mesh, terms, fixed=fixed, masses=masses)
     assert not model.conservative
     limit = S.explicit_stability_limit(model, model.x0)
-    res = S.integrate(model, model.x0, np.zeros(model.n_dof), dt=0.95 * limit, t_end=1500 * limit, method=method,
+    res = integrate(model, model.x0, np.zeros(model.n_dof), dt=0.95 * limit, t_end=1500 * limit, method=method,
                       damping=0.0, save_every=100)
     u_static = np.abs(S.static_solve(model, model.x0).x - model.x0).max()
     assert np.abs(res.x - model.x0).max() <= 2.5 * u_static
     with pytest.raises(S.DivergenceError, match="explicit instability"):
-        S.integrate(model, model.x0, np.zeros(model.n_dof), dt=1.2 * limit, t_end=300 * limit, method=method,
+        integrate(model, model.x0, np.zeros(model.n_dof), dt=1.2 * limit, t_end=300 * limit, method=method,
                     damping=0.0, allow_unstable=True)
 
 
@@ -294,7 +295,7 @@ def _number_after_floor(msg):
 
 def test_implicit_euler_uses_the_floor():
     model, _, _ = slender_beam(50, 1)
-    res = S.integrate(model, model.x0, np.zeros(model.n_dof), dt=1e-3, t_end=5e-3, method="implicit_euler")
+    res = integrate(model, model.x0, np.zeros(model.n_dof), dt=1e-3, t_end=5e-3, method="implicit_euler")
     assert res.stats["n_newton_iterations"] <= 3 * 5
     assert np.isfinite(res.x).all()
 

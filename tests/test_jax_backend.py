@@ -1,4 +1,4 @@
-"""The JAX backend of the explicit steps (msslib.explicit.jax_backend) on JAX's CPU backend,
+"""The JAX backend of the explicit steps (msslib.stepping.jax_backend) on JAX's CPU backend,
 against the numba kernels: a Lloyd tetrahedral network (gmsh cylinder) and a Golec lattice
 (with and without the hexahedron volume term), positions after 200 steps to 1e-12 of the body's
 size in fp64; the force against Model.force and the load balance; the fp32 error bounded; the
@@ -13,15 +13,15 @@ import msslib
 from msslib import mesh as M
 from msslib import solvers as S
 from msslib.errors import DivergenceError, MsslibWarning, StabilityError
-from msslib.explicit import LatticeExplicit
-from msslib.explicit.network import N_MONITOR, network_forces, network_layout, network_steps, records
+from msslib.stepping import LatticeExplicit
+from msslib.stepping.network_kernels import N_MONITOR, network_forces, network_layout, network_steps, records
 from msslib.system import Model
 from msslib.models.golec import golec_cube_springs
 from msslib.terms import Gravity
 
 jax = pytest.importorskip("jax")
 
-from msslib.explicit import jax_backend as JB  # noqa: E402
+from msslib.stepping import jax_backend as JB  # noqa: E402
 
 N_STEPS = 200
 ALPHA = 3.0  # mass-proportional damping (1/s)
@@ -59,7 +59,7 @@ def golec():
 
 
 def _numba_network(model, h, v0, n):
-    """The numba kernels of msslib.explicit.network called directly: positions after n steps."""
+    """The numba kernels of msslib.stepping.network_kernels called directly: positions after n steps."""
     arrays = JB.network_arrays(model)
     rowptr_ib_kl = network_layout(arrays["conn"], arrays["k"], arrays["rest_length"], model.n_nodes)
     free = model.free

@@ -11,11 +11,11 @@ import pytest
 import msslib
 from msslib import mesh as M
 from msslib import solvers as S
-from msslib.simulator import Simulator
+from msslib.stepping import Simulator
 
 pytest.importorskip("jax")
 
-from msslib.explicit.jax_backend import network as JN  # noqa: E402
+from msslib.stepping.jax_backend import network as JN  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -61,7 +61,7 @@ def test_reset_rebuilds_and_a_second_simulator_do_not_compile_again(column, trac
 def test_new_shapes_or_options_do_compile(column, traces):
     """The counter does count: a new precision traces again (the cache is keyed on it)."""
     model, dt = column
-    from msslib.explicit.jax_backend import JaxNetwork
+    from msslib.stepping.jax_backend import JaxNetwork
 
     JN._compiled.cache_clear()
     net = JaxNetwork.from_model(model, dt, 3.0)

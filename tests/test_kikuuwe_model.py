@@ -112,14 +112,15 @@ def test_simulator_steps_equal_integrate_and_settle_on_the_static_solution():
     the static solution."""
     import msslib
     from msslib import solvers as S
-    from msslib.simulator import Simulator
+    from msslib.stepping import integrate
+    from msslib.stepping import Simulator
 
     mesh = M.cylinder_mesh(0.02, 0.08, 0.01)
     setup = msslib.build_model("kikuuwe_tetrahedron", mesh, msslib.Material(1e4, 0.3, density=1000.0),
                                fixed={"plane": ["z", 0.0]}, loads={"type": "gravity", "g": [0, 0, -9.81]})
     model = setup.model
     dt = 0.8 * S.explicit_stability_limit(model, model.x0)
-    ref = S.integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=100 * dt, damping=3.0, save_every=100)
+    ref = integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=100 * dt, damping=3.0, save_every=100)
     sim = Simulator(model, dt=dt, damping=3.0)
     sim.step(100)
     moved = np.abs(ref.x_final - model.x0).max()

@@ -10,8 +10,9 @@ from cell_helpers import example_mesh
 import msslib
 from msslib import mesh as M
 from msslib import solvers as S
+from msslib.stepping import integrate
 from msslib.errors import DivergenceError, StabilityError
-from msslib.simulator import Curve, Simulator
+from msslib.stepping import Curve, Simulator
 
 
 @pytest.fixture(scope="module")
@@ -32,7 +33,7 @@ def _rel(a, b, model):
 def test_engines_equal_integrate(column, engine):
     model, limit = column
     dt = 0.8 * limit
-    ref = S.integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=250 * dt, damping=3.0, save_every=250)
+    ref = integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=250 * dt, damping=3.0, save_every=250)
     sim = Simulator(model, dt=dt, damping=3.0, engine=engine)
     assert sim.engine == engine
     sim.step(100)
@@ -47,7 +48,7 @@ def test_engines_equal_integrate(column, engine):
 def test_other_schemes_run_on_the_generic_engine(column, method):
     model, limit = column
     dt = (0.8 if method == "velocity_verlet" else 4.0) * limit
-    ref = S.integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=40 * dt, method=method, damping=3.0,
+    ref = integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=40 * dt, method=method, damping=3.0,
                       save_every=40)
     sim = Simulator(model, dt=dt, method=method, damping=3.0)
     assert sim.engine == "generic"
@@ -205,7 +206,7 @@ def test_every_model_steps_as_integrate_does(name, cell, make):
         model = msslib.build_model(name, mesh, msslib.Material(1e4, 0.3, density=1000.0),
                                    fixed={"plane": [axis, 0.0]}, loads={"type": "gravity", "g": g}, **kw).model
         dt = 0.8 * S.explicit_stability_limit(model, model.x0)
-        ref = S.integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=60 * dt, damping=3.0, save_every=60)
+        ref = integrate(model, model.x0, np.zeros(model.n_dof), dt=dt, t_end=60 * dt, damping=3.0, save_every=60)
         sim = Simulator(model, dt=dt, damping=3.0)
         sim.step(60)
     # the fused kernel runs 3D spring networks: Baudet's correction and Kikuuwe's edge energy are not springs
@@ -229,7 +230,7 @@ def test_jax_engine_equals_the_network_engine_and_refuses_what_it_cannot_run(col
     assert np.abs(a.reaction - b.reaction).max() < 1e-12 * np.abs(b.reaction).max()
     with pytest.raises(ValueError, match="engine='jax' runs constant loads"):
         Simulator(model, dt=dt, engine="jax", load=[[0.0, 0.0], [0.1, 1.0]])
-    from msslib.explicit.jax_backend import device
+    from msslib.stepping.jax_backend import device
 
     monkeypatch.setattr(device, "available", lambda: (False, "jax cannot be imported (test)"))
     with pytest.warns(msslib.errors.MsslibWarning, match="jax cannot be imported"):

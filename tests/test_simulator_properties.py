@@ -15,7 +15,7 @@ from hypothesis import strategies as st  # noqa: E402
 import msslib  # noqa: E402
 from msslib import mesh as M  # noqa: E402
 from msslib import solvers as S  # noqa: E402
-from msslib.simulator import Simulator  # noqa: E402
+from msslib.stepping import Simulator  # noqa: E402
 
 SETTINGS = settings(max_examples=15, deadline=None, derandomize=True,
                     suppress_health_check=[HealthCheck.too_slow])

@@ -6,7 +6,7 @@ import pytest
 
 import msslib
 from msslib import mesh as M
-from msslib.simulator import Simulator
+from msslib.stepping import Simulator
 
 
 @pytest.fixture(scope="module")

@@ -43,7 +43,7 @@ def layer(monkeypatch):
             state["inside"] -= 1
 
     for target in ("msslib.solvers.linear.solve_linear_system", "msslib.solvers.statics.solve_linear_system",
-                   "msslib.solvers.dynamics.solve_linear_system"):
+                   "msslib.stepping.generic.solve_linear_system"):
         monkeypatch.setattr(target, entry)
     for name in DIRECT:
         original = getattr(spla, name)

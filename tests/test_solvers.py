@@ -17,9 +17,9 @@ from msslib.solvers import (
     ConvergenceError,
     DivergenceError,
     explicit_stability_limit,
-    integrate,
     static_solve,
 )
+from msslib.stepping import integrate
 
 # ---------------------------------------------------------------------------------------------
 # statics

@@ -102,7 +102,7 @@ def test_submatrix_refill_in_place_equals_fresh_extraction():
 @pytest.mark.parametrize("shift", [0.0, -0.5])  # SPD (banded Cholesky) and indefinite (banded LU)
 def test_banded_direct_solve_matches_dense(shift):
     from msslib.solvers.direct import _direct_solve
-    from msslib.solvers.context import _solver_context
+    from msslib.solvers.context import linear_solve_context
 
     prob = lattice_block(3, 3, 6)
     x = prob.x0()
@@ -113,7 +113,7 @@ def test_banded_direct_solve_matches_dense(shift):
     A = sp.csr_matrix(A)
     A.sum_duplicates()
     b = np.random.default_rng(0).standard_normal(A.shape[0])
-    ctx = _solver_context(prob, x, free)
+    ctx = linear_solve_context(prob, x, free)
     sol = _direct_solve(A, b, True, ctx)
     ref = np.linalg.solve(A.toarray(), b)
     np.testing.assert_allclose(sol, ref, rtol=1e-8, atol=1e-10 * np.abs(ref).max())
@@ -174,12 +174,12 @@ def test_static_solve_cg_and_direct_agree_on_a_nonlinear_lattice():
 
 def test_free_node_blocks_as_bsr_equal_the_csr_block_and_refill_in_place():
     from msslib.solvers.submatrices import _is_node_blocked, _submatrix_bsr
-    from msslib.solvers.context import _solver_context
+    from msslib.solvers.context import linear_solve_context
 
     model = clamped_golec_block(3, 2, 2)
     free = model.free
     idx = np.flatnonzero(free)
-    ctx = _solver_context(model, model.x0, free)
+    ctx = linear_solve_context(model, model.x0, free)
     rng = np.random.default_rng(6)
     K = model.stiffness(model.x0)
     B = _submatrix_bsr(K, ctx["node_free"], 3, plans=ctx)
@@ -230,12 +230,12 @@ def test_band_width_bound_never_exceeds_the_bandwidth_found(shape, monkeypatch):
     from msslib.solvers.direct import _band_plan
     from msslib.solvers.policy import _band_surely_wide
     from msslib.solvers.submatrices import _bsr_entry, _eccentricity, submatrix
-    from msslib.solvers.context import _solver_context
+    from msslib.solvers.context import linear_solve_context
 
     nx, ny, nz = shape
     model = clamped_golec_block(nx, ny, nz)
     K = model.stiffness(model.x0)
-    ctx = _solver_context(model, model.x0, model.free)
+    ctx = linear_solve_context(model, model.x0, model.free)
     entry = _bsr_entry(K, ctx["node_free"], 3)
     e = _eccentricity(entry["bptr"], entry["bind"])
     # 26-neighbour lattice: Chebyshev distance from the first free node (a corner of layer x = 1)

@@ -11,6 +11,7 @@ import scipy.sparse as sp
 import msslib
 from msslib import mesh as M
 from msslib import solvers as S
+from msslib.stepping import integrate
 from msslib.errors import DivergenceError, StabilityError
 from msslib.solvers import stability as ST
 
@@ -133,7 +134,7 @@ def test_steps_at_099_of_the_certified_limit_stay_bounded_and_over_the_exact_lim
     v0 = 1e-3 * rng.standard_normal(model.n_dof) * model.free  # every mode excited
 
     def amplitude(dt, n):
-        out = S.integrate(model, x0, v0, dt=dt, t_end=n * dt, damping=0.0, allow_unstable=True, save_every=n)
+        out = integrate(model, x0, v0, dt=dt, t_end=n * dt, damping=0.0, allow_unstable=True, save_every=n)
         return float(np.abs(out.x_final - x0).max())
 
     n = 3000

@@ -28,7 +28,7 @@ MATERIALS = {"liver": {"E": 5.0e3, "nu": 0.25, "density": 1060.0},
 def build(mesh_path, damping: float = 20.0):
     """The model and a simulator at 0.9 of the stability limit."""
     import msslib
-    from msslib.simulator import Simulator
+    from msslib.stepping import Simulator
     from msslib.solvers import explicit_stability_limit
 
     setup = msslib.build_model("lloyd_tetrahedron", str(mesh_path), {k: msslib.Material(**v) for k, v in MATERIALS.items()},

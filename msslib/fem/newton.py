@@ -40,7 +40,7 @@ def linear_solve(K, rhs, free, points, dim: int, linear_solver="auto", symmetric
     from msslib.solvers.policy import banded_cholesky_is_cheap, choose_linear_solver
     from msslib.solvers.protocol import NewtonFailure
 
-    ctx = _context._solver_context(SimpleNamespace(dim=dim), np.asarray(points, dtype=float).ravel(), free)
+    ctx = _context.linear_solve_context(SimpleNamespace(dim=dim), np.asarray(points, dtype=float).ravel(), free)
     A = submatrix(K.tocsr(), free, plans=ctx)
     how = choose_linear_solver(linear_solver, A.shape[0], symmetric, lambda: banded_cholesky_is_cheap(A, ctx))
     messages: list = []

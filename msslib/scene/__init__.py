@@ -169,7 +169,7 @@ is checked for unknown keys: a typo is an error naming its full path, e.g.
     stiffness at rest instead: the MSS model's Hessian, or linear FEM), or ``{type: dynamic, method:
     symplectic_euler | velocity_verlet | implicit_euler, dt: 1.0e-4, t_end: 0.1, damping: 0.0,
     save_every: 1, allow_unstable: false, load_curve: [[0, 0], [0.05, 1]]}`` (MSS only, stepped from
-    rest by :class:`msslib.simulator.Simulator`; ``damping`` is a mass-proportional ``alpha``
+    rest by :class:`msslib.stepping.Simulator`; ``damping`` is a mass-proportional ``alpha``
     (1/s) or a Rayleigh pair ``[alpha, beta]``; ``load_curve``, optional, the load factor of every
     load and prescribed displacement against time, piecewise linear through the rows
     ``[t (s), factor]`` and held after the last: a ramp, a pulse, a cycle).  An

@@ -121,7 +121,7 @@ def _solve_mss_linear(setup: Setup):
 
 
 def _solve_mss_dynamic(setup: Setup, report):
-    from msslib.simulator import Simulator
+    from msslib.stepping import Simulator
 
     model, s = setup.model, setup.scene.solver
     curve = s.get("load_curve")

@@ -380,7 +380,7 @@ def _load_curve(path, value):
     """``[[t, factor], ...]``: the load factor of a dynamic run against time (None: 1)."""
     if value is None:
         return None
-    from msslib.simulator.loads import Curve
+    from msslib.stepping.loads import Curve
 
     try:
         Curve(value, path)

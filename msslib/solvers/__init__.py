@@ -35,7 +35,7 @@ Problem protocol
     Lumped masses (one value per dof; repeat a node's mass for each of its coordinates). Only the
     dynamics needs it.
 ``damping`` : float or (alpha, beta), optional
-    Default damping for :func:`integrate`: a scalar is a mass-proportional coefficient ``alpha``;
+    Default damping for :func:`msslib.stepping.integrate`: a scalar is a mass-proportional coefficient ``alpha``;
     a pair is Rayleigh damping ``C = alpha * M + beta * K``.
 ``dim`` : int, optional
     Spatial dimension: the bounding box of the divergence check, and the node blocks (with the
@@ -94,7 +94,7 @@ The same absolute threshold is used at every load level.
 
 Dynamics
 --------
-:func:`integrate` advances ``M dv/dt = force(x, load) - C v`` with symplectic Euler, velocity
+:func:`msslib.stepping.integrate` advances ``M dv/dt = force(x, load) - C v`` with symplectic Euler, velocity
 Verlet or implicit Euler. Constrained dofs keep their initial position and have zero velocity.
 An explicit run first checks its step against the stability limit of the model at rest
 (:func:`check_time_step`: ``2 / omega_max``, lowered by the damping where it does,
@@ -120,8 +120,9 @@ Modules (each imports only those above it)
 :mod:`~msslib.solvers.linear` (the linear solves), :mod:`~msslib.solvers.context` (solver
 contexts), :mod:`~msslib.solvers.roundoff` (the convergence test), :mod:`~msslib.solvers.statics`
 (:func:`static_solve`), :mod:`~msslib.solvers.displacement` (the FEM references through
-:func:`static_solve`), :mod:`~msslib.solvers.stability` (explicit stability limit),
-:mod:`~msslib.solvers.dynamics` (:func:`integrate`).  :class:`ConvergenceError` and
+:func:`static_solve`), :mod:`~msslib.solvers.stability` (explicit stability limit).  Time
+stepping (:func:`msslib.stepping.integrate`, the :class:`~msslib.stepping.Simulator`) builds on
+these in :mod:`msslib.stepping`.  :class:`ConvergenceError` and
 :class:`DivergenceError` are defined in :mod:`msslib.errors`.
 """
 
@@ -136,7 +137,6 @@ from . import (  # noqa: F401 - the modules, for monkeypatching where a name is 
     context,
     direct,
     displacement,
-    dynamics,
     linear,
     policy,
     protocol,
@@ -148,7 +148,6 @@ from . import (  # noqa: F401 - the modules, for monkeypatching where a name is 
 from .amg_cycle import VCYCLE_SINGLE  # noqa: F401
 from .context import SolverContext  # noqa: F401
 from .direct import BAND_COST_MAX, BAND_PLAN_MAX_DOFS  # noqa: F401
-from .dynamics import integrate
 from .submatrices import PlanCache  # noqa: F401
 from .policy import BAND_AUTO_COST, ITERATIVE_THRESHOLD, choose_linear_solver  # noqa: F401
 from .protocol import DynamicResult, StaticResult
@@ -173,7 +172,6 @@ __all__ = [
     "critical_time_step",
     "explicit_stability_limit",
     "omega_max_bound",
-    "integrate",
     "roundoff_floor",
     "static_solve",
 ]

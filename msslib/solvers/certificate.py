@@ -12,7 +12,7 @@ import scipy.sparse as sp
 from numba import njit
 
 
-def _mass_vector(problem):
+def mass_vector(problem):
     m = np.asarray(problem.mass, dtype=float).reshape(-1)
     if m.shape != (int(problem.n_dof),):
         raise ValueError(f"problem.mass must have shape ({problem.n_dof},), got {m.shape}")
@@ -179,7 +179,7 @@ def collatz_wielandt_bound(problem, x, free, lam_target: float) -> tuple[float |
     springs = _spring_terms(problem)
     if springs is None:
         return None, 0
-    m = _mass_vector(problem)
+    m = mass_vector(problem)
     isq = np.zeros(m.size)
     isq[free] = 1.0 / np.sqrt(m[free])
     x = np.ascontiguousarray(x, dtype=float).reshape(-1)
@@ -231,7 +231,7 @@ def _scaled_operator(problem, x, load, free):
     its stiffness and takes minus Gershgorin's lower bound of its spectrum."""
     from msslib.terms.internal import Springs
 
-    m = _mass_vector(problem)
+    m = mass_vector(problem)
     if np.any(m[free] <= 0):
         raise ValueError("masses of free dofs must be positive")
     isq = np.zeros(m.size)

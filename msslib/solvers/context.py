@@ -52,7 +52,7 @@ def _keep_context(problem, ctx) -> bool:
     return True
 
 
-def _solver_context(problem, x, free, plans: PlanCache | None = None):
+def linear_solve_context(problem, x, free, plans: PlanCache | None = None):
     """Context of :func:`msslib.solvers.linear.solve_linear_system`: spatial dimension and coordinates
     of the free nodes when the free dofs are whole nodes (all or none of a node's dofs free); the
     coordinates are ``x``, or the problem's ``coordinates`` attribute when it has one.
@@ -80,12 +80,12 @@ def _solver_context(problem, x, free, plans: PlanCache | None = None):
 
 
 def _static_context(problem, x, free, linear_solver):
-    """The solver context of a static solve (see :func:`_solver_context`): the one left by the
+    """The solver context of a static solve (see :func:`linear_solve_context`): the one left by the
     previous solve of ``problem`` when it is compatible and not in use (another thread), else a
     new one (sharing the old one's plans), kept for the next solve.  Release it with
     :func:`_release_context`."""
     old = _kept_context(problem)
-    ctx = _solver_context(problem, x, free, old.plans if old is not None else None)
+    ctx = linear_solve_context(problem, x, free, old.plans if old is not None else None)
     if not isinstance(linear_solver, str):  # a user solver: nothing to keep
         return ctx
     ctx["linear_solver"] = linear_solver

@@ -72,7 +72,7 @@ class NewtonFailure(Exception):
     """Internal: a Newton iteration could not proceed (reason in the message)."""
 
 
-def _free_mask(problem) -> np.ndarray:
+def free_mask(problem) -> np.ndarray:
     n = int(problem.n_dof)
     free = getattr(problem, "free", None)
     if free is None:
@@ -90,7 +90,7 @@ def _with_prescribed(problem, x, load):
     return np.array(fn(np.array(x, dtype=float), load), dtype=float)
 
 
-def _energy_or_none(problem, x, load):
+def energy_or_none(problem, x, load):
     fn = getattr(problem, "energy", None)
     if fn is None:
         return None
@@ -98,8 +98,8 @@ def _energy_or_none(problem, x, load):
     return None if e is None else float(e)
 
 
-def _is_conservative(problem, x, load) -> bool:
-    return _energy_or_none(problem, x, load) is not None
+def is_conservative(problem, x, load) -> bool:
+    return energy_or_none(problem, x, load) is not None
 
 
 def _accepts_out(problem) -> bool:
@@ -112,16 +112,16 @@ def _accepts_out(problem) -> bool:
         return False
 
 
-def _load_vector(problem, x0):
+def load_vector(problem, x0):
     """The load-proportional force at ``x0``: ``force(x0, 1) - force(x0, 0)`` (all dofs)."""
     with np.errstate(all="ignore"):
         return np.asarray(problem.force(x0, 1.0), dtype=float) - np.asarray(problem.force(x0, 0.0), dtype=float)
 
 
-def _force_scale(problem, x0, free, f_ext=None):
+def reference_force_scale(problem, x0, free, f_ext=None):
     """``F_ref`` of the convergence criterion (module docstring); ``f_ext`` the load vector if known."""
     if f_ext is None:
-        f_ext = _load_vector(problem, x0)
+        f_ext = load_vector(problem, x0)
     s = float(np.linalg.norm(f_ext[free]))
     if np.isfinite(s) and s > TINY:
         return s

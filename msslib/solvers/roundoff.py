@@ -87,7 +87,7 @@ def _abs_times(K, z):
     return out
 
 
-def _force_magnitude(K_free, x_free, load_abs_free) -> float:
+def force_magnitude_norm(K_free, x_free, load_abs_free) -> float:
     """``|| |K| |x| + |f_ext| ||`` on the free dofs: the size of what a force computed from the
     absolute positions ``x`` sums (rounding ``x`` by eps changes the force by about eps times it)."""
     with np.errstate(all="ignore"):
@@ -99,4 +99,4 @@ def _roundoff_floor_at(problem, x, free, load_abs_free, load=1.0) -> float:
     """The round-off floor at state ``x`` (assembles the tangent once)."""
     with np.errstate(all="ignore"):
         K = submatrix(problem.stiffness(x, load), free)
-    return roundoff_floor(_force_magnitude(K, x[free], load_abs_free))
+    return roundoff_floor(force_magnitude_norm(K, x[free], load_abs_free))

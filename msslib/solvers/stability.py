@@ -13,7 +13,7 @@ from .certificate import (  # noqa: F401  (the check's stages; tests reach them 
     _CW_MAX_PRODUCTS,
     CERTIFICATE_FAILURE,
     _abs_matvec,
-    _mass_vector,
+    mass_vector,
     _scaled_operator,
     _spring_abs_prep,
     _spring_matvec,
@@ -22,7 +22,7 @@ from .certificate import (  # noqa: F401  (the check's stages; tests reach them 
     certified_omega_max,
     collatz_wielandt_bound,
 )
-from .protocol import _free_mask
+from .protocol import free_mask
 from .submatrices import submatrix
 
 EXPLICIT_METHODS = ("symplectic_euler", "velocity_verlet")
@@ -31,8 +31,8 @@ _EIG_TOL = 1e-4  # ARPACK's tolerance for omega_max^2: the Ritz residual is adde
 
 def _scaled_stiffness(problem, x, load):
     """``M^-1/2 K M^-1/2`` on the free dofs at ``x`` (CSR)."""
-    free = _free_mask(problem)
-    m = _mass_vector(problem)[free]
+    free = free_mask(problem)
+    m = mass_vector(problem)[free]
     if np.any(m <= 0):
         raise ValueError("masses of free dofs must be positive")
     K = submatrix(problem.stiffness(np.asarray(x, dtype=float), load), free)
@@ -217,8 +217,8 @@ def omega_max_bound(problem, x, load: float = 1.0) -> tuple[float, np.ndarray]:
     stiffness.  It never lies below the top eigenvalue; on Lloyd's tetrahedral springs it lies
     1.8-2.5 times above it (a step up to 0.63-0.75 of the limit is accepted on the bound alone:
     0.66 at 122 k springs, 0.63 at 945 k), on Golec's lattices about 1.9 times (0.72)."""
-    free = _free_mask(problem)
-    m = _mass_vector(problem)
+    free = free_mask(problem)
+    m = mass_vector(problem)
     if np.any(m[free] <= 0):
         raise ValueError("masses of free dofs must be positive")
     isq = np.zeros(m.size)
@@ -275,7 +275,7 @@ def _certified(problem, x, load, rows, dt, method, alpha, beta, bound):
     target = _omega_allowed(dt, method, alpha, beta, bound)
     if target is None or not bool(getattr(problem, "symmetric", True)):
         return None
-    free = _free_mask(problem)
+    free = free_mask(problem)
     if free.sum() <= 400:  # the dense path is exact and cheap
         return None
     lam, products = collatz_wielandt_bound(problem, x, free, target * target)
@@ -331,7 +331,7 @@ def check_time_step(problem, x, dt: float, *, method: str = "symplectic_euler", 
     passed: a value computed earlier for the same state)."""
     if estimate not in ("auto", "lanczos"):
         raise ValueError(f"estimate must be 'auto' or 'lanczos', got {estimate!r}")
-    alpha, beta = _resolve_damping(problem, damping)
+    alpha, beta = resolve_damping(problem, damping)
     bound = None
     if omega_max is not None:
         omega, origin = float(omega_max), "given"
@@ -373,13 +373,13 @@ def _limit_origin(limit, undamped, omega):
 def mass_proportional_alpha(problem, damping, who: str) -> float:
     """``alpha`` of a damping that must be mass-proportional (``damping`` as :func:`integrate`
     takes it; None: ``problem.damping``); a Rayleigh ``beta`` is a ValueError naming ``who``."""
-    alpha, beta = _resolve_damping(problem, damping)
+    alpha, beta = resolve_damping(problem, damping)
     if beta:
         raise ValueError(f"{who} supports mass-proportional damping only (beta = 0)")
     return alpha
 
 
-def _resolve_damping(problem, damping):
+def resolve_damping(problem, damping):
     if damping is None:
         damping = getattr(problem, "damping", None)
     if damping is None:

@@ -9,31 +9,31 @@ import numpy as np
 
 from msslib.errors import ConvergenceError
 
-from .context import _release_context, _solver_context, _static_context
+from .context import _release_context, linear_solve_context, _static_context
 from .linear import solve_linear_system
 from .submatrices import submatrix, _submatrix_bsr
 from .policy import _wants_blocks
 from .protocol import (
     StaticResult,
     _accepts_out,
-    _energy_or_none,
-    _force_scale,
-    _free_mask,
-    _is_conservative,
-    _load_vector,
+    energy_or_none,
+    reference_force_scale,
+    free_mask,
+    is_conservative,
+    load_vector,
     NewtonFailure,
     _with_prescribed,
 )
 from .roundoff import (
-    _force_magnitude,
+    force_magnitude_norm,
     _roundoff_floor_at,
     convergence_threshold,
     roundoff_floor,
     roundoff_note,
 )
 
-_ARMIJO_C = 1e-4
-_MAX_BACKTRACKS = 20
+ARMIJO_C = 1e-4
+MAX_BACKTRACKS = 20
 
 
 def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy, resolve=None):
@@ -53,7 +53,7 @@ def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy, resolve=N
     energy_merit = use_energy and e0 is not None and slope < 0.0
     dx_norm = float(np.linalg.norm(dx))
     alpha = 1.0
-    for _ in range(_MAX_BACKTRACKS + 1):
+    for _ in range(MAX_BACKTRACKS + 1):
         xt = x.copy()
         xt[free] += alpha * dx
         with np.errstate(all="ignore"):
@@ -61,9 +61,9 @@ def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy, resolve=N
         rtn = float(np.linalg.norm(rt))
         if np.isfinite(rtn):
             if energy_merit:
-                et = _energy_or_none(problem, xt, load)
+                et = energy_or_none(problem, xt, load)
                 if et is not None and np.isfinite(et):
-                    if et <= e0 + _ARMIJO_C * alpha * slope:
+                    if et <= e0 + ARMIJO_C * alpha * slope:
                         return xt, rt, rtn, et, alpha
                     # energy differences drowned in round-off: judge by the residual instead
                     noise = 64 * np.finfo(float).eps * (abs(e0) + abs(et))
@@ -71,9 +71,9 @@ def _line_search(problem, x, dx, free, load, r, rnorm, e0, use_energy, resolve=N
                         return xt, rt, rtn, et, alpha
             else:
                 # merit 0.5 ||r||^2, whose slope along the exact Newton direction is -||r||^2
-                if rtn**2 <= (1.0 - 2.0 * _ARMIJO_C * alpha) * rnorm**2 or _natural_monotone(
+                if rtn**2 <= (1.0 - 2.0 * ARMIJO_C * alpha) * rnorm**2 or _natural_monotone(
                         resolve, rt, alpha, dx_norm):
-                    et = _energy_or_none(problem, xt, load) if use_energy else None
+                    et = energy_or_none(problem, xt, load) if use_energy else None
                     return xt, rt, rtn, et, alpha
         alpha *= 0.5
     raise NewtonFailure(f"line search failed (no sufficient decrease down to step length {2 * alpha:.1e})")
@@ -156,8 +156,8 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
         r = np.asarray(problem.force(x, load), dtype=float)[free]
     rnorm = float(np.linalg.norm(r))
     history = [rnorm]
-    context = _solver_context(problem, x, free) if solver_context is None else solver_context
-    e = _energy_or_none(problem, x, load) if (line_search and use_energy) else None
+    context = linear_solve_context(problem, x, free) if solver_context is None else solver_context
+    e = energy_or_none(problem, x, load) if (line_search and use_energy) else None
     it = 0
     rnorm_prev = eta_prev = None
     magnitude_of = getattr(problem, "force_magnitude", None)
@@ -231,7 +231,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
                     K_new = submatrix(K_full, free, out=K, plans=context)
             K = context["K"] = K_new
         if scales.get("floor") is None and not callable(magnitude_of):  # from this tangent: no extra assembly
-            scales["floor"] = roundoff_floor(_force_magnitude(K, x[free], scales.get("load_abs", 0.0)))
+            scales["floor"] = roundoff_floor(force_magnitude_norm(K, x[free], scales.get("load_abs", 0.0)))
             if rnorm <= target():
                 break
         it += 1
@@ -253,7 +253,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
                                                                         rtol))
                 rnorm_before = rnorm
                 x, r, rnorm, e, alpha = _line_search(problem, x, dx, free, load, r, rnorm, e, use_energy, resolve)
-                armijo = rnorm**2 <= (1.0 - 2.0 * _ARMIJO_C * alpha) * rnorm_before**2
+                armijo = rnorm**2 <= (1.0 - 2.0 * ARMIJO_C * alpha) * rnorm_before**2
                 monotone_step = None if (armijo or not monotone) else dx_norm
             except NewtonFailure as exc:
                 raise fail(str(exc)) from None
@@ -273,7 +273,7 @@ def _newton(problem, x, free, load, threshold, max_iter, line_search, linear_sol
     return x, it, history
 
 
-def _floor_text(floor):
+def floor_text(floor):
     return "not computed" if floor is None else f"{floor:.3e}"
 
 
@@ -329,17 +329,17 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
     t_start = time.perf_counter()
     if load_steps < 1:
         raise ValueError("load_steps must be >= 1")
-    free = _free_mask(problem)
+    free = free_mask(problem)
     x = np.array(x0, dtype=float).reshape(-1)
     if x.shape != (int(problem.n_dof),):
         raise ValueError(f"x0 must have {problem.n_dof} entries, got {x.shape}")
     if not np.all(np.isfinite(x)):
         raise ValueError("x0 contains non-finite values")
     symmetric = bool(getattr(problem, "symmetric", True))
-    use_energy = line_search and _is_conservative(problem, x, 1.0)
+    use_energy = line_search and is_conservative(problem, x, 1.0)
     merit = "none" if not line_search else ("energy" if use_energy else "residual")
-    f_load = _load_vector(problem, x)
-    scale = float(force_scale) if force_scale is not None else _force_scale(problem, x, free, f_load)
+    f_load = load_vector(problem, x)
+    scale = float(force_scale) if force_scale is not None else reference_force_scale(problem, x, free, f_load)
     threshold = tol * scale
     with np.errstate(all="ignore"):
         load_abs = np.abs(f_load[free])
@@ -390,7 +390,7 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
                         f"(last converged load factor {lam:.6g}, increment {target - lam:.3g} after "
                         f"{cuts_this_step} halvings), iteration {exc.iteration}, residual {exc.residual:.3e} "
                         f"(threshold {convergence_threshold(tol, scale, scales['floor']):.3e} = max(tol {tol:.1e} "
-                        f"x F_ref {scale:.3e}, round-off floor {_floor_text(scales['floor'])})): {exc}"
+                        f"x F_ref {scale:.3e}, round-off floor {floor_text(scales['floor'])})): {exc}"
                         + (f"; {hint}" if hint else ""),
                         load_step=step_index, load=target, iteration=exc.iteration, residual=exc.residual,
                         x_last=x.copy(),

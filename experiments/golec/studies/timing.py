@@ -9,7 +9,7 @@ run is only timed over a short interval and its 10 s cost extrapolated (reported
 
 The run comparable with the paper's number uses the material the paper states (its compression
 sample: E = 20 kPa, nu = 0.4999, 1000 kg/m^3) on the same 1,000 cubes of 1 cm, with the structured-
-lattice kernels (msslib.explicit.LatticeExplicit, symplectic Euler, double precision, one
+lattice kernels (msslib.stepping.LatticeExplicit, symplectic Euler, double precision, one
 thread) and the largest stable step of that scheme (msslib.solvers.critical_time_step at the
 lattice's omega_max with the damping above) times SAFETY (the limit itself is marginal). The paper
 states neither its time step nor its integrator, so the cost per cube and step is the comparable
@@ -25,7 +25,7 @@ import numpy as np
 import xarray as xr
 
 from experiments import script
-from msslib.explicit import LatticeExplicit
+from msslib.stepping import LatticeExplicit
 from msslib.results import mesh_from_result, write_result
 from msslib.metrics import mesh_volume
 from msslib.scene import load_scene, prepare, run_scene

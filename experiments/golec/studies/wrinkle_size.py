@@ -33,7 +33,7 @@ from experiments.golec.studies.wrinkles import min_eigen, wrinkled
 from msslib.experiment import load_experiment, scene_of
 from msslib.results import write_result
 from msslib.scene import load_scene, prepare
-from msslib.simulator import Simulator
+from msslib.stepping import Simulator
 from msslib.solvers import static_solve
 
 HERE = Path(__file__).resolve().parent.parent

@@ -12,14 +12,14 @@ from numba import njit
 
 from msslib.errors import ConvergenceError, DivergenceError
 
-from . import protocol
-from .context import _solver_context
-from .linear import solve_linear_system
-from .submatrices import submatrix
-from .protocol import TINY, DynamicResult
-from .roundoff import _force_magnitude, convergence_threshold, roundoff_floor
-from .stability import EXPLICIT_METHODS, _mass_vector, _resolve_damping, check_time_step
-from .statics import _ARMIJO_C, _MAX_BACKTRACKS, _floor_text
+from msslib.solvers import protocol
+from msslib.solvers.context import linear_solve_context
+from msslib.solvers.linear import solve_linear_system
+from msslib.solvers.submatrices import submatrix
+from msslib.solvers.protocol import TINY, DynamicResult
+from msslib.solvers.roundoff import force_magnitude_norm, convergence_threshold, roundoff_floor
+from msslib.solvers.stability import EXPLICIT_METHODS, mass_vector, resolve_damping, check_time_step
+from msslib.solvers.statics import ARMIJO_C, MAX_BACKTRACKS, floor_text
 
 
 def _bbox_size(problem, x0):
@@ -68,7 +68,7 @@ def relative_potential_energy(problem, x, load, cache: dict | None = None):
     displacement ``x - x0`` (for a constant load ``f``: ``E_int(x) - load f.(x - x0)``), so that it
     does not change when the whole mesh is moved.  None for a model with a non-conservative term.
     ``cache`` (a dict) keeps ``E(x0, load) - E(x0, 0)`` per load factor."""
-    e = protocol._energy_or_none(problem, x, load)
+    e = protocol.energy_or_none(problem, x, load)
     if e is None:
         return None
     x0 = getattr(problem, "x0", None)
@@ -77,7 +77,7 @@ def relative_potential_energy(problem, x, load, cache: dict | None = None):
     key = float(load)
     shift = None if cache is None else cache.get(key)
     if shift is None:
-        shift = protocol._energy_or_none(problem, x0, load) - protocol._energy_or_none(problem, x0, 0.0)
+        shift = protocol.energy_or_none(problem, x0, load) - protocol.energy_or_none(problem, x0, 0.0)
         if cache is not None:
             cache[key] = shift
     return float(e - shift)
@@ -206,7 +206,7 @@ def integrate(problem, x0, v0, *, dt: float, t_end: float, method: str = "symple
 
 class Integrator:
     """The time stepper of :func:`integrate`, one step at a time: the engine of
-    :class:`msslib.simulator.Simulator` for every model and scheme (the fused spring-network
+    :class:`msslib.stepping.Simulator` for every model and scheme (the fused spring-network
     kernel aside).
 
     Built from the state ``x0, v0`` (copied) with the arguments of :func:`integrate`; the
@@ -231,7 +231,7 @@ class Integrator:
         self.problem, self.method, self.dt, self.load = problem, method, float(dt), load
         self.newton_tol, self.newton_max_iter, self.linear_solver = newton_tol, newton_max_iter, linear_solver
         n = int(problem.n_dof)
-        model_free = protocol._free_mask(problem)
+        model_free = protocol.free_mask(problem)
         if free is None:
             free = model_free
         else:
@@ -239,11 +239,11 @@ class Integrator:
             if free.shape != (n,) or np.any(free & ~model_free):
                 raise ValueError("free must be a mask of the problem's free dofs")
         self.free = free
-        mass = _mass_vector(problem)
+        mass = mass_vector(problem)
         if np.any(mass[free] <= 0):
             raise ValueError("masses of free dofs must be positive")
         self.mass = mass
-        self.alpha, self.beta = _resolve_damping(problem, damping)
+        self.alpha, self.beta = resolve_damping(problem, damping)
         x = np.array(x0, dtype=float).reshape(-1)
         v = np.array(v0, dtype=float).reshape(-1)
         if x.shape != (n,) or v.shape != (n,):
@@ -274,7 +274,7 @@ class Integrator:
                                              load=load, allow_unstable=allow_unstable))
             stats["stability_check_time"] = time.perf_counter() - t_check
             self.limit = stats["stability_limit"]
-        self.conservative = protocol._is_conservative(problem, x, load)
+        self.conservative = protocol.is_conservative(problem, x, load)
         self.mf = mass[free]
         self.inv_m = 1.0 / self.mf
         self.messages: list[str] = []
@@ -282,14 +282,14 @@ class Integrator:
             self.messages.append(f"dt = {dt:.6g} s is {stats['dt_over_limit']:.3g} x the explicit stability limit "
                                  f"{self.limit:.6g} s of the model at rest (allow_unstable)")
         # the plans of the free-dof submatrices and, for implicit Euler, the kept AMG hierarchy
-        self.solver_context = _solver_context(problem, x, free)
+        self.solver_context = linear_solve_context(problem, x, free)
         self.f_scale = self.magnitude = None
         if method == "implicit_euler":
-            f_load = protocol._load_vector(problem, x)
-            self.f_scale = protocol._force_scale(problem, x, free, f_load)
+            f_load = protocol.load_vector(problem, x)
+            self.f_scale = protocol.reference_force_scale(problem, x, free, f_load)
             with np.errstate(all="ignore"):
                 K0 = submatrix(problem.stiffness(x, load), free, plans=self.solver_context)
-                self.magnitude = _force_magnitude(K0, x[free], np.nan_to_num(np.abs(load * f_load[free])))
+                self.magnitude = force_magnitude_norm(K0, x[free], np.nan_to_num(np.abs(load * f_load[free])))
         # divergence detector (explicit methods): see _GROWTH_MIN
         omega = stats["omega_max"] or 0.0
         self.j_floor = (omega**4 * float(self.mf.sum()) * (_FLOOR_SIZE * _bbox_size(problem, self.x_ref)) ** 2
@@ -342,7 +342,7 @@ class Integrator:
             a += self._omega2 * float(np.sqrt(np.sum(self._m_fixed * du * du)))
         if self.load != load_before:
             if self._load_norm is None:
-                f_load = protocol._load_vector(self.problem, self.x_ref)[self.free]
+                f_load = protocol.load_vector(self.problem, self.x_ref)[self.free]
                 self._load_norm = float(np.sqrt(np.sum(f_load * f_load * self.inv_m)))
             a += abs(float(self.load) - float(load_before)) * self._load_norm
         if self.extra is not extra_before:
@@ -371,6 +371,21 @@ class Integrator:
 
     def kinetic_energy(self) -> float:
         return 0.5 * float(self.mass[self.free] @ (self.v[self.free] ** 2))
+
+    def evaluate(self):
+        """The force of the current state with the current loads (explicit schemes keep it)."""
+        self.f = self.force(self.x) if self.explicit else None
+
+    def reaction(self):
+        """Minus the total force on the dofs that do not move, 0 on the free ones (flat, N)."""
+        f = self.full_force() if self.explicit else np.asarray(self.problem.force(np.ravel(self.x), self.load),
+                                                                dtype=float)
+        return np.where(self.free, 0.0, -f)
+
+    def steps(self, n: int, h: float | None = None, t_new: float | None = None) -> None:
+        """``n`` calls of :meth:`step`; ``t_new`` is the time after the last one."""
+        for i in range(n):
+            self.step(h, t_new if i + 1 == n else None)
 
     def _damping_force(self, xx, vf):
         """-(alpha M + beta K) v on the free dofs, ``vf`` the free velocities."""
@@ -487,7 +502,7 @@ def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, ma
             raise ConvergenceError(
                 f"implicit Euler Newton iteration did not converge at step {step}, t = {t_new:.6g} s: "
                 f"iteration {it}, residual {rn:.3e} (threshold {threshold:.3e}, round-off floor "
-                f"{_floor_text(floor)})",
+                f"{floor_text(floor)})",
                 iteration=it, residual=rn, x_last=x.copy(), step=step, time=t_new, load=load)
         it += 1
         K = submatrix(problem.stiffness(xt, load), free, plans=solver_context)
@@ -500,16 +515,16 @@ def _implicit_euler_step(problem, x, vf, h, free, mf, alpha, beta, load, tol, ma
                 iteration=it, residual=rn, x_last=x.copy(), step=step, time=t_new, load=load) from None
         stats["n_linear_solves"] += 1
         lam = 1.0
-        for _ in range(_MAX_BACKTRACKS + 1):
+        for _ in range(MAX_BACKTRACKS + 1):
             Rt, xtt = residual(w + lam * dw)
             rtn = float(np.linalg.norm(Rt))
-            if np.isfinite(rtn) and rtn <= (1.0 - _ARMIJO_C * lam) * rn:
+            if np.isfinite(rtn) and rtn <= (1.0 - ARMIJO_C * lam) * rn:
                 break
             lam *= 0.5
         else:
             raise ConvergenceError(
                 f"implicit Euler line search failed at step {step}, t = {t_new:.6g} s, iteration {it}, "
-                f"residual {rn:.3e} (threshold {threshold:.3e}, round-off floor {_floor_text(floor)})",
+                f"residual {rn:.3e} (threshold {threshold:.3e}, round-off floor {floor_text(floor)})",
                 iteration=it, residual=rn, x_last=x.copy(), step=step, time=t_new, load=load)
         w = w + lam * dw
         R, xt, rn = Rt, xtt, rtn

@@ -1,6 +1,6 @@
 """The fused spring-network engine of the stepping API: :class:`NetworkStepper` runs the steps of
-:class:`msslib.solvers.dynamics.Integrator` (symplectic Euler, mass-proportional damping) with
-the kernels of :mod:`msslib.explicit.network`, and the same stability check and divergence
+:class:`msslib.stepping.generic.Integrator` (symplectic Euler, mass-proportional damping) with
+the kernels of :mod:`msslib.stepping.network_kernels`, and the same stability check and divergence
 detector."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from msslib.errors import DivergenceError
-from msslib.explicit.network import N_MONITOR, fused_advance, fused_pass, fused_steps, network_layout, network_terms, records
-from msslib.solvers.dynamics import Integrator
+from msslib.stepping.network_kernels import N_MONITOR, fused_advance, fused_pass, fused_steps, network_layout, network_terms, records
+from msslib.stepping.generic import Integrator
 
 
 class NetworkStepper(Integrator):
@@ -92,6 +92,10 @@ class NetworkStepper(Integrator):
         fused_pass(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self.x_ref, self.react,
               self.mon, 0, False)
         self.stats["n_force_evals"] += 1
+
+    def reaction(self):
+        """The reactions the fused kernel keeps current (flat, N)."""
+        return self.react
 
     def full_force(self):
         return self.F

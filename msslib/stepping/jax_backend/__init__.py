@@ -1,6 +1,6 @@
 """A JAX backend of the explicit steps: general 3D spring networks (:class:`JaxNetwork`, the
-scheme of :mod:`msslib.explicit.network`) and structured lattices (:class:`JaxLattice`, that of
-:class:`msslib.explicit.LatticeExplicit`), on the first GPU JAX sees, else on its CPU, where the
+scheme of :mod:`msslib.stepping.network_kernels`) and structured lattices (:class:`JaxLattice`, that of
+:class:`msslib.stepping.LatticeExplicit`), on the first GPU JAX sees, else on its CPU, where the
 same code is tested against the numba kernels.
 
 ``available()`` says whether JAX runs here and on what; :func:`network_engine` and

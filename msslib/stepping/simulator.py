@@ -7,12 +7,12 @@ import time
 
 import numpy as np
 
-from msslib.solvers.dynamics import Integrator
+from msslib.stepping.generic import Integrator
 
 from msslib.terms.pressure import outward_facets, pressure_nodal_forces
 
 from .loads import time_function
-from msslib.explicit.network import network_terms
+from msslib.stepping.network_kernels import network_terms
 
 from .network import NetworkStepper
 
@@ -59,16 +59,16 @@ class Simulator:
     ``Simulator(model, dt=...)`` takes a :class:`msslib.system.Model` (or what
     :func:`msslib.build_model` returns) at rest, with its own loads and supports, and integrates
     ``M dv/dt = f(x, load(t)) + f_user(t) - C v`` from ``x0`` (its prescribed displacements
-    applied) at rest, with the schemes of :func:`msslib.solvers.integrate`: ``method`` is
+    applied) at rest, with the schemes of :func:`msslib.stepping.integrate`: ``method`` is
     ``"symplectic_euler"`` (default), ``"velocity_verlet"`` or ``"implicit_euler"``, ``damping``
     ``alpha`` or ``(alpha, beta)`` (None: the model's).  The explicit schemes check ``dt`` against
     the stability limit once, when the simulator is built (a cheap safe bound first, a certified
     short Lanczos run or the Lanczos estimate only when the step exceeds it, see
     :func:`msslib.solvers.check_time_step`), and every step runs
-    the divergence checks of :func:`~msslib.solvers.integrate` (``allow_unstable``, ``blowup``).
+    the divergence checks of :func:`~msslib.stepping.integrate` (``allow_unstable``, ``blowup``).
 
     Loads, changeable between steps (each value a constant, a callable of time, or a table of
-    ``[t, ...]`` rows read as a piecewise-linear curve, :mod:`msslib.simulator.loads`):
+    ``[t, ...]`` rows read as a piecewise-linear curve, :mod:`msslib.stepping.loads`):
 
     * :meth:`set_load`: the load factor of the model's own loads (and prescribed displacements);
     * :meth:`apply_force`: nodal forces on a selection (per node, or a total shared equally);
@@ -83,12 +83,12 @@ class Simulator:
     time over the wall time spent in :meth:`step`.  :meth:`reset` returns to the start.
 
     ``engine``: ``"network"`` runs symplectic Euler on 3D spring models with the fused kernel of
-    :mod:`msslib.explicit.network` (other internal terms added before each pass; many steps in
+    :mod:`msslib.stepping.network_kernels` (other internal terms added before each pass; many steps in
     one call when nothing changes in between); ``"generic"`` runs
-    :class:`msslib.solvers.dynamics.Integrator` on any model and scheme; ``"jax"`` runs 3D
-    spring networks with constant loads on :mod:`msslib.explicit.jax_backend` (the first GPU
+    :class:`msslib.stepping.generic.Integrator` on any model and scheme; ``"jax"`` runs 3D
+    spring networks with constant loads on :mod:`msslib.stepping.jax_backend` (the first GPU
     JAX sees, else its CPU; without JAX a warning names the reason and ``network`` runs; the
-    state lives on the device, so reading it copies, see :mod:`msslib.simulator.accelerated`);
+    state lives on the device, so reading it copies, see :mod:`msslib.stepping.accelerated`);
     ``"auto"`` (default) takes ``network`` where it applies.  They run the same scheme and agree
     to round-off.
     """
@@ -138,7 +138,7 @@ class Simulator:
         if self._engine_request == "generic":
             return "generic"
         if self._engine_request == "jax":
-            from msslib.explicit.jax_backend import use_jax
+            from msslib.stepping.jax_backend import use_jax
 
             if self._varies() or self._forces or self._paths or self._pressures:
                 raise ValueError("engine='jax' runs constant loads: a load curve, nodal forces or prescribed paths "
@@ -192,12 +192,8 @@ class Simulator:
         holder.append(stepper)
         self._stepper = stepper
         self._apply(t, stepper.x, stepper, plan, True)
-        if self.engine in ("network", "jax"):
-            stepper.evaluate()
-        else:
-            stepper.f = stepper.force(stepper.x) if stepper.explicit else None
-        if hasattr(stepper, "restart_detector"):
-            stepper.restart_detector()  # its reference from the force with this call's loads
+        stepper.evaluate()
+        stepper.restart_detector()  # its reference from the force with this call's loads
 
     def _drive_plan(self):
         """What :meth:`_apply` writes, indexed once per build instead of once per step: the
@@ -449,11 +445,7 @@ class Simulator:
                 or any(e[1].user for e in self._paths.values()) or any(e[1].user for e in self._pressures.values()))
         saved = (st.x.copy(), st.v.copy(), st.t, st.n_taken) if user else None  # a callable may raise
         try:
-            if self.engine in ("network", "jax"):
-                st.steps(n, h, t_new)
-            else:
-                for i in range(n):
-                    st.step(h, t_new if i + 1 == n else None)
+            st.steps(n, h, t_new)
         except Exception as exc:
             from msslib.errors import DivergenceError
 
@@ -518,11 +510,7 @@ class Simulator:
     def reaction(self) -> np.ndarray:
         """Force the supports and the prescribed paths apply, ``(n_nodes, dim)`` (N): minus the
         total force of the terms on every dof that does not move, 0 elsewhere."""
-        st = self._stepper
-        if self.engine == "network":
-            return self._view(st.react)
-        f = st.full_force() if st.explicit else np.asarray(self.model.force(np.ravel(st.x), st.load), dtype=float)
-        return self._view(np.where(st.free, 0.0, -f))
+        return self._view(self._stepper.reaction())
 
     @property
     def t(self) -> float:
@@ -558,12 +546,12 @@ class Simulator:
     def potential_energy(self) -> float | None:
         """Internal energy minus the work of the loads on the displacement from the rest
         positions, at the current load factor (J): it does not depend on where the mesh sits
-        (:func:`msslib.solvers.dynamics.relative_potential_energy`); None for a model with a
+        (:func:`msslib.stepping.generic.relative_potential_energy`); None for a model with a
         non-conservative term."""
         st = self._stepper
         if not st.conservative:
             return None
-        from msslib.solvers.dynamics import relative_potential_energy
+        from msslib.stepping.generic import relative_potential_energy
 
         x = np.ravel(np.asarray(st.x))
         if self._forces:  # the extra nodal forces do work on the displacement too

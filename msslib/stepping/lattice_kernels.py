@@ -1,4 +1,4 @@
-"""The numba kernels of :class:`msslib.explicit.LatticeExplicit`.
+"""The numba kernels of :class:`msslib.stepping.LatticeExplicit`.
 
 Node arrays are lattice ordered (``q = i + NX (j + NY k)``), length ``N``, one array per
 coordinate (structure of arrays).  The springs of one of the 13 lattice directions with flat

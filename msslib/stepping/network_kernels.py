@@ -17,12 +17,12 @@ cache line instead of two, which doubles the speed when the mesh's numbering sca
 (a gmsh mesh of 5 10^5 springs: 48 to 99 M spring-steps/s); the positions are the view
 ``R[:, :3]``.
 
-The scheme is that of :func:`msslib.solvers.integrate` with ``method="symplectic_euler"`` and
+The scheme is that of :func:`msslib.stepping.integrate` with ``method="symplectic_euler"`` and
 mass-proportional damping: ``v+ = v + h M^-1 (F(x) - alpha M v)``, ``x+ = x + h v+``, written as
 ``v+ = damp v + w F`` with ``damp = 1 - h alpha`` on free dofs and ``w = h / m`` (0 on fixed dofs,
 which keep their position: prescribed motion sets them between steps).
 
-Each force pass also writes what the divergence detector of :mod:`msslib.solvers.dynamics` needs
+Each force pass also writes what the divergence detector of :mod:`msslib.stepping.generic` needs
 for the step whose end state it evaluates (``v.v``, ``F.M^-1 F_prev``, ``v.(F - F_prev)``,
 ``F.M^-1 F`` over the free dofs and ``max |x - x_ref|``), and the support reactions ``-F`` on the
 fixed dofs, so that the state, the force and the reaction are current after every call.

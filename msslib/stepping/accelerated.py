@@ -1,6 +1,6 @@
 """The JAX engine of the stepping API: :class:`JaxStepper` runs a spring network on
-:class:`msslib.explicit.jax_backend.JaxNetwork` (the first GPU JAX sees, else its CPU) behind the
-interface the :class:`~msslib.simulator.Simulator` steps.
+:class:`msslib.stepping.jax_backend.JaxNetwork` (the first GPU JAX sees, else its CPU) behind the
+interface the :class:`~msslib.stepping.Simulator` steps.
 
 The state lives on the device: reading ``x``, ``v`` or the reactions copies it to the host, so a
 loop that reads every step pays a transfer; many steps per call are what the device is for.
@@ -23,7 +23,7 @@ class JaxStepper:
 
     def __init__(self, model, x0, v0, *, dt, damping=None, load=1.0, allow_unstable=False, blowup=1e3,
                  free=None, drive=None):
-        from msslib.explicit.jax_backend import JaxNetwork
+        from msslib.stepping.jax_backend import JaxNetwork
 
         if drive is not None:
             raise ValueError("engine='jax' runs constant loads: a load curve, time-varying forces or a moving path "
@@ -57,6 +57,14 @@ class JaxStepper:
 
     def evaluate(self):
         """Nothing to do: the device keeps the force current."""
+
+    def restart_detector(self):
+        """Nothing to restart: the device's divergence check is its non-finite test at the end
+        of each call."""
+
+    def reaction(self):
+        """Minus the total force on the dofs that do not move, 0 on the free ones (flat, N)."""
+        return np.where(self.free, 0.0, -self.full_force())
 
     def steps(self, n: int, h=None, t_new=None):
         if h is not None and abs(h - self.dt) > 1e-12 * self.dt:

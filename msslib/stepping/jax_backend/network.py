@@ -1,8 +1,8 @@
 """Explicit steps of a general 3D spring network on JAX (:class:`JaxNetwork`), and the numba CPU
 path behind the same interface (:class:`CpuNetwork`, the kernels of
-:mod:`msslib.explicit.network`).
+:mod:`msslib.stepping.network_kernels`).
 
-The scheme is that of :mod:`msslib.explicit.network`: symplectic Euler with mass-proportional
+The scheme is that of :mod:`msslib.stepping.network_kernels`: symplectic Euler with mass-proportional
 damping on the flat state ``x, v`` (``3 n_nodes``): ``F = f_springs(x) + f_ext``,
 ``v = damp v + w F``, ``x += h_free v`` with ``w = h / m`` and ``damp = 1 - h alpha`` on the free
 dofs, ``w = 0``, ``damp = 1``, ``h_free = 0`` on the fixed ones (they keep their position and
@@ -29,7 +29,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from msslib.errors import DivergenceError
-from msslib.explicit.network import N_MONITOR, network_forces, network_layout, network_steps, records
+from msslib.stepping.network_kernels import N_MONITOR, network_forces, network_layout, network_steps, records
 
 from .device import check_precision, default_device, describe, use_jax, x64
 
@@ -40,7 +40,7 @@ def network_arrays(model, load: float = 1.0):
     """``dict(x0, conn, k, rest_length, mass, free, fext)`` of a 3D model whose internal terms are
     :class:`msslib.terms.Springs` and whose other terms are dead external loads (at the load
     factor ``load``; fixed dofs at their prescribed positions); ValueError naming any other term."""
-    from msslib.explicit.network import network_terms
+    from msslib.stepping.network_kernels import network_terms
 
     springs, other, why = network_terms(model)
     if why is None and other:
@@ -153,7 +153,7 @@ class _NetworkBase:
 
 
 class CpuNetwork(_NetworkBase):
-    """The numba kernels of :mod:`msslib.explicit.network` (one CPU thread per network) behind the
+    """The numba kernels of :mod:`msslib.stepping.network_kernels` (one CPU thread per network) behind the
     interface of :class:`JaxNetwork`: ``steps(n)``, ``positions()``, ``velocities()``,
     ``forces()``, ``reactions()``; always double precision."""
 
@@ -255,14 +255,14 @@ class JaxNetwork(_NetworkBase):
     ----------
     x0 : flat positions (3 n_nodes).
     conn, k, rest_length : springs (s, 2), their constants and rest lengths (those of the numba
-        path, :func:`msslib.explicit.network.network_layout`).
+        path, :func:`msslib.stepping.network_kernels.network_layout`).
     mass, free, fext : per dof: masses, the free mask (fixed dofs keep their position), the
         constant external force.
     h, alpha : the step (s) and the mass-proportional damping (1/s).
     v0 : initial velocities (0 on the fixed dofs).
     precision : ``"double"`` (default: agrees with the numba path to round-off) or ``"single"``:
         spring forces in fp32 on an fp32 copy of the positions, state and update in fp64 (as
-        :class:`msslib.explicit.LatticeExplicit` ``precision="single"``).
+        :class:`msslib.stepping.LatticeExplicit` ``precision="single"``).
     unroll : steps per iteration of the device loop (default 8 below 10^6 springs, else 1).
     device : None (the first GPU JAX sees, else its CPU), ``"gpu"`` or ``"cpu"``.
     allow_unstable : run a step above the stability limit (:func:`msslib.solvers.check_time_step`,

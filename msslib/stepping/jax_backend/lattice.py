@@ -1,8 +1,8 @@
 """Explicit steps of a model on a structured hexahedral lattice on JAX (:class:`JaxLattice`), the
-scheme and the forces of :class:`msslib.explicit.LatticeExplicit` as a stencil.
+scheme and the forces of :class:`msslib.stepping.LatticeExplicit` as a stencil.
 
 The state is one array ``(3, NZ, NY, NX)`` per quantity (the lattice order of
-:class:`~msslib.explicit.LatticeExplicit`, ``q = i + NX (j + NY k)``, reshaped).  The springs of
+:class:`~msslib.stepping.LatticeExplicit`, ``q = i + NX (j + NY k)``, reshaped).  The springs of
 each of the 13 lattice directions ``(di, dj, dk)`` are the pairs of a slice of the lattice and the
 same slice shifted by the direction (no wrap-around: the slices stop at the boundary); their
 forces are added to both ends by padding them back to the lattice's shape, which the compiler
@@ -10,7 +10,7 @@ fuses into one pass.  The hexahedron volume term (Golec's averaged-edge volume
 ``V = ex . (ey x ez) / 64``) is evaluated on the ``(NZ-1, NY-1, NX-1)`` cells from the 8 shifted
 corner slices and its corner forces are padded back the same way.  The tables (spring constants
 and rest lengths per direction and base node, the volume constants per cell, masses, loads) and
-the checks of the model are those of :class:`~msslib.explicit.LatticeExplicit`, which is built
+the checks of the model are those of :class:`~msslib.stepping.LatticeExplicit`, which is built
 once for them.
 
 :meth:`JaxLattice.run` has the signature and the results of :meth:`LatticeExplicit.run`
@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from msslib.errors import DivergenceError
-from msslib.explicit.lattice import _DIRS, _HEX_CORNERS, LatticeExplicit
+from msslib.stepping.lattice import _DIRS, _HEX_CORNERS, LatticeExplicit
 
 from .device import check_precision, default_device, describe, use_jax, x64
 
@@ -44,13 +44,13 @@ class JaxLattice:
 
     Parameters
     ----------
-    model, load : as :class:`msslib.explicit.LatticeExplicit` (3D Springs between lattice
+    model, load : as :class:`msslib.stepping.LatticeExplicit` (3D Springs between lattice
         neighbours, HexVolume terms on lattice cells, constant external loads; anything else
         raises its ValueError naming the term).
     precision : ``"double"`` (default; agrees with ``LatticeExplicit(model,
         precision="double")`` to round-off) or ``"single"``: the force stencil in fp32 on an fp32
         copy of the positions, state and update in fp64 (the meaning of ``"single"`` in
-        :class:`~msslib.explicit.LatticeExplicit`).
+        :class:`~msslib.stepping.LatticeExplicit`).
     unroll : steps per iteration of the device loop (default 8 below 10^6 nodes, else 1).
     device : None (the first GPU JAX sees, else its CPU), ``"gpu"`` or ``"cpu"``.
 
@@ -243,7 +243,7 @@ class JaxLattice:
 
     def run(self, x, v, h: float, n_steps: int, alpha: float | None = None, save_every: int = 1,
             allow_unstable: bool = False):
-        """:meth:`msslib.explicit.LatticeExplicit.run` on the device: returns ``(x, v, saved)``,
+        """:meth:`msslib.stepping.LatticeExplicit.run` on the device: returns ``(x, v, saved)``,
         ``saved`` the positions after steps ``save_every, 2 save_every, ...`` (one device call
         per saved state)."""
         if not (h > 0) or n_steps < 0 or save_every < 1:
@@ -259,7 +259,7 @@ class JaxLattice:
 def lattice_engine(model, load: float = 1.0, precision: str = "double", *, backend: str = "jax", **options):
     """A :class:`JaxLattice`, or, for ``backend="numba"`` or when JAX is not available (a
     :class:`msslib.errors.MsslibWarning` names the reason), a
-    :class:`msslib.explicit.LatticeExplicit`: both run ``run(x, v, h, n_steps, alpha,
+    :class:`msslib.stepping.LatticeExplicit`: both run ``run(x, v, h, n_steps, alpha,
     save_every)`` with the same results."""
     if use_jax(backend):
         return JaxLattice(model, load, precision, **options)

@@ -21,7 +21,7 @@ pair that is not a spring (it wraps around the lattice, or the model has no spri
 are gathered from the neighbouring cells.
 
 :meth:`LatticeExplicit.run` is the symplectic Euler loop of
-``msslib.solvers.integrate(..., method="symplectic_euler")`` with mass-proportional damping,
+``msslib.stepping.integrate(..., method="symplectic_euler")`` with mass-proportional damping,
 entirely in numba: ``v += h (f(x) - alpha M v) / M`` on the free dofs, then ``x += h v``.
 In double precision (the default) results agree with the model to round-off (summation order
 differs); with ``precision="single"`` the force kernels run in single precision on a copy of
@@ -29,14 +29,14 @@ the positions (state and update stay double), about twice as fast, with forces w
 1e-5 of the double ones; see ``tests/test_fastexplicit.py``.
 
 This module finds the lattice (:func:`lattice_index`) and holds the integrator; the numba
-kernels are in :mod:`msslib.explicit.kernels`.
+kernels are in :mod:`msslib.stepping.lattice_kernels`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from msslib.explicit.kernels import _from_lattice, _gradient, _run, _to_lattice
+from msslib.stepping.lattice_kernels import _from_lattice, _gradient, _run, _to_lattice
 from msslib.terms import ExternalForce, HexVolume, Springs, Term
 
 __all__ = ["LatticeExplicit", "lattice_index"]
@@ -332,14 +332,14 @@ class LatticeExplicit:
     def run(self, x, v, h: float, n_steps: int, alpha: float | None = None, save_every: int = 1,
             allow_unstable: bool = False):
         """Symplectic Euler with mass-proportional damping ``C = alpha M`` for ``n_steps`` steps of
-        ``h``; the scheme of ``solvers.integrate(method="symplectic_euler", damping=alpha)``.
+        ``h``; the scheme of ``msslib.stepping.integrate(method="symplectic_euler", damping=alpha)``.
 
         ``x``, ``v``: flat model-layout state (not modified; the velocity of fixed dofs is set to
         0 and fixed dofs keep their position).  ``alpha`` None takes ``model.damping`` (a scalar;
         Rayleigh ``beta`` is not supported).  Returns ``(x, v, saved)`` with ``saved`` the
         positions after steps ``save_every, 2 save_every, ...`` (``n_steps // save_every`` rows).
 
-        As in :func:`msslib.solvers.integrate`, a step ``h`` above the stability limit of the model
+        As in :func:`msslib.stepping.integrate`, a step ``h`` above the stability limit of the model
         at ``x`` (:func:`msslib.solvers.check_time_step`, computed on the first call from a given
         ``x`` and kept) raises :class:`msslib.errors.StabilityError` unless ``allow_unstable``.
         The numba loop itself has no per-step divergence detector (it would cost the loop its

@@ -1,0 +1,85 @@
+"""One home for time stepping: every engine behind the Simulator follows the one Stepper protocol,
+the Simulator calls nothing else, and the engines' reactions agree through it."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import msslib
+from msslib import mesh as M
+from msslib import solvers as S
+from msslib.stepping import ENGINES, Simulator, Stepper
+from msslib.stepping.protocol import Stepper as ProtocolClass
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def column():
+    mesh = M.cylinder_mesh(0.02, 0.08, 0.01)
+    setup = msslib.build_model("lloyd_tetrahedron", mesh, msslib.Material(1e4, 0.25, density=1000.0),
+                               fixed={"plane": ["z", 0.0]}, loads={"type": "gravity", "g": [0, 0, -9.81]})
+    model = setup.model
+    return model, S.explicit_stability_limit(model, model.x0)
+
+
+def _engines():
+    engines = ["network", "generic"]
+    try:
+        import jax  # noqa: F401
+
+        engines.append("jax")
+    except ImportError:
+        pass
+    return engines
+
+
+@pytest.mark.parametrize("engine", _engines())
+def test_every_engine_is_a_stepper_and_reacts_alike(column, engine):
+    model, limit = column
+    sim = Simulator(model, dt=0.8 * limit, damping=3.0, engine=engine)
+    assert sim.engine == engine
+    assert isinstance(sim._stepper, Stepper)
+    sim.step(40)
+    ref = Simulator(model, dt=0.8 * limit, damping=3.0, engine="generic").step(40)
+    scale = np.abs(ref.reaction).max()
+    assert scale > 0
+    assert np.abs(sim.reaction - ref.reaction).max() < 1e-10 * scale
+    # the protocol's reaction is minus the total force on the dofs that do not move
+    st = sim._stepper
+    f = np.asarray(st.full_force())
+    np.testing.assert_allclose(np.ravel(st.reaction()), np.where(st.free, 0.0, -f), rtol=0, atol=1e-12 * scale)
+
+
+def test_an_engine_missing_a_member_is_not_a_stepper():
+    class Incomplete:
+        explicit = conservative = True
+        free = np.ones(3, bool)
+        load, extra, t, n_taken, stats, messages = 1.0, None, 0.0, 0, {}, []
+        x = v = np.zeros(3)
+
+        def steps(self, n, h=None, t_new=None):
+            pass
+
+    assert not isinstance(Incomplete(), Stepper)
+
+
+def test_the_simulator_uses_only_the_protocol_of_its_stepper():
+    """Every attribute the Simulator reads or calls on its stepper is a member of Stepper (plus
+    the flag it sets on a network stepper whose driven load reads the state)."""
+    members = {n for n in dir(ProtocolClass) if not n.startswith("_")} | set(ProtocolClass.__annotations__)
+    tree = ast.parse((ROOT / "msslib" / "stepping" / "simulator.py").read_text())
+    used = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) and node.value.id in ("st", "stepper"):
+            used.add(node.attr)
+        if (isinstance(node, ast.Attribute) and isinstance(node.value, ast.Attribute)
+                and node.value.attr == "_stepper"):
+            used.add(node.attr)
+    extra = used - members - {"drive_reads_state"}
+    assert not extra, f"the Simulator reaches past the Stepper protocol: {sorted(extra)}"
+    assert set(ENGINES) >= {"network", "generic", "jax"}
