@@ -83,3 +83,54 @@ def test_the_simulator_uses_only_the_protocol_of_its_stepper():
     extra = used - members - {"drive_reads_state"}
     assert not extra, f"the Simulator reaches past the Stepper protocol: {sorted(extra)}"
     assert set(ENGINES) >= {"network", "generic", "jax"}
+
+
+@pytest.fixture(scope="module")
+def beam():
+    """Golec's cubes on a structured lattice: a cantilever under its weight."""
+    mesh = M.hex_grid(0.4, 0.1, 0.1, 8, 2, 2)
+    setup = msslib.build_model("golec_cube", mesh, msslib.Material(1000.0, 0.3, density=0.3125),
+                               fixed={"plane": ["x", 0.0]}, loads={"type": "gravity", "g": [0, 0, -9.81]})
+    model = setup.model
+    return model, S.explicit_stability_limit(model, model.x0)
+
+
+def test_the_lattice_engine_is_a_stepper_behind_the_simulator(beam):
+    model, limit = beam
+    dt = 0.8 * limit
+    a = Simulator(model, dt=dt, damping=3.0, engine="lattice")
+    b = Simulator(model, dt=dt, damping=3.0, engine="network")
+    assert a.engine == "lattice" and isinstance(a._stepper, Stepper)
+    a.step(120).step(80)
+    b.step(200)
+    scale = np.abs(b.x - model.x0.reshape(-1, 3)).max()
+    assert np.abs(a.x - b.x).max() < 1e-11 * scale
+    assert np.abs(a.v - b.v).max() < 1e-10 * np.abs(b.v).max()
+    assert np.abs(a.reaction - b.reaction).max() < 1e-10 * np.abs(b.reaction).max()
+    assert a.t == pytest.approx(200 * dt) and a.n_steps == 200
+    x_before = a.x
+    a.reset()
+    np.testing.assert_array_equal(a.x, model.x0.reshape(-1, 3))
+    a.step(200)
+    np.testing.assert_array_equal(a.x, x_before)  # reset and replay: bitwise the same
+
+
+def test_the_lattice_engine_refuses_what_it_cannot_run(beam, column):
+    model, limit = beam
+    dt = 0.8 * limit
+    with pytest.raises(ValueError, match="engine='lattice' runs constant loads"):
+        Simulator(model, dt=dt, engine="lattice", load=[[0.0, 0.0], [0.1, 1.0]])
+    with pytest.raises(ValueError, match="engine='lattice' runs symplectic_euler only"):
+        Simulator(model, dt=dt, engine="lattice", method="velocity_verlet")
+    sim = Simulator(model, dt=dt, engine="lattice")
+    with pytest.raises(ValueError, match="engine='lattice' runs constant loads"):
+        sim.apply_force([5], [0.0, 0.0, -1.0])
+    assert sim.engine == "lattice" and sim.n_steps == 0  # the refused call changed nothing
+    tet, tet_limit = column
+    with pytest.raises(ValueError, match="engine='lattice' runs models on a full structured hexahedral lattice.*not a "
+                                         "structured lattice"):
+        Simulator(tet, dt=0.5 * tet_limit, engine="lattice")
+    from msslib.errors import StabilityError
+
+    with pytest.raises(StabilityError):
+        Simulator(model, dt=1.05 * limit, engine="lattice")

@@ -372,3 +372,106 @@ class LatticeExplicit:
                 step=int(n_steps), time=float(n_steps * h), quantity="position", dof=-1, value=float("nan"),
                 dt=float(h), stability_limit=limit)
         return self.from_lattice(P), self.from_lattice(Vel), out
+
+
+class LatticeStepper:
+    """The stepper of ``engine="lattice"`` (a :class:`~msslib.stepping.protocol.Stepper`):
+    :class:`LatticeExplicit`'s vectorised symplectic Euler behind the Simulator.
+
+    For a model on a full structured hexahedral lattice (springs between lattice neighbours,
+    Golec's hexahedron volume terms, constant external loads) with its own supports, constant loads
+    and mass-proportional damping.  The state stays in lattice order between calls (reading ``x``
+    or ``v`` converts it); the divergence check is the non-finite test at the end of each call, as
+    on the JAX engine.  The stability check runs once, on the model (as the other engines')."""
+
+    explicit = True
+
+    def __init__(self, model, x0, v0, *, dt, damping=None, load=1.0, allow_unstable=False, blowup=1e3,
+                 free=None, drive=None):
+        from msslib.solvers import protocol
+        from msslib.solvers.stability import check_time_step, mass_proportional_alpha
+
+        if drive is not None:
+            raise ValueError("engine='lattice' runs constant loads: a load curve, time-varying forces or a moving "
+                             "path run on the network engine (engine='network')")
+        if free is not None and np.any(np.asarray(free) != np.asarray(model.free)):
+            raise ValueError("engine='lattice' keeps the model's supports: prescribed paths run on the network engine")
+        alpha = mass_proportional_alpha(model, damping, "engine='lattice'")
+        try:
+            self.lat = LatticeExplicit(model, load=float(load))
+        except ValueError as exc:
+            raise ValueError(f"engine='lattice' runs models on a full structured hexahedral lattice with springs, "
+                             f"hexahedron volume terms and constant loads ({exc}); other models run on engine="
+                             f"'network' or 'generic'") from None
+        self.model, self.dt, self.load, self.alpha, self.extra = model, float(dt), float(load), float(alpha), None
+        self.free = np.asarray(model.free, dtype=bool)
+        self.mass = np.asarray(model.mass, dtype=float)
+        x0 = np.array(x0, dtype=float).reshape(-1)
+        check = check_time_step(model, x0, self.dt, method="symplectic_euler", damping=self.alpha, load=self.load,
+                                allow_unstable=allow_unstable)
+        self.limit = check["stability_limit"]
+        self.conservative = protocol.is_conservative(model, x0, self.load)
+        vv = np.array(v0, dtype=float).reshape(-1)
+        vv[~self.free] = 0.0
+        self._P, self._V = self.lat.to_lattice(x0), self.lat.to_lattice(vv)
+        copy = self.lat.dtype != self._P.dtype
+        self._Pk = np.empty(self._P.shape, dtype=self.lat.dtype) if copy else self._P
+        self._G = np.zeros(self._P.shape, dtype=self.lat.dtype)
+        self._copy = copy
+        self._none = np.empty((0, 3 * self.lat.N))
+        self.t, self.n_taken = 0.0, 0
+        self.messages: list[str] = []
+        self.stats = {"method": "symplectic_euler", "dt": self.dt, "n_steps": 0, "damping": (self.alpha, 0.0),
+                      **check, "engine": "lattice", "n_force_evals": 0}
+
+    @property
+    def x(self) -> np.ndarray:
+        return self.lat.from_lattice(self._P)
+
+    @property
+    def v(self) -> np.ndarray:
+        return self.lat.from_lattice(self._V)
+
+    def full_force(self) -> np.ndarray:
+        return np.asarray(self.model.force(self.x, self.load), dtype=float)
+
+    def reaction(self) -> np.ndarray:
+        return np.where(self.free, 0.0, -self.full_force())
+
+    def kinetic_energy(self) -> float:
+        v = self.v
+        return 0.5 * float(self.mass[self.free] @ (v[self.free] ** 2))
+
+    def evaluate(self):
+        """Nothing to keep: the loop computes the force at the start of every step."""
+
+    def restart_detector(self):
+        """Nothing to restart: the check is the non-finite test at the end of each call."""
+
+    def steps(self, n: int, h=None, t_new=None):
+        from msslib.errors import DivergenceError
+        from msslib.stepping.lattice_kernels import _run
+
+        if h is not None and abs(h - self.dt) > 1e-12 * self.dt:
+            raise ValueError(f"engine='lattice' steps at dt = {self.dt:.6g} s only, got h = {h!r}")
+        n = int(n)
+        lat = self.lat
+        P, V = self._P.copy(), self._V.copy()  # the state before the call stays until the call succeeded
+        Pk = np.empty(P.shape, dtype=lat.dtype) if self._copy else P
+        _run(P, V, self.dt, n, n + 1, self.alpha, lat.mass, lat.inv_m, lat.fext, lat.offs, lat.nspan, lat._K,
+             lat._L0, lat._F, lat.ncell, lat.NX, lat.S, lat._kv, lat._V0, lat._W, lat.pad, lat.lat, self._none, Pk,
+             self._G, self._copy)
+        if not (np.isfinite(P).all() and np.isfinite(V).all()):
+            raise DivergenceError(
+                f"engine='lattice' diverged: non-finite state after {self.n_taken + n} steps of dt = {self.dt:.6g} s "
+                f"(the stability limit at the start is {self.limit:.6g} s; the loop checks at the end of each call); "
+                f"the state is that before the call", step=self.n_taken + n, time=self.t + n * self.dt,
+                quantity="position", dof=-1, value=float("nan"), dt=self.dt, stability_limit=self.limit)
+        self._P, self._V = P, V
+        self.n_taken += n
+        self.t = self.t + n * self.dt if t_new is None else float(t_new)
+        self.stats["n_steps"] = self.n_taken
+        self.stats["n_force_evals"] += n
+
+    def step(self, h=None, t_new=None):
+        self.steps(1, h, t_new)

@@ -16,7 +16,7 @@ from msslib.stepping.network_kernels import network_terms
 
 from .network import NetworkStepper
 
-ENGINES = ("auto", "network", "generic", "jax")
+ENGINES = ("auto", "network", "generic", "jax", "lattice")
 METHODS = ("symplectic_euler", "velocity_verlet", "implicit_euler")
 # steps of one fused kernel call: the monitor rows it fills are held at most this many at a time
 _CHUNK = 256
@@ -89,7 +89,12 @@ class Simulator:
     spring networks with constant loads on :mod:`msslib.stepping.jax_backend` (the first GPU
     JAX sees, else its CPU; without JAX a warning names the reason and ``network`` runs; the
     state lives on the device, so reading it copies, see :mod:`msslib.stepping.accelerated`);
-    ``"auto"`` (default) takes ``network`` where it applies.  They run the same scheme and agree
+    ``"lattice"`` runs a model on a full structured hexahedral lattice (Golec's cubes on a
+    ``hex_grid``) with constant loads and its own supports on the vectorised loops of
+    :class:`msslib.stepping.lattice.LatticeExplicit` (the state kept in lattice order; its
+    divergence check is the non-finite test at the end of each call, as on ``jax``);
+    ``"auto"`` (default) takes ``network`` where it applies (never ``lattice`` or ``jax``, whose
+    divergence check is coarser: ask for them).  They run the same scheme and agree
     to round-off.
     """
 
@@ -110,8 +115,8 @@ class Simulator:
         if blowup <= 0:
             raise ValueError(f"blowup must be a finite number > 0, got {blowup!r}")
         damping = _checked_damping(damping)
-        if engine == "jax" and method != "symplectic_euler":
-            raise ValueError(f"engine='jax' runs symplectic_euler only, got method={method!r} "
+        if engine in ("jax", "lattice") and method != "symplectic_euler":
+            raise ValueError(f"engine={engine!r} runs symplectic_euler only, got method={method!r} "
                              "(the other schemes run on engine='generic')")
         self.model = model
         self.dim = int(model.dim)
@@ -137,6 +142,11 @@ class Simulator:
     def _engine(self):
         if self._engine_request == "generic":
             return "generic"
+        if self._engine_request == "lattice":
+            if self._varies() or self._forces or self._paths or self._pressures:
+                raise ValueError("engine='lattice' runs constant loads: a load curve, nodal forces, pressures or "
+                                 "prescribed paths run on the network engine (engine='network')")
+            return "lattice"
         if self._engine_request == "jax":
             from msslib.stepping.jax_backend import use_jax
 
@@ -183,6 +193,10 @@ class Simulator:
             from .accelerated import JaxStepper
 
             stepper = JaxStepper(self.model, x, v, **kw)
+        elif self.engine == "lattice":
+            from .lattice import LatticeStepper
+
+            stepper = LatticeStepper(self.model, x, v, **kw)
         else:
             stepper = Integrator(self.model, x, v, method=self._options["method"], **kw, **self._implicit)
         stepper.t = t
