@@ -27,7 +27,9 @@ def test_the_factorisation_is_chosen_by_size_and_symmetry(monkeypatch):
     monkeypatch.setattr(pardiso, "available", lambda: True)
     assert policy.choose_factorisation(policy.PARDISO_MIN_DOFS, True) == "pardiso"
     assert policy.choose_factorisation(policy.PARDISO_MIN_DOFS - 1, True) == "superlu"
-    assert policy.choose_factorisation(10 * policy.PARDISO_MIN_DOFS, False) == "superlu"
+    # non-symmetric systems too (real non-symmetric Pardiso), by the same size
+    assert policy.choose_factorisation(10 * policy.PARDISO_MIN_DOFS, False) == "pardiso"
+    assert policy.choose_factorisation(policy.PARDISO_MIN_DOFS - 1, False) == "superlu"
     monkeypatch.setattr(pardiso, "available", lambda: False)
     assert policy.choose_factorisation(10 * policy.PARDISO_MIN_DOFS, True) == "superlu"
     # an indefinite tangent goes direct under "auto" only where the indefinite factorisation exists

@@ -32,16 +32,17 @@ def linear_solve(K, rhs, free, points, dim: int, linear_solver="auto", symmetric
 
     ``points`` ``(n_scalar, dim)``: the location of every scalar dof (for the AMG near-null
     space). Returns ``(x, how)``, ``how`` naming the solver taken (``"direct"`` or ``"cg"``).
-    ``symmetric``: whether ``K`` is (CG is chosen for symmetric systems only).
+    ``symmetric``: whether ``K`` is (CG is chosen for symmetric systems only); a ``K`` declared
+    non-symmetric that is symmetric to round-off is solved as symmetric.
     Raises :class:`numpy.linalg.LinAlgError` for a singular matrix."""
     from msslib.solvers import context as _context
     from msslib.solvers.linear import solve_linear_system
     from msslib.solvers.submatrices import submatrix
-    from msslib.solvers.policy import banded_cholesky_is_cheap, choose_linear_solver
+    from msslib.solvers.policy import as_symmetric, banded_cholesky_is_cheap, choose_linear_solver
     from msslib.solvers.protocol import NewtonFailure
 
     ctx = _context.linear_solve_context(SimpleNamespace(dim=dim), np.asarray(points, dtype=float).ravel(), free)
-    A = submatrix(K.tocsr(), free, plans=ctx)
+    A, symmetric = as_symmetric(submatrix(K.tocsr(), free, plans=ctx), symmetric)  # round-off asymmetry
     how = choose_linear_solver(linear_solver, A.shape[0], symmetric, lambda: banded_cholesky_is_cheap(A, ctx))
     messages: list = []
     try:

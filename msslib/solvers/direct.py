@@ -150,7 +150,9 @@ def _direct_solve(A, b, symmetric, context=None, factorisation="superlu"):
     definite; above ``PARDISO_MIN_DOFS`` MKL Pardiso (symmetric indefinite, its analysis kept in
     ``context`` for the later matrices of the pattern; :mod:`msslib.solvers.pardiso`) where it
     is installed; otherwise SuperLU with the minimum-degree ordering of A^T + A (less fill than
-    the default COLAMD on lattice stiffnesses).  Non-symmetric: SuperLU with COLAMD."""
+    the default COLAMD on lattice stiffnesses).  Non-symmetric: above ``PARDISO_MIN_DOFS`` MKL
+    Pardiso (real non-symmetric, its analysis kept likewise) where it is installed, otherwise
+    SuperLU with COLAMD."""
     if symmetric:
         x = _banded_cholesky_solve(A, b, context)
         if x is not None:
@@ -159,15 +161,16 @@ def _direct_solve(A, b, symmetric, context=None, factorisation="superlu"):
         from .pardiso import PardisoFactor
 
         state = context if context is not None else {}
-        factor = state.get("pardiso")
+        key = "pardiso" if symmetric else "pardiso_nonsymmetric"
+        factor = state.get(key)
         if factor is None:
-            factor = state["pardiso"] = PardisoFactor()
+            factor = state[key] = PardisoFactor(symmetric)
         try:
             x = factor.solve(A, b)
         except RuntimeError:  # a (nearly) singular tangent: SuperLU's pivoting decides, as before
             x = None
         if x is not None:
-            state["direct_solver"] = "pardiso"
+            state["direct_solver"] = "pardiso" if symmetric else "pardiso (non-symmetric)"
             if factor.inertia is not None and factor.inertia[1] > 0:
                 state["indefinite"] = True  # CG is not tried again on this problem's tangents
             return x

@@ -11,14 +11,16 @@ import numpy as np
 from .amg import _preconditioner
 from .amg_cycle import _matvec_of, _VCycle
 from .direct import _direct_solve
-from .policy import banded_cholesky_is_cheap, choose_factorisation, choose_linear_solver
+from .policy import as_symmetric, banded_cholesky_is_cheap, choose_factorisation, choose_linear_solver
 from .protocol import NewtonFailure
 
 
 def solve_linear_system(A, b, method, symmetric, messages, context=None, rtol=1e-10, truncate=False):
     """Solve ``A x = b``; raise NewtonFailure when the matrix is singular or the solve fails.
 
-    The solver is the one :func:`~msslib.solvers.policy.choose_linear_solver` chooses.
+    The solver is the one :func:`~msslib.solvers.policy.choose_linear_solver` chooses; a matrix
+    declared non-symmetric that is symmetric to round-off is solved as symmetric
+    (:func:`~msslib.solvers.policy.as_symmetric`).
     ``context`` (optional dict) holds ``dim`` and ``coords`` (free nodes) for the AMG near-null
     space and a ``cache`` where the AMG hierarchy is kept and reused for the next matrices
     (Newton iterations, load steps, later static solves of the same problem, time steps) as long
@@ -28,6 +30,7 @@ def solve_linear_system(A, b, method, symmetric, messages, context=None, rtol=1e
     (relative to ``||b||``).  With ``truncate``, a CG run that meets negative
     curvature returns its last iterate (truncated Newton: used under an energy line search)
     instead of falling back to sparse LU."""
+    A, symmetric = as_symmetric(A, symmetric)  # symmetric to round-off: the symmetric way
     indefinite = (not truncate and context is not None and bool(context.get("indefinite"))
                   and choose_factorisation(A.shape[0], symmetric) == "pardiso")
     choice = choose_linear_solver(method, A.shape[0], symmetric, lambda: banded_cholesky_is_cheap(A, context),

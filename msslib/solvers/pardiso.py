@@ -1,9 +1,11 @@
-"""MKL Pardiso for the large symmetric Newton systems (through ``pypardiso``, a dependency where
+"""MKL Pardiso for the large Newton systems (through ``pypardiso``, a dependency where
 MKL has wheels: Linux and Windows on x86-64; elsewhere :func:`available` is False and the
 direct solves stay with SuperLU).
 
 Symmetric indefinite factorisation (``mtype = -2``: Bunch-Kaufman pivoting, positive definite or
-not, as a Newton tangent of a finite-strain law past a limit point), of the upper triangle.  One
+not, as a Newton tangent of a finite-strain law past a limit point), of the upper triangle; real
+non-symmetric factorisation (``mtype = 11``: pivoting with weighted matching and scaling, as the
+tangent of a follower pressure) of the whole matrix.  One
 :class:`PardisoFactor` is kept in a solver context: the symbolic analysis (fill-reducing ordering)
 of a pattern is done once and reused by every later matrix of that pattern (Newton iterations,
 load steps, time steps); each new matrix costs a numerical factorisation only.  Measured on the
@@ -38,21 +40,29 @@ def available() -> bool:
 
 
 class PardisoFactor:
-    """A Pardiso solver of symmetric matrices that keeps the analysis of their pattern.
+    """A Pardiso solver that keeps the analysis of its matrices' pattern: symmetric (the default)
+    or, with ``symmetric=False``, real non-symmetric.
 
     :meth:`solve` returns ``A^-1 b`` or raises RuntimeError (singular matrix, Pardiso error).
-    ``inertia``: ``(positive, negative)`` eigenvalue counts of the last factorised matrix
-    (Sylvester's law on the ``L D L^T`` factor): 0 negative means positive definite."""
+    ``inertia`` (symmetric only, else None): ``(positive, negative)`` eigenvalue counts of the
+    last factorised matrix (Sylvester's law on the ``L D L^T`` factor): 0 negative means positive
+    definite."""
 
-    def __init__(self):
+    def __init__(self, symmetric: bool = True):
         if not available():
             raise RuntimeError("pypardiso (MKL Pardiso) is not installed")
-        self._s = _SOLVER.PyPardisoSolver(mtype=-2)
+        self.symmetric = bool(symmetric)
+        self._s = _SOLVER.PyPardisoSolver(mtype=-2 if self.symmetric else 11)
         self._s.set_iparm(1, 1)  # user settings below, the rest default
         self._s.set_iparm(2, 2)  # nested dissection (METIS) ordering
         self._s.set_iparm(8, 2)  # at most two steps of iterative refinement
-        self._s.set_iparm(10, 8)  # pivots perturbed by 1e-8 (symmetric indefinite default)
-        self._s.set_iparm(21, 1)  # Bunch-Kaufman 1x1 and 2x2 pivoting
+        if self.symmetric:
+            self._s.set_iparm(10, 8)  # pivots perturbed by 1e-8 (symmetric indefinite default)
+            self._s.set_iparm(21, 1)  # Bunch-Kaufman 1x1 and 2x2 pivoting
+        else:
+            self._s.set_iparm(10, 13)  # pivots perturbed by 1e-13 (non-symmetric default)
+            self._s.set_iparm(11, 1)  # scaling and
+            self._s.set_iparm(13, 1)  # weighted matching (the non-symmetric defaults)
         self._pattern = None  # (indptr, indices) of the analysed upper triangle
         self._values = None
         self.inertia = None
@@ -64,7 +74,8 @@ class PardisoFactor:
         return self._s._call_pardiso(U, b)
 
     def solve(self, A, b):
-        U = sp.triu(sp.csr_matrix(A), format="csr")
+        U = sp.triu(sp.csr_matrix(A), format="csr") if self.symmetric else sp.csr_matrix(A, copy=True)
+        U.sum_duplicates()
         U.sort_indices()
         b = np.asarray(b, dtype=float)
         same = (self._pattern is not None and self._pattern[0].shape == U.indptr.shape
@@ -81,11 +92,16 @@ class PardisoFactor:
                 self._values = U.data.copy()
                 self.factorisations += 1
                 ip = self._s.iparm
-                self.inertia = (int(ip[21]), int(ip[22]))
-                if int(ip[13]) > 0 or self.inertia[0] + self.inertia[1] < U.shape[0]:
-                    self._values = None
-                    raise RuntimeError(f"singular matrix ({int(ip[13])} pivots perturbed, inertia "
-                                       f"{self.inertia[0]} positive / {self.inertia[1]} negative of {U.shape[0]})")
+                if not self.symmetric:
+                    if int(ip[13]) > 0:
+                        self._values = None
+                        raise RuntimeError(f"singular matrix ({int(ip[13])} pivots perturbed of {U.shape[0]})")
+                else:
+                    self.inertia = (int(ip[21]), int(ip[22]))
+                    if int(ip[13]) > 0 or self.inertia[0] + self.inertia[1] < U.shape[0]:
+                        self._values = None
+                        raise RuntimeError(f"singular matrix ({int(ip[13])} pivots perturbed, inertia "
+                                           f"{self.inertia[0]} positive / {self.inertia[1]} negative of {U.shape[0]})")
             x = np.asarray(self._call(33, U, b), dtype=float)
         except Exception as exc:  # pypardiso's error (a Pardiso error code) or ours
             self._values = None
@@ -107,7 +123,7 @@ class PardisoFactor:
             pass
 
     def __reduce__(self):  # a copy starts afresh (the factor lives in MKL's memory)
-        return (PardisoFactor, ())
+        return (PardisoFactor, (self.symmetric,))
 
 
 __all__ = ["PardisoFactor", "available"]
