@@ -241,5 +241,5 @@ def test_the_cpu_network_holds_a_bounded_monitor_for_many_steps(lloyd, monkeypat
     a.steps(600)
     for _ in range(6):
         b.steps(100)
-    assert a._mon.shape[0] <= 256
+    assert a._st.mon.shape[0] <= 256  # the network engine's monitor
     assert np.array_equal(a.positions(), b.positions()) and np.array_equal(a.velocities(), b.velocities())

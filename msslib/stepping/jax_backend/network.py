@@ -29,11 +29,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from msslib.errors import DivergenceError
-from msslib.stepping.network_kernels import N_MONITOR, network_forces, network_layout, network_steps, records
 
 from .device import check_precision, default_device, describe, use_jax, x64
 
-__all__ = ["JaxNetwork", "CpuNetwork", "network_engine", "network_arrays"]
+__all__ = ["JaxNetwork", "CpuNetwork", "network_engine", "network_arrays", "spring_model"]
 
 
 def network_arrays(model, load: float = 1.0):
@@ -113,7 +112,7 @@ class _NetworkBase:
             raise ValueError(f"springs refer to node {int(conn.max())}; the network has {self.n_nodes} nodes")
         self.n_springs = len(conn)
         if problem is None:
-            problem = _SpringProblem(springs, mass, free)
+            problem = self._array_problem(x0, conn, springs, mass, free, fext)
         self.stability = check_time_step(problem, x0, self.h, method="symplectic_euler", damping=self.alpha,
                                          load=load, allow_unstable=allow_unstable)
         self.free = free
@@ -123,7 +122,12 @@ class _NetworkBase:
         self.hfree = np.where(free, self.h, 0.0)
         v0[~free] = 0.0
         self.n_steps = 0
+        self._problem, self._mass, self._load = problem, mass, load
         self._setup(x0, v0, conn, springs.k, springs.rest_length, fext)
+
+    def _array_problem(self, x0, conn, springs, mass, free, fext):
+        """The problem whose stability limit is checked, for a network given as arrays."""
+        return _SpringProblem(springs, mass, free)
 
     @classmethod
     def from_model(cls, model, h, alpha=None, *, load: float = 1.0, x0=None, v0=None, **options):
@@ -153,50 +157,74 @@ class _NetworkBase:
 
 
 class CpuNetwork(_NetworkBase):
-    """The numba kernels of :mod:`msslib.stepping.network_kernels` (one CPU thread per network) behind the
+    """The network engine of the Simulator (:class:`msslib.stepping.network.NetworkStepper`, the
+    fused kernels of :mod:`msslib.stepping.network_kernels` on one CPU thread) behind the array
     interface of :class:`JaxNetwork`: ``steps(n)``, ``positions()``, ``velocities()``,
-    ``forces()``, ``reactions()``; always double precision."""
+    ``forces()``, ``reactions()``; always double precision.  Not a second wrapper of the kernels:
+    arrays without a model become a spring :class:`msslib.system.Model` (:func:`spring_model`),
+    and the steps are the stepper's, with its divergence detector."""
 
     backend = "numba"
     device = "cpu (numba)"
     precision = "double"
 
+    def _array_problem(self, x0, conn, springs, mass, free, fext):
+        return spring_model(x0, conn, springs.k, springs.rest_length, mass, free, fext)
+
     def _setup(self, x0, v0, conn, k, L0, fext):
-        self.layout = network_layout(conn, k, L0, self.n_nodes)
-        R = records(x0)
-        n = x0.size
-        self._state = (R, v0, np.zeros(n), self.w, 1.0 - self.h * self.alpha, self.h, fext, x0.copy(), np.zeros(n))
-        self._mon = np.zeros((1, N_MONITOR))
-        network_forces(self._state, self.layout, self._mon)
+        from msslib.stepping.network import NetworkStepper
+
+        # checked already, on the same model (the base class): the stepper's check reuses it
+        self._st = NetworkStepper(self._problem, x0, v0, dt=self.h, damping=self.alpha, load=self._load,
+                                  allow_unstable=True, free=self.free)
+        self._st.messages.clear()
 
     def steps(self, n: int):
-        """Advance ``n`` steps (the force is current after the call)."""
+        """Advance ``n`` steps (the force is current after the call); a divergence leaves the
+        state as it was before the call."""
         n = int(n)
         if n <= 0:
             return self
-        R, v, F = self._state[:3]
-        saved = (R.copy(), v.copy(), F.copy())
-        done = 0
-        while done < n:  # kernel calls of at most 256 steps: the monitor does not grow with n
-            k = min(256, n - done)
-            if self._mon.shape[0] < k:
-                self._mon = np.zeros((k, N_MONITOR))
-            network_steps(self._state, self.layout, self._mon, k)
-            done += k
-        if not (np.isfinite(R[:, :3]).all() and np.isfinite(v).all()):
-            R[:], v[:], F[:] = saved
+        st = self._st
+        saved = (st.R.copy(), st.v.copy(), st.F.copy(), st.t, st.n_taken)
+        try:
+            st.steps(n)
+            ok = bool(np.isfinite(st.x).all() and np.isfinite(st.v).all())
+        except DivergenceError:
+            ok = False
+        if not ok:
+            st.R[:], st.v[:], st.F[:] = saved[:3]
+            st.t, st.n_taken = saved[3], saved[4]
             self._diverged(n)
         self.n_steps += n
         return self
 
     def positions(self) -> np.ndarray:
-        return self._state[0][:, :3].reshape(-1).copy()
+        return np.array(self._st.x, dtype=float).reshape(-1)
 
     def velocities(self) -> np.ndarray:
-        return self._state[1].copy()
+        return np.array(self._st.v, dtype=float).reshape(-1)
 
     def forces(self) -> np.ndarray:
-        return self._state[2].copy()
+        return np.array(self._st.F, dtype=float)
+
+
+def spring_model(x0, conn, k, rest_length, mass, free, fext):
+    """A :class:`msslib.system.Model` of 3D springs given as arrays (no cells: a network has no
+    elements), with dead loads ``fext`` (flat), masses ``mass`` (flat, one value per node
+    repeated over its three dofs) and the supports ``~free``."""
+    from msslib.mesh import Mesh
+    from msslib.system import Model
+    from msslib.terms import ExternalForce, Springs
+
+    x0 = np.asarray(x0, dtype=float).reshape(-1, 3)
+    mass = np.asarray(mass, dtype=float).reshape(-1, 3)
+    if np.any(mass != mass[:, :1]):
+        raise ValueError("mass must be one value per node, repeated over its three dofs")
+    mesh = Mesh(x0, np.zeros((0, 4), dtype=np.int64), "tetra")
+    springs = Springs(np.asarray(conn, dtype=np.int64).reshape(-1, 2), k, rest_length, 3, signed=True)
+    terms = [springs, ExternalForce(np.asarray(fext, dtype=float).reshape(-1, 3), 3)]
+    return Model(mesh, terms, masses=mass[:, 0], fixed=~np.asarray(free, dtype=bool).reshape(-1, 3))
 
 
 def _spring_force(jnp, segment_sum, x, a, b, k, L0, n_nodes, dtype):
