@@ -102,20 +102,17 @@ def test_collatz_wielandt_bound_is_never_below_the_top_eigenvalue(name):
         assert ST.collatz_wielandt_bound(model, x, free, 0.999 * rho)[0] is None
         # B column by column, from the same kernels
         springs = ST._spring_terms(model)
+        rowptr, ib, conn, k, L0 = ST._row_layout(springs, model.n_nodes)
         diag = np.zeros((model.n_nodes, 3, 3))
+        coef = np.empty((len(conn), 5))
+        assert ST._spring_abs_prep(np.ravel(x), conn, k, L0, isq, coef, diag)
+        R = np.zeros((model.n_nodes, 6))
         cols = []
-        prepared = []
-        for t in springs:
-            coef = np.empty((len(t.conn), 5))
-            assert ST._spring_abs_prep(np.ravel(x), t.conn.astype(np.int64), t.k, t.rest_length, isq, coef, diag)
-            prepared.append((t.conn.astype(np.int64), coef))
         for j in range(model.n_dof):
             e = np.zeros(model.n_dof)
             e[j] = 1.0
             out = np.zeros(model.n_dof)
-            for conn, coef in prepared:
-                ST._abs_matvec(conn, coef, isq * e, out)
-            out = out * isq + np.einsum("ipq,iq->ip", np.abs(diag), e.reshape(-1, 3)).ravel()
+            ST._abs_row_product(R, rowptr, ib, coef, isq, np.abs(diag), e, out)
             cols.append(out)
         B = np.column_stack(cols)
         assert np.all(B >= A - 1e-12 * A.max())

@@ -55,35 +55,11 @@ def _spring_prep(x, conn, k, L0, isq, coef, shift_rows):
 
 
 @njit(cache=True, nogil=True)
-def _spring_matvec(conn, coef, u, out):
-    """``out += K u`` for springs prepared by :func:`_spring_prep`."""
-    for s in range(conn.shape[0]):
-        a = 3 * conn[s, 0]
-        b = 3 * conn[s, 1]
-        u0 = u[b] - u[a]
-        u1 = u[b + 1] - u[a + 1]
-        u2 = u[b + 2] - u[a + 2]
-        n0 = coef[s, 0]
-        n1 = coef[s, 1]
-        n2 = coef[s, 2]
-        t = coef[s, 3] * (n0 * u0 + n1 * u1 + n2 * u2)
-        c = coef[s, 4]
-        f0 = t * n0 + c * u0
-        f1 = t * n1 + c * u1
-        f2 = t * n2 + c * u2
-        out[a] -= f0
-        out[a + 1] -= f1
-        out[a + 2] -= f2
-        out[b] += f0
-        out[b + 1] += f1
-        out[b + 2] += f2
-
-
-@njit(cache=True, nogil=True)
 def _spring_abs_prep(x, conn, k, L0, isq, coef, diag):
-    """For :func:`_abs_matvec`: per spring ``coef[s] = (|n|, k L0/l, |k (1 - L0/l)|)``, and into
-    ``diag`` (nodes, 3, 3) the node blocks of ``D K D`` (signed sums).  False for coincident
-    nodes."""
+    """For :func:`_abs_row_product`: per spring ``coef[s] = (|n|, k L0/l, |k (1 - L0/l)|)``, and
+    into ``diag`` (nodes, 3, 3) the node blocks of ``D K D`` (signed sums).  False for coincident
+    nodes.  ``|H| <= k L0/l |n| |n|^T + |k (1 - L0/l)| I`` entrywise for the spring's block
+    ``H``."""
     for s in range(conn.shape[0]):
         na = conn[s, 0]
         nb = conn[s, 1]
@@ -116,35 +92,98 @@ def _spring_abs_prep(x, conn, k, L0, isq, coef, diag):
     return True
 
 
-@njit(cache=True, nogil=True)
-def _abs_matvec(conn, coef, u, out):
-    """``out += |H| u`` summed over the springs, with ``|H| <= k L0/l |n| |n|^T + |k (1 - L0/l)| I``
-    (``u`` the vector scaled by ``M^-1/2``; the caller scales ``out`` and adds the node blocks)."""
-    for s in range(conn.shape[0]):
-        a = 3 * conn[s, 0]
-        b = 3 * conn[s, 1]
-        m0 = coef[s, 0]
-        m1 = coef[s, 1]
-        m2 = coef[s, 2]
-        kr = coef[s, 3]
-        c = coef[s, 4]
-        ua0 = u[a]
-        ua1 = u[a + 1]
-        ua2 = u[a + 2]
-        ub0 = u[b]
-        ub1 = u[b + 1]
-        ub2 = u[b + 2]
-        ta = kr * (m0 * ua0 + m1 * ua1 + m2 * ua2)
-        tb = kr * (m0 * ub0 + m1 * ub1 + m2 * ub2)
-        out[a] += tb * m0 + c * ub0
-        out[a + 1] += tb * m1 + c * ub1
-        out[a + 2] += tb * m2 + c * ub2
-        out[b] += ta * m0 + c * ua0
-        out[b + 1] += ta * m1 + c * ua1
-        out[b + 2] += ta * m2 + c * ua2
-
-
 _CW_MAX_PRODUCTS = 16
+
+
+@njit(cache=True, nogil=True)
+def _abs_row_product(R, rowptr, ib, coef, isq, absdiag, w, out):
+    """``out = B w`` of :func:`collatz_wielandt_bound`: ``D |H| D`` of every spring (the bound of
+    :func:`_spring_abs_prep`) between its two nodes plus the absolute node blocks ``absdiag`` of
+    ``D K D``, for springs in rows by lower node (:func:`_row_layout`); ``R`` (nodes, 6) is
+    scratch."""
+    nn = rowptr.shape[0] - 1
+    for i in range(nn):
+        for p in range(3):
+            R[i, p] = isq[3 * i + p] * w[3 * i + p]
+            R[i, 3 + p] = 0.0
+    for na in range(nn):
+        ua0 = R[na, 0]
+        ua1 = R[na, 1]
+        ua2 = R[na, 2]
+        ga0 = R[na, 3]
+        ga1 = R[na, 4]
+        ga2 = R[na, 5]
+        for s in range(rowptr[na], rowptr[na + 1]):
+            b = ib[s]
+            m0 = coef[s, 0]
+            m1 = coef[s, 1]
+            m2 = coef[s, 2]
+            kr = coef[s, 3]
+            c = coef[s, 4]
+            ub0 = R[b, 0]
+            ub1 = R[b, 1]
+            ub2 = R[b, 2]
+            ta = kr * (m0 * ua0 + m1 * ua1 + m2 * ua2)
+            tb = kr * (m0 * ub0 + m1 * ub1 + m2 * ub2)
+            ga0 += tb * m0 + c * ub0
+            ga1 += tb * m1 + c * ub1
+            ga2 += tb * m2 + c * ub2
+            R[b, 3] += ta * m0 + c * ua0
+            R[b, 4] += ta * m1 + c * ua1
+            R[b, 5] += ta * m2 + c * ua2
+        a = 3 * na
+        w0 = w[a]
+        w1 = w[a + 1]
+        w2 = w[a + 2]
+        for p in range(3):
+            g = ga0 if p == 0 else (ga1 if p == 1 else ga2)
+            out[a + p] = isq[a + p] * g + absdiag[na, p, 0] * w0 + absdiag[na, p, 1] * w1 + absdiag[na, p, 2] * w2
+
+
+@njit(cache=True, nogil=True)
+def _cw_rows(rowptr, ib, coef, isq, absdiag, lam_target, max_products):
+    """The power iterations of :func:`collatz_wielandt_bound` on springs in rows:
+    ``(bound, products, accepted)``."""
+    n = isq.shape[0]
+    R = np.zeros((rowptr.shape[0] - 1, 6))
+    w = np.zeros(n)
+    Bw = np.empty(n)
+    n_active = 0
+    for i in range(n):
+        if isq[i] > 0.0:
+            w[i] = 1.0
+            n_active += 1
+    prev = -1.0
+    best = np.inf
+    for k in range(1, max_products + 1):
+        _abs_row_product(R, rowptr, ib, coef, isq, absdiag, w, Bw)
+        hi = 0.0
+        lo = np.inf
+        for i in range(n):
+            if isq[i] > 0.0:
+                r = Bw[i] / w[i]
+                if not r <= hi:  # larger, or not a number
+                    hi = r
+                lo = min(lo, r)
+        hi = hi * (1.0 + 1e-12) if n_active else 0.0
+        if not hi < np.inf:  # not finite: no bound
+            return best, k, False
+        best = min(best, hi)
+        if best <= lam_target:
+            return best, k, True
+        if lo >= lam_target:
+            return best, k, False  # rho(B) is above the target: no w brings the bound there
+        if prev >= 0.0 and best - lam_target > (prev - best) * (max_products - k):
+            return best, k, False
+        prev = best
+        top = 0.0
+        for i in range(n):
+            wi = Bw[i] + 1e-9 * hi * w[i]  # stays positive
+            w[i] = wi
+            top = max(top, wi)
+        for i in range(n):
+            w[i] /= top
+    return best, max_products, False
 
 
 def _spring_terms(problem):
@@ -163,7 +202,7 @@ def _spring_terms(problem):
     return springs or None
 
 
-def collatz_wielandt_bound(problem, x, free, lam_target: float) -> tuple[float | None, int]:
+def collatz_wielandt_bound(problem, x, free, lam_target: float, layout=None) -> tuple[float | None, int]:
     """A deterministic bound of the top eigenvalue of ``A = M^-1/2 K M^-1/2`` (free dofs) of a
     3D spring model, tried up to ``lam_target``: ``(lam, products)`` with ``lam <= lam_target``,
     or None when it does not get there (or the model is not springs and dead loads only).
@@ -182,41 +221,13 @@ def collatz_wielandt_bound(problem, x, free, lam_target: float) -> tuple[float |
     m = mass_vector(problem)
     isq = np.zeros(m.size)
     isq[free] = 1.0 / np.sqrt(m[free])
-    x = np.ascontiguousarray(x, dtype=float).reshape(-1)
+    rowptr, ib, conn, k, L0 = layout if layout is not None else _row_layout(springs, m.size // 3)
     diag = np.zeros((m.size // 3, 3, 3))
-    prepared = []
-    for t in springs:
-        conn = np.ascontiguousarray(t.conn, dtype=np.int64)
-        coef = np.empty((len(conn), 5))
-        if not _spring_abs_prep(x, conn, np.asarray(t.k, dtype=float), np.asarray(t.rest_length, dtype=float), isq,
-                                coef, diag):
-            return None, 0
-        prepared.append((conn, coef))
-    absdiag = np.abs(diag)
-    active = isq > 0.0
-    w = active.astype(float)
-    prev = None
-    best = np.inf
-    for k in range(1, _CW_MAX_PRODUCTS + 1):
-        u = isq * w
-        Bw = np.zeros(m.size)
-        for conn, coef in prepared:
-            _abs_matvec(conn, coef, u, Bw)
-        Bw *= isq
-        Bw += np.einsum("ipq,iq->ip", absdiag, w.reshape(-1, 3)).reshape(-1)
-        ratio = Bw[active] / w[active]
-        hi = float(ratio.max()) * (1.0 + 1e-12) if ratio.size else 0.0
-        best = min(best, hi)
-        if best <= lam_target:
-            return best, k
-        if float(ratio.min()) >= lam_target:
-            return None, k  # rho(B) is above the target: no w brings the bound there
-        if prev is not None and best - lam_target > (prev - best) * (_CW_MAX_PRODUCTS - k):
-            return None, k
-        prev = best
-        w = Bw + 1e-9 * hi * w  # stays positive
-        w /= w.max()
-    return None, _CW_MAX_PRODUCTS
+    coef = np.empty((len(conn), 5))
+    if not _spring_abs_prep(np.ascontiguousarray(x, dtype=float).reshape(-1), conn, k, L0, isq, coef, diag):
+        return None, 0
+    lam, products, ok = _cw_rows(rowptr, ib, coef, isq, np.abs(diag), float(lam_target), _CW_MAX_PRODUCTS)
+    return (float(lam), int(products)) if ok else (None, int(products))
 
 
 def _scaled_operator(problem, x, load, free):
@@ -229,42 +240,25 @@ def _scaled_operator(problem, x, load, free):
     into a semidefinite part and, for a compressed spring, ``k (1 - L0/l) I`` < 0, whose
     Gershgorin bound is the shift (0 when no spring is compressed).  Any other model assembles
     its stiffness and takes minus Gershgorin's lower bound of its spectrum."""
-    from msslib.terms.internal import Springs
-
     m = mass_vector(problem)
     if np.any(m[free] <= 0):
         raise ValueError("masses of free dofs must be positive")
     isq = np.zeros(m.size)
     isq[free] = 1.0 / np.sqrt(m[free])
     x = np.ascontiguousarray(x, dtype=float).reshape(-1)
-    springs, ok = [], getattr(problem, "terms", None) is not None and int(getattr(problem, "dim", 0)) == 3
-    for t in getattr(problem, "terms", None) or ():
-        if not ok:
-            break
-        if type(t) is Springs and t.dim == 3 and not getattr(t, "scales_with_load", False) and np.all(t.k >= 0):
-            springs.append(t)
-        elif not (t.kind == "external" and t.abs_row_sums(np.zeros(0), 1.0, np.zeros(0), np.zeros(0))):
-            ok = False  # a term with stiffness of its own: assemble
-    if ok and springs:
-        prepared, shift_rows = [], np.zeros(m.size)
-        for t in springs:
-            conn = np.ascontiguousarray(t.conn, dtype=np.int64)
-            coef = np.empty((len(conn), 5))
-            if not _spring_prep(x, conn, np.asarray(t.k, dtype=float), np.asarray(t.rest_length, dtype=float),
-                                isq, coef, shift_rows):
-                ok = False
-                break
-            prepared.append((conn, coef))
-        if ok:
+    springs = _spring_terms(problem)
+    if springs is not None:
+        rows = spring_rows(x, springs, isq)
+        if rows is not None:
+            rowptr, ib, coef, shift = rows
+            R = np.zeros((m.size // 3, 6))
+
             def matvec(v):  # D K D v
-                u = isq * v
-                out = np.zeros(v.size)
-                for conn, coef in prepared:
-                    _spring_matvec(conn, coef, u, out)
-                out *= isq
+                out = np.empty(v.size)
+                _row_product(R, rowptr, ib, coef, isq, np.ascontiguousarray(v, dtype=float), 0.0, out)
                 return out
 
-            return matvec, m.size, float(shift_rows.max()) if shift_rows.size else 0.0
+            return matvec, m.size, shift
     A = sp.csr_matrix(problem.stiffness(x, load), dtype=float, copy=True)
     A.data *= np.repeat(isq, np.diff(A.indptr)) * isq[A.indices]
     diag = A.diagonal()
@@ -327,3 +321,212 @@ def certified_omega_max(matvec, n: int, shift: float, omega_target: float, seed:
         beta.append(b)
         q = w / b
     return None, steps
+
+
+# ---- the certified run of a spring model in one compiled call ------------------------------------
+# The short Lanczos run above, for 3D spring models, without a Python call per step: the springs
+# are stored once under their lower node (``rowptr`` offsets by node, ``ib`` the other ends, ``coef``
+# the per-spring (n, k L0/l, k (1 - L0/l)) of :func:`_spring_prep`), and the vector ``D q`` and the
+# accumulator of ``K D q`` are one record of six numbers per node (the fused step kernel's
+# layout): a product reads each spring once and the other end's record in one cache line, and a
+# node's row of ``D K D q`` is complete when its own row is done.  The Ritz value comes from
+# Sturm-sequence bisection of the tridiagonal matrix, kept on the safe (upper) side.
+
+
+@njit(cache=True, nogil=True)
+def _rows_by_lower_node(conn, n_nodes, rowptr, order, ib):
+    """Counting sort of the springs by their lower node: ``rowptr`` (n_nodes + 1), ``order`` (the
+    spring of each slot) and ``ib`` (its upper node)."""
+    for s in range(conn.shape[0]):
+        rowptr[min(conn[s, 0], conn[s, 1]) + 1] += 1
+    for i in range(n_nodes):
+        rowptr[i + 1] += rowptr[i]
+    fill = rowptr[:-1].copy()
+    for s in range(conn.shape[0]):
+        a = min(conn[s, 0], conn[s, 1])
+        j = fill[a]
+        fill[a] += 1
+        order[j] = s
+        ib[j] = max(conn[s, 0], conn[s, 1])
+
+
+@njit(cache=True, nogil=True)
+def _row_product(R, rowptr, ib, coef, isq, q, shift, w):
+    """``w = (D K D + shift I) q`` and ``q.w`` for springs in rows (see above); ``R`` (nodes, 6) is
+    scratch.  Spring ``(a, b)``, ``a < b``: its force on ``b`` is ``f = t n + c (u_b - u_a)``."""
+    nn = rowptr.shape[0] - 1
+    for i in range(nn):
+        for p in range(3):
+            R[i, p] = isq[3 * i + p] * q[3 * i + p]
+            R[i, 3 + p] = 0.0
+    dot = 0.0
+    for na in range(nn):
+        ua0 = R[na, 0]
+        ua1 = R[na, 1]
+        ua2 = R[na, 2]
+        ga0 = R[na, 3]
+        ga1 = R[na, 4]
+        ga2 = R[na, 5]
+        for s in range(rowptr[na], rowptr[na + 1]):
+            b = ib[s]
+            u0 = R[b, 0] - ua0
+            u1 = R[b, 1] - ua1
+            u2 = R[b, 2] - ua2
+            n0 = coef[s, 0]
+            n1 = coef[s, 1]
+            n2 = coef[s, 2]
+            t = coef[s, 3] * (n0 * u0 + n1 * u1 + n2 * u2)
+            c = coef[s, 4]
+            f0 = t * n0 + c * u0
+            f1 = t * n1 + c * u1
+            f2 = t * n2 + c * u2
+            ga0 -= f0
+            ga1 -= f1
+            ga2 -= f2
+            R[b, 3] += f0
+            R[b, 4] += f1
+            R[b, 5] += f2
+        for p in range(3):
+            j = 3 * na + p
+            wj = isq[j] * (ga0 if p == 0 else (ga1 if p == 1 else ga2)) + shift * q[j]
+            w[j] = wj
+            dot += q[j] * wj
+    return dot
+
+
+@njit(cache=True, nogil=True)
+def _sturm_count(alpha, beta, k, x):
+    """Eigenvalues of the tridiagonal ``T_k`` (diagonal ``alpha``, off-diagonal ``beta``) below ``x``."""
+    count = 0
+    d = 1.0
+    for i in range(k):
+        b2 = beta[i - 1] * beta[i - 1] if i else 0.0
+        d = alpha[i] - x - (b2 / d if i else 0.0)
+        if d == 0.0:
+            d = -1e-300
+        if d < 0.0:
+            count += 1
+    return count
+
+
+@njit(cache=True, nogil=True)
+def _top_ritz(alpha, beta, k):
+    """An upper end of a bracket of the largest eigenvalue of ``T_k`` (relative width 1e-13):
+    bisection on Sturm counts inside Gershgorin's interval."""
+    lo = np.inf
+    hi = -np.inf
+    for i in range(k):
+        r = (abs(beta[i - 1]) if i else 0.0) + (abs(beta[i]) if i + 1 < k else 0.0)
+        lo = min(lo, alpha[i] - r)
+        hi = max(hi, alpha[i] + r)
+    for _ in range(200):
+        if hi - lo <= 1e-13 * max(abs(hi), abs(lo), 1e-300):
+            break
+        mid = 0.5 * (lo + hi)
+        if _sturm_count(alpha, beta, k, mid) == k:  # every eigenvalue below mid
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _reorthogonalise(Q, k, w, h):
+    """``w -= Q_k^T (Q_k w)``: classical Gram-Schmidt against the first ``k`` rows of ``Q``."""
+    n = w.shape[0]
+    for r in range(k):
+        s = 0.0
+        for i in range(n):
+            s += Q[r, i] * w[i]
+        h[r] = s
+    for r in range(k):
+        hr = h[r]
+        for i in range(n):
+            w[i] -= hr * Q[r, i]
+
+
+@njit(cache=True, nogil=True)
+def _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, max_steps, Q, alpha, beta):
+    """The run of :func:`certified_omega_max` on springs in rows, from the unit vector ``q``:
+    ``(bound of lambda_max(A + shift I) or -1.0, steps)``."""
+    n = q.shape[0]
+    R = np.zeros((rowptr.shape[0] - 1, 6))
+    w = np.empty(n)
+    h = np.empty(max_steps)
+    for j in range(max_steps):
+        Q[j, :] = q
+        a = _row_product(R, rowptr, ib, coef, isq, q, shift, w)
+        for i in range(n):
+            w[i] -= a * q[i]
+        if j:
+            bj = beta[j - 1]
+            for i in range(n):
+                w[i] -= bj * Q[j - 1, i]
+        _reorthogonalise(Q, j + 1, w, h)
+        alpha[j] = a
+        k = j + 1
+        theta = _top_ritz(alpha, beta, k) if j else a
+        theta = max(theta, 0.0) * (1.0 + 1e-9)  # round-off of the Ritz value
+        eps = (c / (2 * k - 1)) ** 2
+        if eps < 1.0 and theta / (1.0 - eps) <= target:
+            return theta / (1.0 - eps), k
+        if theta >= target:
+            return -1.0, k  # a Ritz value above the target: the step is over the limit
+        if (c / np.sqrt(1.0 - theta / target) + 1.0) / 2.0 > max_steps:
+            return -1.0, k  # too many steps would be needed if theta did not grow
+        b = 0.0
+        for i in range(n):
+            b += w[i] * w[i]
+        b = np.sqrt(b)
+        if not b > 1e-13 * max(abs(a), theta, 1e-300):
+            return -1.0, k  # an invariant subspace: no further step
+        beta[j] = b
+        for i in range(n):
+            q[i] = w[i] / b
+    return -1.0, max_steps
+
+
+def _row_layout(springs, n_nodes):
+    """The springs of the terms ``springs`` in rows by lower node: ``(rowptr, ib, conn, k, L0)``,
+    ``conn`` (s, 2) the (lower, upper) nodes of each slot, ``k`` and ``L0`` its constants."""
+    conn = np.ascontiguousarray(np.concatenate([t.conn for t in springs]), dtype=np.int64)
+    k = np.concatenate([np.asarray(t.k, dtype=float) for t in springs])
+    L0 = np.concatenate([np.asarray(t.rest_length, dtype=float) for t in springs])
+    rowptr = np.zeros(n_nodes + 1, dtype=np.int64)
+    order = np.empty(len(conn), dtype=np.int64)
+    ib = np.empty(len(conn), dtype=np.int64)
+    _rows_by_lower_node(conn, n_nodes, rowptr, order, ib)
+    lower = np.repeat(np.arange(n_nodes, dtype=np.int64), np.diff(rowptr))
+    return rowptr, ib, np.column_stack([lower, ib]), k[order], L0[order]
+
+
+def spring_rows(x, springs, isq, layout=None):
+    """The springs of the terms ``springs`` at ``x`` in rows by lower node for
+    :func:`certified_springs`: ``(rowptr, ib, coef, shift)`` (``shift`` as in
+    :func:`_scaled_operator`), or None for coincident nodes.  ``layout``: :func:`_row_layout`
+    of the same springs, when the caller has it."""
+    x = np.ascontiguousarray(x, dtype=float).reshape(-1)
+    rowptr, ib, conn, k, L0 = layout if layout is not None else _row_layout(springs, x.size // 3)
+    coef = np.empty((len(conn), 5))
+    shift_rows = np.zeros(x.size)
+    if not _spring_prep(x, conn, k, L0, isq, coef, shift_rows):
+        return None
+    return rowptr, ib, coef, float(shift_rows.max()) if shift_rows.size else 0.0
+
+
+def certified_springs(rows, isq, omega_target: float, seed: int) -> tuple[float | None, int]:
+    """:func:`certified_omega_max` for springs in rows (:func:`spring_rows`), the whole run in
+    one compiled call: the same start vector, steps and bound, with the Ritz value from
+    Sturm bisection (upper end of its bracket) instead of LAPACK."""
+    rowptr, ib, coef, shift = rows
+    n = isq.size
+    target = omega_target * omega_target + shift
+    c = float(np.log(1.648 * np.sqrt(n) / CERTIFICATE_FAILURE))
+    steps = min(_CERT_MAX_STEPS, n)
+    q = np.random.default_rng(seed).standard_normal(n)
+    q /= np.linalg.norm(q)
+    lam, k = _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, steps, np.empty((steps, n)),
+                             np.zeros(steps), np.zeros(steps))
+    if lam < 0.0:
+        return None, int(k)
+    return float(np.sqrt(max(lam - shift, 0.0))), int(k)
