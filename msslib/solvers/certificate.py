@@ -448,11 +448,27 @@ def _reorthogonalise(Q, k, w, h):
 @njit(cache=True, nogil=True)
 def _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, max_steps, Q, alpha, beta):
     """The run of :func:`certified_omega_max` on springs in rows, from the unit vector ``q``:
-    ``(bound of lambda_max(A + shift I) or -1.0, steps)``."""
+    ``(bound of lambda_max(A + shift I) or -1.0, steps)``.
+
+    The basis is kept semiorthogonal (Simon's partial reorthogonalisation): the recurrence of
+    H. D. Simon (Math. Comp. 42 (1984) 115-142) estimates ``q_j . q_k`` from the Lanczos
+    coefficients, with a round-off term of ``eps sqrt(n) ||T||`` per step on the pessimistic side,
+    and the new vector (and the next) is reorthogonalised against the whole basis when an
+    estimate exceeds ``sqrt(eps)``; the tridiagonal matrix is then the projection of ``A`` on the
+    Krylov space to working precision, so its Ritz values are those of the fully
+    reorthogonalised run to round-off."""
     n = q.shape[0]
     R = np.zeros((rowptr.shape[0] - 1, 6))
     w = np.empty(n)
     h = np.empty(max_steps)
+    om_old = np.zeros(max_steps + 1)  # estimates of q_{j-1} . q_k
+    om = np.zeros(max_steps + 1)  # of q_j . q_k
+    om_new = np.zeros(max_steps + 1)
+    om[0] = 1.0
+    unit = 2.220446049250313e-16
+    noise = unit * np.sqrt(n)
+    force = False
+    tnorm = 0.0
     for j in range(max_steps):
         Q[j, :] = q
         a = _row_product(R, rowptr, ib, coef, isq, q, shift, w)
@@ -462,7 +478,6 @@ def _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, max_steps, Q, al
             bj = beta[j - 1]
             for i in range(n):
                 w[i] -= bj * Q[j - 1, i]
-        _reorthogonalise(Q, j + 1, w, h)
         alpha[j] = a
         k = j + 1
         theta = _top_ritz(alpha, beta, k) if j else a
@@ -474,10 +489,27 @@ def _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, max_steps, Q, al
             return -1.0, k  # a Ritz value above the target: the step is over the limit
         if (c / np.sqrt(1.0 - theta / target) + 1.0) / 2.0 > max_steps:
             return -1.0, k  # too many steps would be needed if theta did not grow
-        b = 0.0
-        for i in range(n):
-            b += w[i] * w[i]
-        b = np.sqrt(b)
+        b = np.sqrt(np.sum(w * w))
+        tnorm = max(tnorm, abs(a) + b + (beta[j - 1] if j else 0.0))
+        if b > 0.0:  # Simon's recurrence for q_{j+1} . q_k, k <= j
+            worst = 0.0
+            for kk in range(j):
+                v = (beta[kk] * om[kk + 1] + (alpha[kk] - a) * om[kk] - (beta[j - 1] * om_old[kk] if j else 0.0)
+                     + (beta[kk - 1] * om[kk - 1] if kk else 0.0))
+                v = (v + (noise * tnorm if v >= 0.0 else -noise * tnorm)) / b
+                om_new[kk] = v
+                worst = max(worst, abs(v))
+            om_new[j] = noise * tnorm / b
+            if force or worst > np.sqrt(unit):
+                _reorthogonalise(Q, j + 1, w, h)
+                b = np.sqrt(np.sum(w * w))
+                for kk in range(j + 1):
+                    om_new[kk] = noise
+                force = not force  # the next vector too, once
+            om_new[j + 1] = 1.0
+            for kk in range(j + 2):
+                om_old[kk] = om[kk]
+                om[kk] = om_new[kk]
         if not b > 1e-13 * max(abs(a), theta, 1e-300):
             return -1.0, k  # an invariant subspace: no further step
         beta[j] = b
