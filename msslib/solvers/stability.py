@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import threading
 
 import numpy as np
 import scipy.sparse as sp
@@ -248,24 +249,13 @@ def _lanczos_omega(problem, x, load, rows) -> tuple[float, bool]:
     if cache is not None and key in cache:
         return cache[key], True
     omega = float(np.sqrt(omega_max_squared(problem, x, load)))
-    try:
-        if cache is None:
-            cache = {}
-            problem._spectrum_cache = cache
-        if len(cache) >= 8:
-            cache.pop(next(iter(cache)))
-        cache[key] = omega
-    except (AttributeError, TypeError):  # a problem that takes no attributes: no reuse
-        pass
+    _keep(problem, key, omega)
     return omega, False
 
 
-def _certified(problem, x, load, rows, dt, method, alpha, beta, bound):
-    """``(omega, origin)`` from an estimate kept for this state (eigsh's, or a certified or
-    Collatz-Wielandt bound that covers ``dt``), else from :func:`collatz_wielandt_bound` or
-    :func:`certified_omega_max` when one of them accepts ``dt`` (kept), else None (the caller
-    asks eigsh)."""
-    key = _spectrum_key(x, load, rows)
+def _kept(problem, key, dt, method, alpha, beta):
+    """``(omega, origin)`` of an estimate kept for this state that decides ``dt`` (eigsh's, or a
+    certified or Collatz-Wielandt bound that covers it), else None."""
     cache = getattr(problem, "_spectrum_cache", None) or {}
     if key in cache:
         return cache[key], "lanczos (reused)"
@@ -275,6 +265,17 @@ def _certified(problem, x, load, rows, dt, method, alpha, beta, bound):
     kept = cache.get(("bound",) + key)
     if kept is not None and dt <= critical_time_step(kept, method, alpha, beta):
         return kept, "bound, Collatz-Wielandt (reused)"
+    return None
+
+
+def _certified(problem, x, load, rows, dt, method, alpha, beta, bound):
+    """``(omega, origin)`` from an estimate kept for this state (:func:`_kept`), else from
+    :func:`collatz_wielandt_bound` or :func:`certified_omega_max` when one of them accepts ``dt``
+    (kept), else None (the caller asks eigsh)."""
+    key = _spectrum_key(x, load, rows)
+    kept = _kept(problem, key, dt, method, alpha, beta)
+    if kept is not None:
+        return kept
     target = _omega_allowed(dt, method, alpha, beta, bound)
     if target is None or not bool(getattr(problem, "symmetric", True)):
         return None
@@ -309,7 +310,16 @@ def _free_isq(problem, free):
     return isq
 
 
+_CACHE_LOCK = threading.Lock()  # checks of the same model may run on several threads
+
+
 def _keep(problem, key, omega):
+    """Keep ``omega`` on the problem under ``key`` (the eight newest)."""
+    with _CACHE_LOCK:
+        _keep_locked(problem, key, omega)
+
+
+def _keep_locked(problem, key, omega):
     try:
         if getattr(problem, "_spectrum_cache", None) is None:
             problem._spectrum_cache = {}
@@ -322,7 +332,7 @@ def _keep(problem, key, omega):
 
 def check_time_step(problem, x, dt: float, *, method: str = "symplectic_euler", damping=None,
                     load: float = 1.0, allow_unstable: bool = False, omega_max: float | None = None,
-                    estimate: str = "auto") -> dict:
+                    estimate: str = "auto", cheap_only: bool = False) -> dict | None:
     """The stability limit of an explicit run from state ``x`` (the model at rest, prescribed
     displacements applied) and its check: raises :class:`msslib.errors.StabilityError` when
     ``dt`` exceeds it, unless ``allow_unstable``.
@@ -347,7 +357,11 @@ def check_time_step(problem, x, dt: float, *, method: str = "symplectic_euler", 
     limit is a safe lower bound of the true one,
     ``"certified (k Lanczos steps)"`` or ``"certified (reused)"``: likewise, except with
     probability 1e-9, ``"lanczos"``, ``"lanczos (reused)"`` or ``"given"``, when ``omega_max`` is
-    passed: a value computed earlier for the same state)."""
+    passed: a value computed earlier for the same state).
+
+    ``cheap_only``: return None instead of running the certificates or eigsh, when neither the
+    bound nor a kept estimate decides ``dt`` (:class:`msslib.stepping.generic.Integrator` then
+    runs the whole check on a second thread while the first steps run)."""
     if estimate not in ("auto", "lanczos"):
         raise ValueError(f"estimate must be 'auto' or 'lanczos', got {estimate!r}")
     alpha, beta = resolve_damping(problem, damping)
@@ -360,6 +374,11 @@ def check_time_step(problem, x, dt: float, *, method: str = "symplectic_euler", 
         certified = None
         if estimate == "auto" and dt <= critical_time_step(bound, method, alpha, beta):
             omega, origin = bound, "bound"
+        elif cheap_only and (estimate != "auto" or (kept := _kept(problem, _spectrum_key(x, load, rows), dt, method,
+                                                                  alpha, beta)) is None):
+            return None
+        elif cheap_only:
+            omega, origin = kept
         elif estimate == "auto" and (certified := _certified(problem, x, load, rows, dt, method, alpha, beta,
                                                              bound)) is not None:
             omega, origin = certified

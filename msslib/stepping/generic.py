@@ -18,7 +18,8 @@ from msslib.solvers.linear import solve_linear_system
 from msslib.solvers.submatrices import submatrix
 from msslib.solvers.protocol import TINY, DynamicResult
 from msslib.solvers.roundoff import force_magnitude_norm, convergence_threshold, roundoff_floor
-from msslib.solvers.stability import EXPLICIT_METHODS, mass_vector, resolve_damping, check_time_step
+from msslib.solvers.stability import EXPLICIT_METHODS, mass_vector, resolve_damping
+from msslib.stepping.check import PendingCheck, remember, settle, stability_check
 from msslib.solvers.statics import ARMIJO_C, MAX_BACKTRACKS, floor_text
 
 
@@ -266,21 +267,21 @@ class Integrator:
         self.stats = stats
         if drive is not None:
             drive(0.0, x)
-        self.limit = None
-        if self.explicit:
-            t_check = time.perf_counter()
-            with np.errstate(all="ignore"):
-                stats.update(check_time_step(problem, x, dt, method=method, damping=(self.alpha, self.beta),
-                                             load=load, allow_unstable=allow_unstable))
-            stats["stability_check_time"] = time.perf_counter() - t_check
-            self.limit = stats["stability_limit"]
+        self.limit = self._pending = None
+        if self.explicit:  # see msslib.stepping.check: pending on a thread, or decided here
+            got = stability_check(problem, x, dt, free=free, method=method, damping=(self.alpha, self.beta),
+                                  load=load, allow_unstable=allow_unstable)
+            if isinstance(got, PendingCheck):  # its information None until then
+                self._pending, self._restore_to = got, (x.copy(), v.copy(), 0.0, 0, 0.0)
+            else:
+                stats.update(got)
         self.conservative = protocol.is_conservative(problem, x, load)
         self.mf = mass[free]
         self.inv_m = 1.0 / self.mf
         self.messages: list[str] = []
-        if self.explicit and stats["dt_over_limit"] > 1.0:
+        if self.explicit and (stats["dt_over_limit"] or 0.0) > 1.0:
             self.messages.append(f"dt = {dt:.6g} s is {stats['dt_over_limit']:.3g} x the explicit stability limit "
-                                 f"{self.limit:.6g} s of the model at rest (allow_unstable)")
+                                 f"{stats['stability_limit']:.6g} s of the model at rest (allow_unstable)")
         # the plans of the free-dof submatrices and, for implicit Euler, the kept AMG hierarchy
         self.solver_context = linear_solve_context(problem, x, free)
         self.f_scale = self.magnitude = None
@@ -290,19 +291,16 @@ class Integrator:
             with np.errstate(all="ignore"):
                 K0 = submatrix(problem.stiffness(x, load), free, plans=self.solver_context)
                 self.magnitude = force_magnitude_norm(K0, x[free], np.nan_to_num(np.abs(load * f_load[free])))
-        # divergence detector (explicit methods): see _GROWTH_MIN
-        omega = stats["omega_max"] or 0.0
-        self.j_floor = (omega**4 * float(self.mf.sum()) * (_FLOOR_SIZE * _bbox_size(problem, self.x_ref)) ** 2
-                        if self.explicit and np.isfinite(omega) else 0.0)
+        # divergence detector (explicit methods): see _GROWTH_MIN; its scales from the check
         self.j_min = None
         # the amplitude sqrt(J) the loads and paths put in since the start (see note_input)
         self.a_in = 0.0
-        self._omega2 = omega**2 if self.explicit and np.isfinite(omega) else 0.0
+        if self._pending is None:
+            self._use_check()
         self._fixed = np.flatnonzero(~free)
         m_mean = float(self.mf.mean()) if self.mf.size else 1.0
         self._m_fixed = np.maximum(mass[self._fixed], m_mean)
         self._load_norm = None
-        self.growth = _growth_threshold(stats["dt_over_limit"]) if self.explicit else None
         self.flips = 0  # steps in a row whose force flipped sign
         self._zeros = np.zeros(int(free.sum()))
         self.x, self.v = x, v
@@ -312,11 +310,22 @@ class Integrator:
                 j = float(np.sum(self.f * self.f * self.inv_m))
                 self.j_min = j if np.isfinite(j) else None
 
+    def _use_check(self):
+        """The at-rest limit and the detector's scales from the stability check's ``omega_max``."""
+        omega = self.stats["omega_max"] or 0.0
+        finite = self.explicit and np.isfinite(omega)
+        self.limit, self._omega2 = self.stats["stability_limit"], omega**2 if finite else 0.0
+        self.j_floor = (omega**4 * float(self.mf.sum()) * (_FLOOR_SIZE * _bbox_size(self.problem, self.x_ref)) ** 2
+                        if finite else 0.0)
+        self.growth = _growth_threshold(self.stats["dt_over_limit"]) if self.explicit else None
+
     def restart_detector(self):
         """Set the detector's reference from the current force and velocity (after the caller set
         ``extra`` or ``load`` and re-evaluated the force): from rest, ``J_0 = a.M a``."""
         if not self.explicit:
             return
+        if self._pending is not None:  # the state a refused first call returns to
+            remember(self)
         self.j_min = None
         self.flips = 0
         if not np.any(np.asarray(self.v).reshape(-1)[self.free]):
@@ -336,6 +345,8 @@ class Integrator:
         extra nodal forces by its ``M^-1`` norm.  The detector measures growth against this scale
         too, so that a body at rest driven by a tool or a ramped load (J ~ 0 at the start) is not
         taken for an instability."""
+        if self._pending is not None:
+            settle(self)
         a = 0.0
         if self._fixed.size and x_fixed_before is not None:
             du = np.asarray(x_fixed_after, dtype=float) - np.asarray(x_fixed_before, dtype=float)
@@ -454,7 +465,9 @@ class Integrator:
 
     def observe(self, q, pf, ku, r, dmax, h, step, t, x_prev, v_prev, explicit_terms=True):
         """The divergence checks of one step from its monitor values (see :func:`_monitor`);
-        raises :class:`DivergenceError`."""
+        raises :class:`DivergenceError` (and the pending stability check's refusal)."""
+        if self._pending is not None:
+            settle(self)
         if not (np.isfinite(q) and dmax <= self.bound):
             _check_state(self.problem, self._flat_x(), self.v, self.x_ref, self.bound, step, t, self.dt, self.method,
                          x_prev, v_prev, self.limit)

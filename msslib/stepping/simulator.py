@@ -7,6 +7,7 @@ import time
 
 import numpy as np
 
+from msslib.stepping.check import deferred_checks
 from msslib.stepping.generic import Integrator
 
 from msslib.terms.pressure import outward_facets, pressure_nodal_forces
@@ -64,7 +65,10 @@ class Simulator:
     ``alpha`` or ``(alpha, beta)`` (None: the model's).  The explicit schemes check ``dt`` against
     the stability limit once, when the simulator is built (a cheap safe bound first, a certified
     short Lanczos run or the Lanczos estimate only when the step exceeds it, see
-    :func:`msslib.solvers.check_time_step`), and every step runs
+    :func:`msslib.solvers.check_time_step`; on a model of 20 000 free dofs or more, a step the
+    bound cannot decide is checked on a second thread while the first call steps, and a refusal
+    comes from that call, with the state as before it, and from every later one:
+    :mod:`msslib.stepping.check`), and every step runs
     the divergence checks of :func:`~msslib.stepping.integrate` (``allow_unstable``, ``blowup``).
 
     Loads, changeable between steps (each value a constant, a callable of time, or a table of
@@ -188,7 +192,8 @@ class Simulator:
                   blowup=self._options["blowup"], allow_unstable=self._options["allow_unstable"], free=free,
                   drive=drive)
         if self.engine == "network":
-            stepper = NetworkStepper(self.model, x, v, **kw)
+            with deferred_checks():  # a long stability check runs while the first call steps
+                stepper = NetworkStepper(self.model, x, v, **kw)
         elif self.engine == "jax":
             from .accelerated import JaxStepper
 
@@ -198,7 +203,8 @@ class Simulator:
 
             stepper = LatticeStepper(self.model, x, v, **kw)
         else:
-            stepper = Integrator(self.model, x, v, method=self._options["method"], **kw, **self._implicit)
+            with deferred_checks():
+                stepper = Integrator(self.model, x, v, method=self._options["method"], **kw, **self._implicit)
         stepper.t = t
         stepper.n_taken = n_taken
         if self.engine == "network":  # a follower pressure reads the current positions
