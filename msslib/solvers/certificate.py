@@ -469,15 +469,15 @@ def _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, max_steps, Q, al
     noise = unit * np.sqrt(n)
     force = False
     tnorm = 0.0
+    Q[0, :] = q
     for j in range(max_steps):
-        Q[j, :] = q
         a = _row_product(R, rowptr, ib, coef, isq, q, shift, w)
-        for i in range(n):
-            w[i] -= a * q[i]
-        if j:
-            bj = beta[j - 1]
-            for i in range(n):
-                w[i] -= bj * Q[j - 1, i]
+        bj = beta[j - 1] if j else 0.0
+        ww = 0.0
+        for i in range(n):  # the three-term recurrence and |w|^2 in one pass
+            wi = w[i] - a * q[i] - (bj * Q[j - 1, i] if j else 0.0)
+            w[i] = wi
+            ww += wi * wi
         alpha[j] = a
         k = j + 1
         theta = _top_ritz(alpha, beta, k) if j else a
@@ -489,7 +489,7 @@ def _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, max_steps, Q, al
             return -1.0, k  # a Ritz value above the target: the step is over the limit
         if (c / np.sqrt(1.0 - theta / target) + 1.0) / 2.0 > max_steps:
             return -1.0, k  # too many steps would be needed if theta did not grow
-        b = np.sqrt(np.sum(w * w))
+        b = np.sqrt(ww)
         tnorm = max(tnorm, abs(a) + b + (beta[j - 1] if j else 0.0))
         if b > 0.0:  # Simon's recurrence for q_{j+1} . q_k, k <= j
             worst = 0.0
@@ -502,7 +502,7 @@ def _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, max_steps, Q, al
             om_new[j] = noise * tnorm / b
             if force or worst > np.sqrt(unit):
                 _reorthogonalise(Q, j + 1, w, h)
-                b = np.sqrt(np.sum(w * w))
+                b = np.sqrt(np.dot(w, w))
                 for kk in range(j + 1):
                     om_new[kk] = noise
                 force = not force  # the next vector too, once
@@ -513,8 +513,11 @@ def _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, max_steps, Q, al
         if not b > 1e-13 * max(abs(a), theta, 1e-300):
             return -1.0, k  # an invariant subspace: no further step
         beta[j] = b
-        for i in range(n):
-            q[i] = w[i] / b
+        if j + 1 < max_steps:
+            for i in range(n):
+                qi = w[i] / b
+                q[i] = qi
+                Q[j + 1, i] = qi
     return -1.0, max_steps
 
 
