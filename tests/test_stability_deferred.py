@@ -104,3 +104,11 @@ def test_below_the_size_a_refusal_still_comes_from_the_constructor(column):
     model._spectrum_cache = {}
     with pytest.raises(StabilityError, match="1.02 x the explicit stability limit"):
         Simulator(model, dt=1.02 * limit, damping=0.0)
+
+
+def test_the_docs_name_the_size_from_which_the_check_runs_on_a_thread():
+    from pathlib import Path
+
+    size = f"{CK.DEFER_MIN_DOFS:,}".replace(",", " ")
+    assert f"{size} free dofs or more" in Path(__file__).resolve().parents[1].joinpath("README.md").read_text()
+    assert f"{size} free dofs or more" in " ".join(Simulator.__doc__.split())
