@@ -264,7 +264,8 @@ if not QUICK:
     ruleorder: study_baudet_cantilever_floor > study
 
     # the speed-against-error front of the cantilever down to level 4 (56 k dofs: the Q2 reference, and
-    # Baudet's element-reading Newton solve until its 75 s budget stops it): 2.6 GB, 4.5 min of CPU time
+    # Baudet's element-reading Newton solve, 48 s per run), every point timed seven times: 2.6 GB (measured
+    # when long runs were timed once), 11.3 min on one core
     use rule study as study_performance_front_cantilever with:
         wildcard_constraints:
             paper="performance",
