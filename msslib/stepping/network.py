@@ -1,14 +1,22 @@
 """The fused spring-network engine of the stepping API: :class:`NetworkStepper` runs the steps of
 :class:`msslib.stepping.generic.Integrator` (symplectic Euler, mass-proportional damping) with
 the kernels of :mod:`msslib.stepping.network_kernels`, and the same stability check and divergence
-detector."""
+detector.
+
+A large network whose numbering scatters its springs is stepped in an internal numbering
+(reverse Cuthill-McKee, :func:`~msslib.stepping.network_kernels.cache_order`), chosen once when
+the stepper is built: the pass then reads and writes nodes that are near in memory.  It is
+invisible: ``x``, ``v``, the force and the reactions are arrays in the model's numbering, written
+in place after every call (views of them follow the state), and what the Simulator writes into
+``x`` between steps (paths, prescribed displacements) is read back before the next pass."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from msslib.errors import DivergenceError
-from msslib.stepping.network_kernels import N_MONITOR, fused_advance, fused_pass, fused_steps, network_layout, network_terms, records
+from msslib.stepping.network_kernels import (N_MONITOR, cache_order, fused_advance, fused_pass, fused_steps,
+                                             gather_state, network_layout, network_terms, records, scatter_state)
 from msslib.stepping.generic import Integrator
 
 
@@ -32,38 +40,79 @@ class NetworkStepper(Integrator):
         conn = np.concatenate([s.conn for s in springs])
         k = np.concatenate([s.k for s in springs])
         rest = np.concatenate([s.rest_length for s in springs])
+        # internal node i is node order[i] of the model (None: the model's numbering)
+        self.order = order = cache_order(conn, model.n_nodes)
+        if order is not None:
+            new = np.empty(model.n_nodes, dtype=np.int64)
+            new[order] = np.arange(model.n_nodes)
+            conn = new[conn]
+            self._dofs = (3 * order[:, None] + np.arange(3)).reshape(-1)  # internal dof j is dof _dofs[j]
         self.layout = network_layout(conn, k, rest, model.n_nodes)
         self.n_springs = len(conn)
         self.others = others
         self._external = model.external_force(1.0) if hasattr(model, "external_force") else np.zeros(n)
-        self.R = records(self.x)  # positions and force accumulators, one record per node
-        self.x = self.R[:, :3]  # a view: the state lives in the records
+        self.R = records(self._internal(self.x))  # positions and force accumulators, one record per node
         self.v = np.ascontiguousarray(self.v)
         self.F = np.zeros(n)
         self.react = np.zeros(n)
-        self.fext = np.zeros(n)
+        if order is None:  # the kernels' arrays are the state's
+            self.x = self.R[:, :3]  # a view: the state lives in the records
+            self._v, self._F, self._react = self.v, self.F, self.react
+        else:
+            self.x = np.array(self.x, dtype=float).reshape(-1, 3)  # written after every call
+            self._v, self._F, self._react = self.v[self._dofs], np.zeros(n), np.zeros(n)
+        self._external_i = self._internal(self._external)
+        self._x_ref = self._internal(self.x_ref)
+        self.fext = np.zeros(n)  # internal numbering
         self.inv_m_all = np.where(self.free, 1.0 / np.where(self.mass > 0, self.mass, 1.0), 0.0)
         self._h = None
         self._set_step(self.dt)
         self.mon = np.zeros((1, N_MONITOR))
-        self._fixed_at = 6 * (self._fixed // 3) + self._fixed % 3  # in the flat records
-        self._R_flat = self.R.reshape(-1)  # a view
+        self._fixed_at = 6 * (self._fixed // 3) + self._fixed % 3  # in the flat records (used without renumbering)
         self._fext_of = None  # (load, extra) that fext holds
         self.evaluate()
+
+    def _internal(self, a):
+        """A flat dof array of the model's numbering in the internal one (a copy)."""
+        a = np.asarray(a, dtype=float).reshape(-1)
+        return a.copy() if self.order is None else a[self._dofs]
+
+    def _sync_in(self):
+        """Positions and velocities of the model's numbering into the kernels' arrays."""
+        if self.order is not None:
+            gather_state(self.R, self._v, self.x, self.v, self.order)
+
+    def _sync_out(self):
+        """The kernels' state, force and reactions into the model's numbering (in place)."""
+        if self.order is not None:
+            scatter_state(self.R, self._v, self._F, self._react, self.x, self.v, self.F, self.react, self.order)
+
+    def snapshot(self):
+        """The state (positions, velocities, force, reactions, time, steps taken) to :meth:`restore`."""
+        return (self.x.copy(), self.v.copy(), self.F.copy(), self.react.copy(), self.t, self.n_taken)
+
+    def restore(self, snap):
+        """Back to a :meth:`snapshot` (the force and reactions as they were, no evaluation)."""
+        self.x[:], self.v[:], self.F[:], self.react[:] = snap[:4]
+        self.t, self.n_taken = snap[4], snap[5]
+        if self.order is not None:
+            self._sync_in()
+            self._F[:] = self.F[self._dofs]
+            self._react[:] = self.react[self._dofs]
 
     def _set_step(self, h):
         if h != self._h:
             self._h = float(h)
-            self.w = np.where(self.free, self._h * self.inv_m_all, 0.0)
+            self.w = self._internal(np.where(self.free, self._h * self.inv_m_all, 0.0))
             self.damp = 1.0 - self._h * self.alpha
 
     def _update_external(self):
         of = self._fext_of
         if of is not None and of[0] == self.load and of[1] is self.extra:
             return  # unchanged since the last pass (the reference keeps the array alive)
-        np.multiply(self._external, self.load, out=self.fext)
+        np.multiply(self._external_i, self.load, out=self.fext)
         if self.extra is not None:
-            self.fext += self.extra
+            self.fext += self.extra if self.order is None else self.extra[self._dofs]
         self._fext_of = (self.load, self.extra)
 
     def _preload(self):
@@ -73,7 +122,8 @@ class NetworkStepper(Integrator):
         g = np.zeros(flat.size)
         for t in self.others:
             g += t.gradient(flat)
-        self.R[:, 3:] = -g.reshape(-1, 3)
+        g = g.reshape(-1, 3)
+        self.R[:, 3:] = -(g if self.order is None else g[self.order])
 
     def _flat_x(self):
         return self.x.reshape(-1)
@@ -81,16 +131,20 @@ class NetworkStepper(Integrator):
     def _fixed_positions(self):
         if self.drive is None or not self._fixed.size:
             return None
-        return self._R_flat[self._fixed_at]
+        if self.order is None:
+            return self.R.reshape(-1)[self._fixed_at]
+        return self.x.reshape(-1)[self._fixed]
 
     def evaluate(self):
         """The force, reactions and monitor at the current state (no step): after a change of the
         loads or of the driven dofs' positions made outside :meth:`step`."""
+        self._sync_in()
         self._update_external()
         self._preload()
         rowptr, ib, kl = self.layout
-        fused_pass(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self.x_ref, self.react,
-              self.mon, 0, False)
+        fused_pass(self.R, self._v, self._F, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self._x_ref,
+                   self._react, self.mon, 0, False)
+        self._sync_out()
         self.stats["n_force_evals"] += 1
 
     def reaction(self):
@@ -145,8 +199,9 @@ class NetworkStepper(Integrator):
         if self.drive is None and not self.others:
             if self.mon.shape[0] < n:
                 self.mon = np.zeros((n, N_MONITOR))
-            fused_steps(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self.x_ref, self.react,
-                   self.mon, n)
+            fused_steps(self.R, self._v, self._F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self._x_ref,
+                        self._react, self.mon, n)
+            self._sync_out()
             self.stats["n_force_evals"] += n
             t0 = self.t
             try:
@@ -180,15 +235,18 @@ class NetworkStepper(Integrator):
             before = (self._fixed_positions(), self.load, self.extra)
             self.drive(t_step, self.x)
             self.note_input(before[0], self._fixed_positions(), before[1], before[2])
+            self._sync_in()
             self._update_external()
             rowptr, ib, kl = self.layout
-            fused_steps(self.R, self.v, self.F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self.x_ref,
-                        self.react, self.mon, 1)
+            fused_steps(self.R, self._v, self._F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self._x_ref,
+                        self._react, self.mon, 1)
+            self._sync_out()
             self.stats["n_force_evals"] += 1
             self.n_taken += 1
             self.t = t_step
             return
-        fused_advance(self.R, self.v, self.F, self.w, self.damp, h)
+        fused_advance(self.R, self._v, self._F, self.w, self.damp, h)
+        self._sync_out()
         if self.drive is not None:
             before = (self._fixed_positions(), self.load, self.extra)
             self.drive(t_step, self.x)
@@ -214,7 +272,7 @@ class NetworkStepper(Integrator):
         for n, h, end in self._since:
             self._set_step(h)
             for i in range(n):
-                x_prev, v_prev = self.x.reshape(-1), self.v.copy()
+                x_prev, v_prev = np.array(self.x).reshape(-1), self.v.copy()
                 self._one(h, self.t + h if i + 1 < n else end)
                 self._observe_row(0, h, self.n_taken, self.t, x_prev, v_prev)
         raise RuntimeError("the replay did not find the divergence again")  # pragma: no cover

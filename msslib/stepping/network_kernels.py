@@ -27,8 +27,9 @@ for the step whose end state it evaluates (``v.v``, ``F.M^-1 F_prev``, ``v.(F - 
 ``F.M^-1 F`` over the free dofs and ``max |x - x_ref|``), and the support reactions ``-F`` on the
 fixed dofs, so that the state, the force and the reaction are current after every call.
 
-Node numbering still matters for large networks: :func:`msslib.mesh.reorder_nodes` (reverse
-Cuthill-McKee) gives the scatter locality in memory as well.
+Node numbering matters for large networks: :func:`cache_order` picks reverse Cuthill-McKee for a
+large network whose numbering scatters its springs, and :class:`msslib.stepping.network.NetworkStepper`
+steps in that numbering internally (the state comes back in the model's).
 """
 
 from __future__ import annotations
@@ -41,7 +42,8 @@ from msslib.terms.jit import UINT
 # fast-math without nnan/ninf: the monitor must see a non-finite state
 _FAST = {"nsz", "arcp", "contract", "afn"}
 
-__all__ = ["network_terms", "network_layout", "records", "network_steps", "network_forces", "N_MONITOR"]
+__all__ = ["network_terms", "network_layout", "records", "network_steps", "network_forces", "N_MONITOR",
+           "cache_order"]
 
 N_MONITOR = 5  # columns of a monitor row: q, pf, ku, r, dmax
 
@@ -86,6 +88,58 @@ def network_layout(conn, k, rest_length, n_nodes: int):
     return rowptr, np.ascontiguousarray(b[order], dtype=idx_t), kl
 
 
+# below this many nodes the records, velocities and forces of a network fit in a core's cache:
+# no renumbering pays
+REORDER_MIN_NODES = 8192
+# the factor by which reverse Cuthill-McKee must shorten the springs' mean index span to be used
+REORDER_GAIN = 1.5
+
+
+def cache_order(conn, n_nodes: int):
+    """A renumbering of the nodes for the pass's locality, or None to keep theirs: ``order`` with
+    internal node ``i`` = given node ``order[i]`` (reverse Cuthill-McKee on the springs' graph),
+    when the network is large enough (:data:`REORDER_MIN_NODES`) and the springs' mean index span
+    ``|a - b|`` is at least :data:`REORDER_GAIN` times smaller in that order (a numbering already banded is kept)."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+    conn = np.asarray(conn, dtype=np.int64).reshape(-1, 2)
+    if n_nodes < REORDER_MIN_NODES or not len(conn):
+        return None
+    g = csr_matrix((np.ones(2 * len(conn), dtype=np.int8), (conn.ravel(), conn[:, ::-1].ravel())),
+                   shape=(n_nodes, n_nodes))
+    order = reverse_cuthill_mckee(g, symmetric_mode=True).astype(np.int64)
+    new = np.empty(n_nodes, dtype=np.int64)
+    new[order] = np.arange(n_nodes)
+    span = float(np.abs(conn[:, 0] - conn[:, 1]).mean())
+    span_new = float(np.abs(new[conn[:, 0]] - new[conn[:, 1]]).mean())
+    return order if REORDER_GAIN * span_new <= span else None
+
+
+@njit(cache=True, nogil=True)
+def gather_state(R, v, x, vu, order):
+    """The node records' positions and the velocities in the pass's numbering from the given
+    numbering's ``x`` (n, 3) and ``vu`` (flat): internal node ``i`` is node ``order[i]``."""
+    for i in range(order.shape[0]):
+        o = order[i]
+        for c in range(3):
+            R[i, c] = x[o, c]
+            v[3 * i + c] = vu[3 * o + c]
+
+
+@njit(cache=True, nogil=True)
+def scatter_state(R, v, F, react, x, vu, Fu, ru, order):
+    """The state of the pass's numbering (positions, velocities, forces, reactions) written into
+    the given numbering's arrays (the inverse of :func:`gather_state`)."""
+    for i in range(order.shape[0]):
+        o = order[i]
+        for c in range(3):
+            x[o, c] = R[i, c]
+            vu[3 * o + c] = v[3 * i + c]
+            Fu[3 * o + c] = F[3 * i + c]
+            ru[3 * o + c] = react[3 * i + c]
+
+
 def records(x) -> np.ndarray:
     """The node records ``(n_nodes, 6)`` of flat positions ``x`` (accumulators zero)."""
     x = np.asarray(x, dtype=float).reshape(-1, 3)
@@ -94,7 +148,7 @@ def records(x) -> np.ndarray:
     return R
 
 
-@njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
+@njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST, inline="always")
 def fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, advance):
     """One pass: the force ``F`` at the positions ``R[:, :3]`` (springs + the accumulators
     ``R[:, 3:]``, which hold the other forces and are zeroed, + ``fext``), the monitor row
@@ -175,9 +229,14 @@ def fused_advance(R, v, F, w, damp, h):
 
 @njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
 def fused_steps(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, n_steps):
+    if n_steps < 1:
+        return
     fused_advance(R, v, F, w, damp, h)
-    for p in range(n_steps):
-        fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, p, p + 1 < n_steps)
+    # the pass is inlined twice with a constant ``advance``: the loop over the nodes carries no
+    # test of it
+    for p in range(n_steps - 1):
+        fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, p, True)
+    fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, n_steps - 1, False)
 
 
 def network_forces(state, layout, mon, row: int = 0):

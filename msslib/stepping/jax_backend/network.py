@@ -186,15 +186,14 @@ class CpuNetwork(_NetworkBase):
         if n <= 0:
             return self
         st = self._st
-        saved = (st.R.copy(), st.v.copy(), st.F.copy(), st.t, st.n_taken)
+        saved = st.snapshot()
         try:
             st.steps(n)
             ok = bool(np.isfinite(st.x).all() and np.isfinite(st.v).all())
         except DivergenceError:
             ok = False
         if not ok:
-            st.R[:], st.v[:], st.F[:] = saved[:3]
-            st.t, st.n_taken = saved[3], saved[4]
+            st.restore(saved)
             self._diverged(n)
         self.n_steps += n
         return self
