@@ -4,8 +4,10 @@ Same networks (msslib's constants, masses, fixed nodes and gravity), same scheme
 Euler, undamped, 0.9 of the stability limit), one core, N steps from rest:
 
 * msslib's network engine (:class:`msslib.stepping.Simulator`, fused spring kernel, N steps in
-  one call), on the mesh's node order and on the nodes renumbered by reverse Cuthill-McKee
-  (:func:`msslib.mesh.reorder_nodes`); msslib's generic engine (NumPy step, any model);
+  one call), on the mesh's node order (what a user gets: the engine renumbers a large scattered
+  network internally, the state comes back in the mesh's order) and on the nodes renumbered by
+  reverse Cuthill-McKee (:func:`msslib.mesh.reorder_nodes`: kernel against kernel on the same
+  order); msslib's generic engine (NumPy step, any model);
 * a plain NVIDIA Warp kernel on its CPU device (one thread per spring with atomic adds, then one
   per node), fp64 and fp32, on the same node orders -- when ``warp-lang`` is installed (extra
   ``bench``);
@@ -76,7 +78,8 @@ def _ours(model, dt, engine, n=STEPS):
     sim.reset()
     t = time.perf_counter()
     sim.step(n)
-    return time.perf_counter() - t, np.array(sim.x).ravel()
+    wall = time.perf_counter() - t
+    return wall, np.array(sim.x).ravel(), getattr(sim._stepper, "order", None) is not None
 
 
 def _warp(model, dt, precision, n=STEPS):
@@ -118,7 +121,7 @@ def throughput(res, name, build, quick):
     limit = S.explicit_stability_limit(model, model.x0)
     dt = 0.9 * limit
     size = float(np.ptp(model.x0.reshape(-1, 3), axis=0).max())
-    walls, finals = {}, {}
+    walls, finals, internal = {}, {}, {}
     for _ in range(3):  # interleaved rounds; the best of three (the peers get the same)
         for key, fn in (("network", lambda: _ours(model, dt, "network")),
                         ("warp64", lambda: _warp(model, dt, "double")),
@@ -128,8 +131,10 @@ def throughput(res, name, build, quick):
                 continue
             walls.setdefault(key, []).append(out[0])
             finals[key] = out[1]
+            if len(out) > 2:
+                internal[key] = out[2]
     if not quick or s < 200_000:
-        w, finals["generic"] = _ours(model, dt, "generic")
+        w, finals["generic"], _ = _ours(model, dt, "generic")
         walls["generic"] = [w]
     ordered = build(True)
     for _ in range(3):
@@ -138,6 +143,8 @@ def throughput(res, name, build, quick):
             out = fn()
             if out is not None:
                 walls.setdefault(key, []).append(out[0])
+                if len(out) > 2:
+                    internal[key] = out[2]
     if s < 30_000:
         w = _mujoco(model, dt)
         if w is not None:
@@ -146,15 +153,20 @@ def throughput(res, name, build, quick):
     rate = {k: _rate(s, w) for k, w in best.items()}
     note = f"{s} springs, {model.n_nodes} nodes, {STEPS} steps of 0.9 x the stability limit, 1 thread, best of 3"
     peer = rate.get("warp64")
+    # issue 36: the network step at >= 1.5 x a plain Warp fp64 kernel at 122 k and 945 k springs
+    want = 1.5 if name in ("lloyd_122k", "lloyd_945k") else 1.0
+    how = ("the engine steps in its own reverse Cuthill-McKee numbering, the state comes back in the mesh's"
+           if internal.get("network") else "the engine keeps the mesh's numbering")
     res.add(f"step_{name}_network", rate["network"], "M spring-steps/s", None if peer is None else rate["network"] / peer,
             "plain Warp kernel fp64 (CPU), same node order" if peer else None,
-            note + "; the mesh's node order", target=None if peer is None else (">=", 1.0, "ratio"))
+            note + f"; the mesh's node order as given to both ({how})",
+            target=None if peer is None else (">=", want, "ratio"))
     if "network_rcm" in rate:
         p = rate.get("warp64_rcm")
         res.add(f"step_{name}_network_rcm", rate["network_rcm"], "M spring-steps/s",
                 None if p is None else rate["network_rcm"] / p, "plain Warp kernel fp64, RCM node order" if p else None,
-                note + "; nodes renumbered by reverse Cuthill-McKee (msslib.mesh.reorder_nodes)",
-                target=None if p is None else (">=", 1.0, "ratio"))
+                note + "; nodes renumbered by reverse Cuthill-McKee (msslib.mesh.reorder_nodes) for both: kernel "
+                "against kernel", target=None if p is None else (">=", want, "ratio"))
     for key, label in (("warp64", "plain Warp kernel fp64"), ("warp32", "plain Warp kernel fp32"),
                        ("warp64_rcm", "plain Warp kernel fp64, RCM order"), ("generic", "msslib generic engine"),
                        ("mujoco", "MuJoCo tendons (C)")):
