@@ -128,3 +128,35 @@ def test_baudet_cube_stiffness_is_symmetric_to_roundoff_and_solved_as_symmetric(
     assert (abs(A) > 0).astype(int).__ne__((abs(A.T) > 0).astype(int)).nnz > 0
     S, symmetric = policy.as_symmetric(A, False)
     assert symmetric and abs(S - A).max() <= 1e-12 * abs(A).max()
+
+
+@needs_pardiso
+def test_a_follower_pressure_scene_solved_by_non_symmetric_pardiso_equals_superlu(monkeypatch):
+    """A follower pressure on an open face (a genuinely non-symmetric tangent, 5,400 free dofs):
+    every Newton system goes to non-symmetric Pardiso, and the solution equals SuperLU's."""
+    from msslib.scene import load_scene, run_scene
+    from msslib.solvers import direct as solvers_direct
+    from msslib.solvers import linear as solvers_linear
+
+    n = 9
+    scene = {"name": "flat", "geometry": {"generator": "hex_grid", "args": {"lx": 1.0, "ly": 1.0, "lz": 2.0,
+                                                                           "nx": n, "ny": n, "nz": 2 * n}},
+             "materials": [{"E": 1e6, "nu": 0.3, "density": 1000.0}], "model": "golec_cube",
+             "boundary": [{"select": {"plane": ["z", 0.0]}, "fix": "all"}],
+             "loads": [{"type": "pressure", "select": {"plane": ["x", 1.0]}, "pressure": 2e3, "follow": True}],
+             "solver": {"type": "static", "load_steps": 2}}
+    calls = []
+    real = solvers_direct._direct_solve
+
+    def spy(A, b, symmetric, context=None, factorisation="superlu"):
+        calls.append((symmetric, factorisation, A.shape[0]))
+        return real(A, b, symmetric, context, factorisation)
+
+    monkeypatch.setattr(solvers_linear, "_direct_solve", spy)
+    u = run_scene(load_scene(scene), progress=False)["displacement"].values
+    assert calls and {c[:2] for c in calls} == {(False, "pardiso")} and calls[0][2] >= policy.PARDISO_MIN_DOFS
+    calls.clear()
+    monkeypatch.setattr(solvers_linear, "choose_factorisation", lambda n, s: "superlu")
+    u_lu = run_scene(load_scene(scene), progress=False)["displacement"].values
+    assert {c[:2] for c in calls} == {(False, "superlu")}
+    assert np.abs(u).max() > 1e-3 and np.abs(u - u_lu).max() <= 1e-10 * np.abs(u_lu).max()
