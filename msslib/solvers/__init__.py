@@ -26,7 +26,8 @@ Problem protocol
 ``free`` : bool ndarray ``(n_dof,)``
     Mask of the unconstrained dofs. Constrained dofs keep the value they have in ``x``.
 ``symmetric`` : bool, optional (default True)
-    False when ``stiffness`` is non-symmetric; the iterative (CG) linear solver is then never used.
+    False when ``stiffness`` may be non-symmetric; the iterative (CG) linear solver is then used
+    only for a tangent found symmetric to round-off (:func:`msslib.solvers.policy.as_symmetric`).
 ``apply_prescribed(x, load)`` -> ndarray, optional
     Returns a copy of ``x`` whose constrained dofs are set to their prescribed value at load
     factor ``load`` (prescribed motions scaled by the load). Without it, constrained dofs simply

@@ -300,7 +300,9 @@ def static_solve(problem, x0, *, load_steps: int = 1, tol: float = 1e-8, max_ite
     linear_solver : ``"auto"``, ``"direct"``, ``"cg"``, or a callable ``(K_free, rhs) -> dx``.
         ``"direct"``: for symmetric systems a banded Cholesky in a bandwidth-reducing ordering
         (computed once per sparsity pattern) when it is cheap, banded LU when the tangent is
-        indefinite, else sparse LU (minimum-degree ordering); non-symmetric: sparse LU.
+        indefinite, else MKL Pardiso from 5,000 unknowns where installed, else sparse LU
+        (minimum-degree ordering); non-symmetric (not merely to round-off): the same Pardiso or
+        sparse LU.
         ``"cg"``: CG preconditioned by pyamg smoothed aggregation if installed (node blocks and
         rigid-body modes when the free dofs are whole nodes; the hierarchy is reused across
         Newton iterations, load steps and successive solves of the same problem, from the same
