@@ -141,8 +141,8 @@ class NetworkStepper(Integrator):
         self._sync_in()
         self._update_external()
         self._preload()
-        rowptr, ib, kl = self.layout
-        fused_pass(self.R, self._v, self._F, rowptr, ib, kl, self.w, self.damp, self._h, self.fext, self._x_ref,
+        rowptr, ia, ib, kl = self.layout
+        fused_pass(self.R, self._v, self._F, rowptr, ia, ib, kl, self.w, self.damp, self._h, self.fext, self._x_ref,
                    self._react, self.mon, 0, False)
         self._sync_out()
         self.stats["n_force_evals"] += 1
@@ -194,12 +194,12 @@ class NetworkStepper(Integrator):
         if getattr(self, "_ckpt", None) is None or self.n_taken - self._ckpt[3] >= self._CHECKPOINT_EVERY:
             self._checkpoint()
         self._since.append((n, h, end))
-        rowptr, ib, kl = self.layout
+        rowptr, ia, ib, kl = self.layout
         failed = False
         if self.drive is None and not self.others:
             if self.mon.shape[0] < n:
                 self.mon = np.zeros((n, N_MONITOR))
-            fused_steps(self.R, self._v, self._F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self._x_ref,
+            fused_steps(self.R, self._v, self._F, rowptr, ia, ib, kl, self.w, self.damp, h, self.fext, self._x_ref,
                         self._react, self.mon, n)
             self._sync_out()
             self.stats["n_force_evals"] += n
@@ -237,8 +237,8 @@ class NetworkStepper(Integrator):
             self.note_input(before[0], self._fixed_positions(), before[1], before[2])
             self._sync_in()
             self._update_external()
-            rowptr, ib, kl = self.layout
-            fused_steps(self.R, self._v, self._F, rowptr, ib, kl, self.w, self.damp, h, self.fext, self._x_ref,
+            rowptr, ia, ib, kl = self.layout
+            fused_steps(self.R, self._v, self._F, rowptr, ia, ib, kl, self.w, self.damp, h, self.fext, self._x_ref,
                         self._react, self.mon, 1)
             self._sync_out()
             self.stats["n_force_evals"] += 1

@@ -2,14 +2,15 @@
 forces and the position update fused in one pass over the nodes.
 
 Layout: every spring is stored once, under its lower node ``a`` (``a < b``), the springs sorted by
-``a`` then ``b`` (``rowptr`` offsets by node, ``ib`` the other ends, ``kl`` the constants and rest
-lengths interleaved).  A pass visits the nodes in order; the force on node ``a`` is complete once
-its own row is done, because every spring ``(c, a)`` with ``c < a`` was visited in an earlier row
-and scattered into ``a``'s accumulator.  The node is then advanced at once (``v = damp v + w F``,
-``x += h v``) while it is in cache: later rows only read nodes ``b > a``, which are not advanced
-yet, so the pass computes the forces of one state and advances it, exactly as the two-pass scheme
-(forces of every spring, then every node).  One pass reads each spring's 20 bytes once and each
-node's state once.
+``a`` then ``b`` (``rowptr`` offsets by node, ``ia`` and ``ib`` the two ends, ``kl`` the constants
+and rest lengths interleaved).  A pass visits the nodes in order, in blocks of :data:`BLOCK`; the
+force on node ``a`` is complete once the rows of its block are done, because every spring
+``(c, a)`` with ``c < a`` was visited in that block or an earlier one and scattered into ``a``'s
+accumulator.  The block's nodes are then advanced at once (``v = damp v + w F``, ``x += h v``)
+while they are in cache: later rows only read nodes ``b > a``, which are not advanced yet, so the
+pass computes the forces of one state and advances it, exactly as the two-pass scheme (forces of
+every spring, then every node).  One pass reads each spring's 24 bytes once and each node's
+state once.
 
 Each node's position and force accumulator are one record of six numbers (``R[:, :3]`` the
 positions, ``R[:, 3:]`` the accumulator): the other end of a spring is read and written in one
@@ -42,6 +43,8 @@ from msslib.terms.jit import UINT
 # fast-math without nnan/ninf: the monitor must see a non-finite state
 _FAST = {"nsz", "arcp", "contract", "afn"}
 
+BLOCK = 64  # nodes advanced together after their springs (see fused_pass)
+
 __all__ = ["network_terms", "network_layout", "records", "network_steps", "network_forces", "N_MONITOR",
            "cache_order"]
 
@@ -71,8 +74,9 @@ def network_terms(model):
 
 
 def network_layout(conn, k, rest_length, n_nodes: int):
-    """``(rowptr, ib, kl)`` of springs ``conn`` (s, 2) with constants ``k`` and rest lengths: each
-    spring under its lower node, sorted by lower then upper node (see the module docstring)."""
+    """``(rowptr, ia, ib, kl)`` of springs ``conn`` (s, 2) with constants ``k`` and rest lengths:
+    each spring under its lower node ``ia``, sorted by lower then upper node ``ib`` (see the module
+    docstring)."""
     conn = np.asarray(conn, dtype=np.int64).reshape(-1, 2)
     a = np.minimum(conn[:, 0], conn[:, 1])
     b = np.maximum(conn[:, 0], conn[:, 1])
@@ -85,7 +89,7 @@ def network_layout(conn, k, rest_length, n_nodes: int):
     kl[0::2] = np.asarray(k, dtype=float)[order]
     kl[1::2] = np.asarray(rest_length, dtype=float)[order]
     idx_t = np.int32 if n_nodes < 2**31 else np.int64
-    return rowptr, np.ascontiguousarray(b[order], dtype=idx_t), kl
+    return (rowptr, np.ascontiguousarray(a[order], dtype=idx_t), np.ascontiguousarray(b[order], dtype=idx_t), kl)
 
 
 # below this many nodes the records, velocities and forces of a network fit in a core's cache:
@@ -149,67 +153,74 @@ def records(x) -> np.ndarray:
 
 
 @njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST, inline="always")
-def fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, advance):
+def fused_pass(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon, row, advance):
     """One pass: the force ``F`` at the positions ``R[:, :3]`` (springs + the accumulators
     ``R[:, 3:]``, which hold the other forces and are zeroed, + ``fext``), the monitor row
     ``mon[row]`` (over the free dofs, ``w != 0``; the masses are ``h / w``; its first column is
     ``v.v``, whose finiteness is checked), the reactions; then, if
-    ``advance``, the symplectic Euler update of each node as soon as its force is complete."""
+    ``advance``, the symplectic Euler update of each node as soon as its force is complete.
+
+    The nodes go in blocks of :data:`BLOCK`: one loop over the springs of a block's rows adds
+    each spring's force into both ends' accumulators, then the block's nodes are advanced (their
+    forces are complete: the springs that reach them from lower rows are done).  A loop over
+    the springs of one row at a time would end at an unpredictable count every few springs.  The
+    sums are those of a row-by-row pass, in the same order (bitwise the same forces)."""
     q = 0.0
     pf = 0.0
     ku = 0.0
     r = 0.0
     dmax = 0.0
     hinv = 1.0 / h
-    for na in range(rowptr.shape[0] - 1):
-        a = 3 * na
-        xa0 = R[na, 0]
-        xa1 = R[na, 1]
-        xa2 = R[na, 2]
-        ga0 = R[na, 3]
-        ga1 = R[na, 4]
-        ga2 = R[na, 5]
-        for s in range(rowptr[na], rowptr[na + 1]):
+    n = rowptr.shape[0] - 1
+    for a0 in range(0, n, BLOCK):
+        a1 = min(a0 + BLOCK, n)
+        for s in range(rowptr[a0], rowptr[a1]):
+            na = UINT(ia[UINT(s)])
             b = UINT(ib[UINT(s)])
-            d0 = R[b, 0] - xa0
-            d1 = R[b, 1] - xa1
-            d2 = R[b, 2] - xa2
+            d0 = R[b, 0] - R[na, 0]
+            d1 = R[b, 1] - R[na, 1]
+            d2 = R[b, 2] - R[na, 2]
             l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
             c = kl[2 * s] * (l - kl[2 * s + 1]) / l
             f0 = d0 * c
             f1 = d1 * c
             f2 = d2 * c
-            ga0 += f0
-            ga1 += f1
-            ga2 += f2
+            R[na, 3] += f0
+            R[na, 4] += f1
+            R[na, 5] += f2
             R[b, 3] -= f0
             R[b, 4] -= f1
             R[b, 5] -= f2
-        R[na, 3] = 0.0
-        R[na, 4] = 0.0
-        R[na, 5] = 0.0
-        for i in range(3):
-            j = a + i
-            fj = (ga0 if i == 0 else (ga1 if i == 1 else ga2)) + fext[j]
-            fo = F[j]
-            F[j] = fj
-            vj = v[j]
-            dj = abs(R[na, i] - x_ref[j])
-            if not dj <= dmax:  # larger, or not a number
-                dmax = dj if dmax == dmax else dmax
-            wj = w[j]
-            if wj != 0.0:
-                im = wj * hinv  # 1 / m
-                q += vj * vj  # only its finiteness is checked: no mass needed
-                pf += fj * fo * im
-                ku += vj * (fj - fo)
-                r += fj * fj * im
-                if advance:
-                    vj = damp * vj + wj * fj
-                    v[j] = vj
-                    R[na, i] += h * vj
-            else:
-                react[j] = -fj
+        for na in range(a0, a1):
+            a = 3 * na
+            ga0 = R[na, 3]
+            ga1 = R[na, 4]
+            ga2 = R[na, 5]
+            R[na, 3] = 0.0
+            R[na, 4] = 0.0
+            R[na, 5] = 0.0
+            for i in range(3):
+                j = a + i
+                fj = (ga0 if i == 0 else (ga1 if i == 1 else ga2)) + fext[j]
+                fo = F[j]
+                F[j] = fj
+                vj = v[j]
+                dj = abs(R[na, i] - x_ref[j])
+                if not dj <= dmax:  # larger, or not a number
+                    dmax = dj if dmax == dmax else dmax
+                wj = w[j]
+                if wj != 0.0:
+                    im = wj * hinv  # 1 / m
+                    q += vj * vj  # only its finiteness is checked: no mass needed
+                    pf += fj * fo * im
+                    ku += vj * (fj - fo)
+                    r += fj * fj * im
+                    if advance:
+                        vj = damp * vj + wj * fj
+                        v[j] = vj
+                        R[na, i] += h * vj
+                else:
+                    react[j] = -fj
     mon[row, 0] = q
     mon[row, 1] = pf
     mon[row, 2] = ku
@@ -228,15 +239,15 @@ def fused_advance(R, v, F, w, damp, h):
 
 
 @njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
-def fused_steps(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, n_steps):
+def fused_steps(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon, n_steps):
     if n_steps < 1:
         return
     fused_advance(R, v, F, w, damp, h)
     # the pass is inlined twice with a constant ``advance``: the loop over the nodes carries no
     # test of it
     for p in range(n_steps - 1):
-        fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, p, True)
-    fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, n_steps - 1, False)
+        fused_pass(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon, p, True)
+    fused_pass(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon, n_steps - 1, False)
 
 
 def network_forces(state, layout, mon, row: int = 0):
@@ -244,8 +255,8 @@ def network_forces(state, layout, mon, row: int = 0):
     h, fext, x_ref, react)`` (``R`` from :func:`records`, ``w = h / m`` on the free dofs, 0 on the
     fixed ones); ``F`` becomes the force."""
     R, v, F, w, damp, h, fext, x_ref, react = state
-    rowptr, ib, kl = layout
-    fused_pass(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, row, False)
+    rowptr, ia, ib, kl = layout
+    fused_pass(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon, row, False)
 
 
 def network_steps(state, layout, mon, n_steps: int):
@@ -253,5 +264,5 @@ def network_steps(state, layout, mon, n_steps: int):
     the reactions and ``mon[0:n_steps]`` (the monitor of each step's end state) are current
     after the call.  The accumulators must be zero (spring-only networks)."""
     R, v, F, w, damp, h, fext, x_ref, react = state
-    rowptr, ib, kl = layout
-    fused_steps(R, v, F, rowptr, ib, kl, w, damp, h, fext, x_ref, react, mon, int(n_steps))
+    rowptr, ia, ib, kl = layout
+    fused_steps(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon, int(n_steps))
