@@ -18,6 +18,7 @@ from msslib.errors import MsslibWarning
 from msslib.mesh import CELL_TYPES, Mesh
 from msslib.mesh.cells import RegistryView
 from msslib.models.references import warn_locking
+from msslib.solvers.policy import method_for_material
 
 
 @dataclass(frozen=True)
@@ -132,6 +133,7 @@ def solve_linear(
     E_c, nu_c = _cell_materials(mesh, E, nu)
     if order == 1:
         warn_locking(mesh, nu_c, plane)
+    linear_solver = method_for_material(linear_solver, nu_c)  # nearly incompressible: direct
     lam_c, mu_c = lame(E_c, nu_c, plane if mesh.dim == 2 else None)
     geo = _Geometry(mesh, order, curved=curved)
     w = thickness if mesh.dim == 2 else 1.0
@@ -426,6 +428,7 @@ def solve_nonlinear(
     E_c, nu_c = _cell_materials(mesh, E, nu)
     if order == 1:
         warn_locking(mesh, nu_c, plane)
+    linear_solver = method_for_material(linear_solver, nu_c)  # nearly incompressible: direct
     lam_c, mu_c = lame(E_c, nu_c)  # 3D constants; plane stress handled inside the law
     geo = _Geometry(mesh, order, curved=curved)
     w = thickness if d == 2 else 1.0

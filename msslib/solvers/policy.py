@@ -38,6 +38,11 @@ BAND_AUTO_COST = 1.5e8  # ... unless the banded Cholesky costs at most this n (b
 
 LINEAR_SOLVERS = ("auto", "direct", "cg")
 PARDISO_MIN_DOFS = 5_000  # symmetric systems from this size are factorised by MKL Pardiso, if installed
+#: from this Poisson ratio "auto" solves elasticity systems directly: the AMG-preconditioned CG
+#: needs ever more iterations as lambda / mu grows (quadratic reference of the thick sphere, 13 k
+#: dofs, nu = 0.4999: CG 200 s, direct 1.6-4 s; the 2.5 k-dof octant: 8.5 s against 3.6 s, where
+#: at nu = 0.3 CG takes 0.84 s and direct 1.02 s)
+NEARLY_INCOMPRESSIBLE_NU = 0.45
 # Measured on the quadratic neo-Hookean reference's first tangent (benchmarks/fem_solvers.py),
 # single thread: 13,104 dofs Pardiso 0.21 s (a refactorisation with the kept analysis 0.12 s)
 # against SuperLU's 0.91 s; 94,176 dofs 6.4 s (SuperLU: minutes).  AMG-CG stays ahead on
@@ -69,6 +74,17 @@ def as_symmetric(A, symmetric: bool):
     S.sum_duplicates()
     S.sort_indices()
     return S, True
+
+
+def method_for_material(method, nu):
+    """The linear-solver request of an elasticity solve with Poisson ratios ``nu`` (a number or
+    one per cell): ``"auto"`` becomes ``"direct"`` from :data:`NEARLY_INCOMPRESSIBLE_NU`; any
+    other request is kept."""
+    if isinstance(method, str) and method == "auto":
+        nu = np.asarray(nu, dtype=float)
+        if nu.size and float(np.nanmax(nu)) >= NEARLY_INCOMPRESSIBLE_NU:
+            return "direct"
+    return method
 
 
 def choose_factorisation(n: int, symmetric: bool) -> str:
