@@ -289,10 +289,9 @@ def _certified(problem, x, load, rows, dt, method, alpha, beta, bound):
         _keep(problem, ("bound",) + key, float(np.sqrt(lam)))
         return float(np.sqrt(lam)), f"bound, Collatz-Wielandt ({products} products)"
     seed = int(key[0][:16], 16)
-    isq = _free_isq(problem, free)
-    rows = None if springs is None else spring_rows(x, springs, isq, layout)
+    rows = None if springs is None else spring_rows(x, springs, _free_isq(problem, free), layout)
     if rows is not None:  # 3D springs: the whole run in one compiled call
-        omega, steps = certified_springs(rows, isq, target, seed)
+        omega, steps = certified_springs(rows, target, seed)
     else:
         matvec, n, shift = _scaled_operator(problem, x, load, free)
         omega, steps = certified_omega_max(matvec, n, shift, target, seed)
