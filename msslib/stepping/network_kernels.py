@@ -210,11 +210,11 @@ def fused_pass(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon,
                     dmax = dj if dmax == dmax else dmax
                 wj = w[j]
                 if wj != 0.0:
-                    im = wj * hinv  # 1 / m
+                    g = fj * wj  # h F / m: the sums over the masses are h times theirs
                     q += vj * vj  # only its finiteness is checked: no mass needed
-                    pf += fj * fo * im
+                    pf += g * fo
                     ku += vj * (fj - fo)
-                    r += fj * fj * im
+                    r += g * fj
                     if advance:
                         vj = damp * vj + wj * fj
                         v[j] = vj
@@ -222,9 +222,9 @@ def fused_pass(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon,
                 else:
                     react[j] = -fj
     mon[row, 0] = q
-    mon[row, 1] = pf
+    mon[row, 1] = pf * hinv
     mon[row, 2] = ku
-    mon[row, 3] = r
+    mon[row, 3] = r * hinv
     mon[row, 4] = dmax
 
 
