@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 from numba import njit
+from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 
 def mass_vector(problem):
@@ -328,20 +329,14 @@ def certified_omega_max(matvec, n: int, shift: float, omega_target: float, seed:
     return None, steps
 
 
-# ---- the certified run of a spring model in one compiled call ------------------------------------
-# The short Lanczos run above, for 3D spring models, without a Python call per step: the springs
-# are stored once under their lower node (``rowptr`` offsets by node, ``ib`` the other ends, ``coef``
-# the per-spring (n, k L0/l, k (1 - L0/l)) of :func:`_spring_prep`), and the vector ``D q`` and the
-# accumulator of ``K D q`` are one record of six numbers per node (the fused step kernel's
-# layout): a product reads each spring once and the other end's record in one cache line, and a
-# node's row of ``D K D q`` is complete when its own row is done.  The Ritz value comes from
-# Sturm-sequence bisection of the tridiagonal matrix, kept on the safe (upper) side.
+# ---- the runs of a spring model in one compiled call: the springs stored once under their lower
+# node (:func:`_row_layout`), the vector and the accumulator one record of six numbers per node (the
+# fused step kernel's layout): a product reads each spring once and the other end in one cache line
 
 
 @njit(cache=True, nogil=True)
 def _rows_by_lower_node(conn, n_nodes, rowptr, order, ib):
-    """Counting sort of the springs by their lower node: ``rowptr`` (n_nodes + 1), ``order`` (the
-    spring of each slot) and ``ib`` (its upper node)."""
+    """Counting sort of the springs by lower node: ``rowptr``, ``order`` (slot -> spring), ``ib``."""
     for s in range(conn.shape[0]):
         rowptr[min(conn[s, 0], conn[s, 1]) + 1] += 1
     for i in range(n_nodes):
@@ -526,18 +521,14 @@ def _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, max_steps, Q, al
     return -1.0, max_steps
 
 
-# a network this large whose numbering scatters its springs is run renumbered by reverse
-# Cuthill-McKee (a product's memory locality: 945 k springs of a gmsh mesh, 137 k nodes: 14 ms ->
-# 8 ms a product for 54 ms of renumbering); smaller ones keep theirs, as the check's few tens of
-# products do not pay it back (122 k springs, 18 k nodes: 0.68 -> 0.58 ms for 5 ms)
+# a network this large whose numbering scatters its springs is renumbered by reverse Cuthill-McKee
+# (945 k springs, 137 k nodes: 14 -> 8 ms a product for 54 ms; 18 k nodes: 0.68 -> 0.58 ms for 5 ms)
 _RENUMBER_MIN_NODES = 65536
 _RENUMBER_GAIN = 1.5  # by which the springs' mean index span must shrink
 
 
 def _locality_order(conn, n_nodes):
     """``order`` (internal node ``i`` = given node ``order[i]``), or None to keep the numbering."""
-    from scipy.sparse.csgraph import reverse_cuthill_mckee
-
     if n_nodes < _RENUMBER_MIN_NODES or not len(conn):
         return None
     g = sp.csr_matrix((np.ones(2 * len(conn), dtype=np.int8), (conn.ravel(), conn[:, ::-1].ravel())),
@@ -604,6 +595,4 @@ def certified_springs(rows, omega_target: float, seed: int) -> tuple[float | Non
     q = _internal(q / np.linalg.norm(q), order)
     lam, k = _certified_rows(rowptr, ib, coef, isq, shift, q, target, c, steps, np.empty((steps, n)),
                              np.zeros(steps), np.zeros(steps))
-    if lam < 0.0:
-        return None, int(k)
-    return float(np.sqrt(max(lam - shift, 0.0))), int(k)
+    return (None, int(k)) if lam < 0.0 else (float(np.sqrt(max(lam - shift, 0.0))), int(k))
