@@ -7,7 +7,7 @@ A large network whose numbering scatters its springs is stepped in an internal n
 (reverse Cuthill-McKee, :func:`~msslib.stepping.network_kernels.cache_order`), chosen once when
 the stepper is built: the pass then reads and writes nodes that are near in memory.  It is
 invisible: ``x``, ``v``, the force and the reactions are arrays in the model's numbering, written
-in place after every call (views of them follow the state), and what the Simulator writes into
+in place after every call, and what the Simulator writes into
 ``x`` between steps (paths, prescribed displacements) is read back before the next pass."""
 
 from __future__ import annotations
