@@ -1,6 +1,7 @@
 """The stability check of an explicit run behind the :class:`~msslib.stepping.Simulator`: decided
 at once when the cheap bound (or an estimate kept for the state) decides the step, else run on a
-second thread while the first call's steps run.
+second thread while the first call's steps run (the whole check, bound included, when nothing is
+kept for the model yet).
 
 :func:`msslib.solvers.check_time_step` first tries a bound that costs about one force evaluation;
 a step above it needs the certificates (tens of products with the stiffness, about as many as
@@ -74,6 +75,8 @@ def stability_check(problem, x, dt, *, free, method, damping, load, allow_unstab
     (inside :func:`deferred_checks`, see the module docstring)."""
     kw = {"method": method, "damping": damping, "load": load, "allow_unstable": allow_unstable}
     defer = _DEFER.get() and not allow_unstable and int(np.count_nonzero(free)) >= DEFER_MIN_DOFS
+    if defer and not getattr(problem, "_spectrum_cache", None):  # nothing kept: all of it on the thread
+        return PendingCheck(problem, x, dt, kw)
     t0 = time.perf_counter()
     with np.errstate(all="ignore"):
         info = check_time_step(problem, x, dt, cheap_only=defer, **kw)
