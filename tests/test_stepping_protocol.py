@@ -14,17 +14,9 @@ from msslib import mesh as M
 from msslib import solvers as S
 from msslib.stepping import ENGINES, Simulator, Stepper
 from msslib.stepping.protocol import Stepper as ProtocolClass
+from test_simulator import column  # noqa: F401 - the tetrahedral column fixture, shared
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-@pytest.fixture(scope="module")
-def column():
-    mesh = M.cylinder_mesh(0.02, 0.08, 0.01)
-    setup = msslib.build_model("lloyd_tetrahedron", mesh, msslib.Material(1e4, 0.25, density=1000.0),
-                               fixed={"plane": ["z", 0.0]}, loads={"type": "gravity", "g": [0, 0, -9.81]})
-    model = setup.model
-    return model, S.explicit_stability_limit(model, model.x0)
 
 
 def _engines():

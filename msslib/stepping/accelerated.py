@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from msslib.solvers.stability import mass_proportional_alpha
+from msslib.stepping.protocol import constant_loads_only
 
 
 class JaxStepper:
@@ -25,11 +26,7 @@ class JaxStepper:
                  free=None, drive=None):
         from msslib.stepping.jax_backend import JaxNetwork
 
-        if drive is not None:
-            raise ValueError("engine='jax' runs constant loads: a load curve, time-varying forces or a moving path "
-                             "run on the network engine (engine='network')")
-        if free is not None and np.any(np.asarray(free) != np.asarray(model.free)):
-            raise ValueError("engine='jax' keeps the model's supports: prescribed paths run on the network engine")
+        constant_loads_only("jax", model, free, drive)
         alpha = mass_proportional_alpha(model, damping, "engine='jax'")
         self.net = JaxNetwork.from_model(model, dt, alpha, load=load, x0=x0, v0=v0, allow_unstable=allow_unstable)
         self.model, self.dt, self.load, self.extra = model, float(dt), load, None

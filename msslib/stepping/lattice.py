@@ -390,12 +390,9 @@ class LatticeStepper:
                  free=None, drive=None):
         from msslib.solvers import protocol
         from msslib.solvers.stability import check_time_step, mass_proportional_alpha
+        from msslib.stepping.protocol import constant_loads_only
 
-        if drive is not None:
-            raise ValueError("engine='lattice' runs constant loads: a load curve, time-varying forces or a moving "
-                             "path run on the network engine (engine='network')")
-        if free is not None and np.any(np.asarray(free) != np.asarray(model.free)):
-            raise ValueError("engine='lattice' keeps the model's supports: prescribed paths run on the network engine")
+        constant_loads_only("lattice", model, free, drive)
         alpha = mass_proportional_alpha(model, damping, "engine='lattice'")
         try:
             self.lat = LatticeExplicit(model, load=float(load))

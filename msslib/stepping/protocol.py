@@ -65,4 +65,15 @@ class Stepper(Protocol):
         """``1/2 v.M v`` over the free dofs (J)."""
 
 
-__all__ = ["Stepper"]
+def constant_loads_only(engine: str, model, free, drive) -> None:
+    """Refuse, in one line naming ``engine``, what an engine that runs the steps of a call without
+    the host cannot: a driven load (``drive``, a load curve or a path) or supports other than the
+    model's (``free``, prescribed paths)."""
+    if drive is not None:
+        raise ValueError(f"engine={engine!r} runs constant loads: a load curve, time-varying forces or a moving "
+                         "path run on the network engine (engine='network')")
+    if free is not None and np.any(np.asarray(free) != np.asarray(model.free)):
+        raise ValueError(f"engine={engine!r} keeps the model's supports: prescribed paths run on the network engine")
+
+
+__all__ = ["Stepper", "constant_loads_only"]

@@ -146,17 +146,14 @@ class Simulator:
     def _engine(self):
         if self._engine_request == "generic":
             return "generic"
-        if self._engine_request == "lattice":
+        if self._engine_request in ("lattice", "jax"):
             if self._varies() or self._forces or self._paths or self._pressures:
-                raise ValueError("engine='lattice' runs constant loads: a load curve, nodal forces, pressures or "
-                                 "prescribed paths run on the network engine (engine='network')")
-            return "lattice"
-        if self._engine_request == "jax":
+                raise ValueError(f"engine={self._engine_request!r} runs constant loads: a load curve, nodal forces, "
+                                 "pressures or prescribed paths run on the network engine (engine='network')")
+            if self._engine_request == "lattice":
+                return "lattice"
             from msslib.stepping.jax_backend import use_jax
 
-            if self._varies() or self._forces or self._paths or self._pressures:
-                raise ValueError("engine='jax' runs constant loads: a load curve, nodal forces or prescribed paths "
-                                 "run on the network engine (engine='network')")
             if use_jax("jax"):  # else a warning names the reason and the network engine runs
                 return "jax"
         _, _, why = network_terms(self.model)
