@@ -240,8 +240,8 @@ def fused_advance(R, v, F, w, damp, h):
 
 @njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
 def fused_steps(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon, n_steps):
-    if n_steps < 1:
-        return
+    """``n_steps >= 1`` steps (the callers check: an early return here for ``n_steps < 1`` makes
+    the compiled steps 4-5 % slower, measured at 122 k springs)."""
     fused_advance(R, v, F, w, damp, h)
     # the pass is inlined twice with a constant ``advance``: the loop over the nodes carries no
     # test of it
@@ -263,6 +263,8 @@ def network_steps(state, layout, mon, n_steps: int):
     """``n_steps`` symplectic Euler steps from a state whose force ``F`` is current; the force,
     the reactions and ``mon[0:n_steps]`` (the monitor of each step's end state) are current
     after the call.  The accumulators must be zero (spring-only networks)."""
+    if int(n_steps) < 1:
+        return
     R, v, F, w, damp, h, fext, x_ref, react = state
     rowptr, ia, ib, kl = layout
     fused_steps(R, v, F, rowptr, ia, ib, kl, w, damp, h, fext, x_ref, react, mon, int(n_steps))
