@@ -52,11 +52,16 @@ def test_bound_is_never_below_the_top_eigenvalue(name, model):
 def test_a_step_within_the_bound_needs_no_lanczos_and_a_larger_one_is_decided_by_it():
     model = dict(_models())["lloyd_tetrahedron"]
     exact = 2.0 / _exact_omega(model, model.x0)
-    bound, _ = S.omega_max_bound(model, model.x0)
-    small = 0.9 * 2.0 / bound
+    gershgorin, _ = S.omega_max_bound(model, model.x0)
+    small = 0.9 * 2.0 / gershgorin
     info = S.check_time_step(model, model.x0, small)
     assert info["stability_estimate"] == "bound"
+    # on a spring model the cheap bound is the directional bound's first pass: still safe, and
+    # here tighter than Gershgorin's
+    bound = info["omega_max_bound"]
+    assert 2.0 / exact * (1.0 - 1e-12) <= bound < gershgorin
     assert info["stability_limit"] == pytest.approx(2.0 / bound, rel=1e-12) and info["stability_limit"] <= exact
+    assert S.check_time_step(model, model.x0, 0.99 * 2.0 / bound)["stability_estimate"] == "bound"
     model._spectrum_cache = {}
     info = S.check_time_step(model, model.x0, 0.95 * exact)
     assert info["stability_estimate"] == "lanczos"

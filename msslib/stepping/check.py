@@ -1,15 +1,16 @@
 """The stability check of an explicit run behind the :class:`~msslib.stepping.Simulator`: decided
-at once when the cheap bound (or an estimate kept for the state) decides the step, else run on a
-second thread while the first call's steps run (the whole check, bound included, when nothing is
-kept for the model yet).
+at once when the cheap stages (the cheap bound, an estimate kept for the state, a few passes of
+the directional bound) decide the step, else run on a second thread while the first call's steps
+run.
 
-:func:`msslib.solvers.check_time_step` first tries a bound that costs about one force evaluation;
-a step above it needs the certificates (tens of products with the stiffness, about as many as
-steps of the fused kernel).  Inside :func:`deferred_checks` (the Simulator builds its engines
-there), a model of at least :data:`DEFER_MIN_DOFS` free dofs whose step the cheap stage cannot
-decide gets a :class:`PendingCheck`: the whole check runs on a thread (its compiled kernels
-release the GIL) and the engine waits for it at the first divergence check of the first call
-that steps (:meth:`msslib.stepping.generic.Integrator.observe`), after the first kernel call.  A
+:func:`msslib.solvers.check_time_step` first tries a bound that costs about one force evaluation,
+then, on a spring model, the directional bound (about one force evaluation a pass; two passes
+decide a step at 0.9 of the limit on the benchmark's networks); a step closer to the limit needs
+the certificates (tens of products with the stiffness, about as many as steps of the fused
+kernel).  Inside :func:`deferred_checks` (the Simulator builds its engines there), a model of at
+least :data:`DEFER_MIN_DOFS` free dofs whose step the cheap stages cannot decide gets a
+:class:`PendingCheck`: the whole check runs on a thread (its compiled kernels release the GIL)
+and the engine waits for it at the first divergence check of the first call that steps (:meth:`msslib.stepping.generic.Integrator.observe`), after the first kernel call.  A
 refusal then puts the state back as it was before that call and raises the
 :class:`msslib.errors.StabilityError` the check raised, from that call and from every later one.
 """
@@ -75,8 +76,6 @@ def stability_check(problem, x, dt, *, free, method, damping, load, allow_unstab
     (inside :func:`deferred_checks`, see the module docstring)."""
     kw = {"method": method, "damping": damping, "load": load, "allow_unstable": allow_unstable}
     defer = _DEFER.get() and not allow_unstable and int(np.count_nonzero(free)) >= DEFER_MIN_DOFS
-    if defer and not getattr(problem, "_spectrum_cache", None):  # nothing kept: all of it on the thread
-        return PendingCheck(problem, x, dt, kw)
     t0 = time.perf_counter()
     with np.errstate(all="ignore"):
         info = check_time_step(problem, x, dt, cheap_only=defer, **kw)

@@ -63,10 +63,11 @@ class Simulator:
     applied) at rest, with the schemes of :func:`msslib.stepping.integrate`: ``method`` is
     ``"symplectic_euler"`` (default), ``"velocity_verlet"`` or ``"implicit_euler"``, ``damping``
     ``alpha`` or ``(alpha, beta)`` (None: the model's).  The explicit schemes check ``dt`` against
-    the stability limit once, when the simulator is built (a cheap safe bound first, a certified
-    short Lanczos run or the Lanczos estimate only when the step exceeds it, see
+    the stability limit once, when the simulator is built (a cheap safe bound first, then on
+    spring models a few passes of a deterministic bound, a certified short Lanczos run or the
+    Lanczos estimate only when the step exceeds them, see
     :func:`msslib.solvers.check_time_step`; on a model of 20 000 free dofs or more, a step that
-    nothing kept for the model decides is checked on a second thread while the first call steps,
+    these cheap stages do not decide is checked on a second thread while the first call steps,
     and a refusal comes from that call, with the state as before it, and from every later one:
     :mod:`msslib.stepping.check`), and every step runs
     the divergence checks of :func:`~msslib.stepping.integrate` (``allow_unstable``, ``blowup``).

@@ -11,7 +11,35 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["spring3d_abs_rows", "csr_abs_rows"]
+__all__ = ["spring3d_abs_rows", "spring3d_abs_row_terms", "csr_abs_rows"]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def spring3d_abs_row_terms(x, a, b, k, L0, scale, isq):
+    """One spring between the dofs ``a:a+3`` and ``b:b+3`` (see :func:`spring3d_abs_rows`):
+    ``(r, n0, n1, n2, t0, t1, t2)``, ``r = L0 / l`` (infinite for coincident nodes), ``n`` the
+    unit vector from ``a`` to ``b``, and ``t`` such that row ``a + i`` gains ``isq[a + i] t_i``
+    and row ``b + i`` gains ``isq[b + i] t_i``."""
+    d0 = x[b] - x[a]
+    d1 = x[b + 1] - x[a + 1]
+    d2 = x[b + 2] - x[a + 2]
+    l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    if l > 0.0:
+        il = 1.0 / l
+        r = L0 * il
+        n0, n1, n2 = d0 * il, d1 * il, d2 * il
+    else:  # coincident nodes: bound the block by its largest possible entries
+        r = np.inf
+        n0, n1, n2 = 1.0, 1.0, 1.0
+    kk = abs(k) * abs(scale)
+    c = abs(1.0 - r)
+    # row i of the block: sum_j |H_ij| (isq_a_j + isq_b_j) = r |n_i| sum_j |n_j| s_j + |1 - r| s_i
+    an0, an1, an2 = abs(n0), abs(n1), abs(n2)
+    s0 = isq[a] + isq[b]
+    s1 = isq[a + 1] + isq[b + 1]
+    s2 = isq[a + 2] + isq[b + 2]
+    dot = r * (an0 * s0 + an1 * s1 + an2 * s2)
+    return r, n0, n1, n2, kk * (an0 * dot + c * s0), kk * (an1 * dot + c * s1), kk * (an2 * dot + c * s2)
 
 
 @njit(cache=True, nogil=True)
@@ -21,34 +49,13 @@ def spring3d_abs_rows(x, conn, k, L0, scale, isq, out):
     for s in range(conn.shape[0]):
         a = 3 * conn[s, 0]
         b = 3 * conn[s, 1]
-        d0 = x[b] - x[a]
-        d1 = x[b + 1] - x[a + 1]
-        d2 = x[b + 2] - x[a + 2]
-        l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-        if l > 0.0:
-            r = L0[s] / l
-            n0, n1, n2 = d0 / l, d1 / l, d2 / l
-        else:  # coincident nodes: bound the block by its largest possible entries
-            r = np.inf
-            n0, n1, n2 = 1.0, 1.0, 1.0
-        kk = abs(k[s]) * abs(scale)
-        for i in range(3):
-            ni = n0 if i == 0 else (n1 if i == 1 else n2)
-            ra = isq[a + i]
-            rb = isq[b + i]
-            if ra == 0.0 and rb == 0.0:
-                continue
-            tot = 0.0
-            for j in range(3):
-                nj = n0 if j == 0 else (n1 if j == 1 else n2)
-                h = r * abs(ni * nj)
-                if i == j:
-                    h += abs(1.0 - r)
-                else:
-                    h += 0.0
-                tot += kk * h * (isq[a + j] + isq[b + j])
-            out[a + i] += ra * tot
-            out[b + i] += rb * tot
+        _, _, _, _, t0, t1, t2 = spring3d_abs_row_terms(x, a, b, k[s], L0[s], scale, isq)
+        out[a] += isq[a] * t0
+        out[a + 1] += isq[a + 1] * t1
+        out[a + 2] += isq[a + 2] * t2
+        out[b] += isq[b] * t0
+        out[b + 1] += isq[b + 1] * t1
+        out[b + 2] += isq[b + 2] * t2
 
 
 @njit(cache=True, nogil=True)

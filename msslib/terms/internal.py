@@ -93,6 +93,20 @@ class Springs(ElementTerm):
                             np.ascontiguousarray(self.k[order]), np.ascontiguousarray(self.rest_length[order]))
         return self._layout
 
+    def lower_node_rows(self, n_nodes: int):
+        """The springs in rows by their lower node (built once per node count, cached):
+        ``(rowptr, order, ib)``, ``rowptr`` (n_nodes + 1,) offsets, ``order`` the spring of each
+        slot and ``ib`` its upper node (int64)."""
+        kept = getattr(self, "_lower_rows", None)
+        if kept is None or kept[0] != n_nodes:
+            lo = np.minimum(self.conn[:, 0], self.conn[:, 1])
+            order = np.argsort(lo, kind="stable")
+            rowptr = np.zeros(n_nodes + 1, dtype=np.int64)
+            np.cumsum(np.bincount(lo, minlength=n_nodes), out=rowptr[1:])
+            ib = np.ascontiguousarray(np.maximum(self.conn[:, 0], self.conn[:, 1])[order], dtype=np.int64)
+            kept = self._lower_rows = (n_nodes, rowptr, order.astype(np.int64), ib)
+        return kept[1:]
+
     def symmetric_layout(self):
         """Both-ends layout for the fast Hessian: ``(order, rowptr, nb, k, L0)`` with every spring
         listed under each of its two nodes (``order`` indexes the ``2 s`` half-springs: ``i < s``
