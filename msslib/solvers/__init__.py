@@ -99,9 +99,11 @@ Dynamics
 Verlet or implicit Euler. Constrained dofs keep their initial position and have zero velocity.
 An explicit run first checks its step against the stability limit of the model at rest
 (:func:`check_time_step`: ``2 / omega_max``, lowered by the damping where it does,
-:func:`critical_time_step`; ``omega_max`` from the cheap Gershgorin bound
-:func:`omega_max_bound` when the step is within the limit it gives, else from Lanczos,
-:func:`explicit_stability_limit`, kept for a model and state that did not change) and refuses a larger ``dt`` with
+:func:`critical_time_step`; ``omega_max`` from a cheap bound when the step is within the limit
+it gives -- on 3D spring models the first pass of :func:`directional_bound`, else Gershgorin's
+:func:`omega_max_bound` --, on spring models from a few more passes of the directional bound or a
+certified short Lanczos run, else from Lanczos, :func:`explicit_stability_limit`, kept for a
+model and state that did not change) and refuses a larger ``dt`` with
 :class:`msslib.errors.StabilityError` unless ``allow_unstable=True``. After every step the state
 is checked: a non-finite velocity, a displacement ``max |x - x0|`` beyond ``blowup * size``
 (``size`` the bounding-box diagonal of ``x0``), or, for the explicit schemes, the signature of
@@ -121,7 +123,9 @@ Modules (each imports only those above it)
 :mod:`~msslib.solvers.linear` (the linear solves), :mod:`~msslib.solvers.context` (solver
 contexts), :mod:`~msslib.solvers.roundoff` (the convergence test), :mod:`~msslib.solvers.statics`
 (:func:`static_solve`), :mod:`~msslib.solvers.displacement` (the FEM references through
-:func:`static_solve`), :mod:`~msslib.solvers.stability` (explicit stability limit).  Time
+:func:`static_solve`), :mod:`~msslib.solvers.certificate` and
+:mod:`~msslib.solvers.directional` (the stability check's bounds and certificates),
+:mod:`~msslib.solvers.stability` (explicit stability limit).  Time
 stepping (:func:`msslib.stepping.integrate`, the :class:`~msslib.stepping.Simulator`) builds on
 these in :mod:`msslib.stepping`.  :class:`ConvergenceError` and
 :class:`DivergenceError` are defined in :mod:`msslib.errors`.
@@ -153,6 +157,7 @@ from .submatrices import PlanCache  # noqa: F401
 from .policy import BAND_AUTO_COST, ITERATIVE_THRESHOLD, choose_linear_solver  # noqa: F401
 from .protocol import DynamicResult, StaticResult
 from .roundoff import EPS, ROUNDOFF_FACTOR, convergence_threshold, roundoff_floor, roundoff_note  # noqa: F401
+from .directional import directional_bound
 from .stability import (  # noqa: F401
     EXPLICIT_METHODS,
     check_time_step,
@@ -171,6 +176,7 @@ __all__ = [
     "choose_linear_solver",
     "convergence_threshold",
     "critical_time_step",
+    "directional_bound",
     "explicit_stability_limit",
     "omega_max_bound",
     "roundoff_floor",
