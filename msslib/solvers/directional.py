@@ -14,6 +14,20 @@ from .certificate import _rows_by_lower_node, _spring_terms, mass_vector
 _DIRECTIONAL_MAX_PASSES = 24
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _add_spring(G, b, c, s0, s1, s2, s3, s4, s5, g0, g1, g2, g3, g4, g5):
+    """A spring's ``c S`` (entries ``s``) into the other end ``b``'s sum ``G[b]`` and the row's
+    own node sum ``g`` (returned)."""
+    s0, s1, s2, s3, s4, s5 = c * s0, c * s1, c * s2, c * s3, c * s4, c * s5
+    G[b, 0] += s0
+    G[b, 1] += s1
+    G[b, 2] += s2
+    G[b, 3] += s3
+    G[b, 4] += s4
+    G[b, 5] += s5
+    return g0 + s0, g1 + s1, g2 + s2, g3 + s3, g4 + s4, g5 + s5
+
+
 @njit(cache=True, nogil=True)
 def _directional_prep(x, conn, k, L0, rowptr, order, isq, w, S, G, g):
     """Per spring slot ``j`` (spring ``order[j]``, in rows by lower node: ``rowptr``) at ``x``:
@@ -53,20 +67,7 @@ def _directional_prep(x, conn, k, L0, rowptr, order, isq, w, S, G, g):
             S[j, 4] = s4
             S[j, 5] = s5
             ob = (b if a == 3 * na else a) // 3  # the other end
-            c = wa + w[ob]
-            s0, s1, s2, s3, s4, s5 = c * s0, c * s1, c * s2, c * s3, c * s4, c * s5
-            g0 += s0
-            g1 += s1
-            g2 += s2
-            g3 += s3
-            g4 += s4
-            g5 += s5
-            G[ob, 0] += s0
-            G[ob, 1] += s1
-            G[ob, 2] += s2
-            G[ob, 3] += s3
-            G[ob, 4] += s4
-            G[ob, 5] += s5
+            g0, g1, g2, g3, g4, g5 = _add_spring(G, ob, wa + w[ob], s0, s1, s2, s3, s4, s5, g0, g1, g2, g3, g4, g5)
         for e in range(6):
             G[na, e] = 0.0
         g[na] = _node_top(g0, g1, g2, g3, g4, g5, isq, 3 * na) if wa != 0.0 else 0.0
@@ -121,21 +122,8 @@ def _directional_pass(rowptr, ib, S, isq, w, G, g):
         g0, g1, g2, g3, g4, g5 = G[a, 0], G[a, 1], G[a, 2], G[a, 3], G[a, 4], G[a, 5]
         for j in range(rowptr[a], rowptr[a + 1]):
             b = ib[j]
-            c = wa + w[b]
-            s0, s1, s2 = c * S[j, 0], c * S[j, 1], c * S[j, 2]
-            s3, s4, s5 = c * S[j, 3], c * S[j, 4], c * S[j, 5]
-            g0 += s0
-            g1 += s1
-            g2 += s2
-            g3 += s3
-            g4 += s4
-            g5 += s5
-            G[b, 0] += s0
-            G[b, 1] += s1
-            G[b, 2] += s2
-            G[b, 3] += s3
-            G[b, 4] += s4
-            G[b, 5] += s5
+            g0, g1, g2, g3, g4, g5 = _add_spring(G, b, wa + w[b], S[j, 0], S[j, 1], S[j, 2], S[j, 3], S[j, 4], S[j, 5],
+                                                 g0, g1, g2, g3, g4, g5)
         for e in range(6):
             G[a, e] = 0.0
         g[a] = _node_top(g0, g1, g2, g3, g4, g5, isq, 3 * a) if wa != 0.0 else 0.0
