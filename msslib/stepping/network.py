@@ -12,6 +12,8 @@ in place after every call, and what the Simulator writes into
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from msslib.errors import DivergenceError
@@ -182,6 +184,9 @@ class NetworkStepper(Integrator):
     # steps of one fused kernel call: the monitor rows are held for at most this many steps, so
     # that the memory of a call does not grow with its number of steps
     _CHUNK = 256
+    # from this many steps a call leaves the exact max |x - x_ref| out of the kernel (see
+    # _bound_displacements); below, the bound's bookkeeping costs more than it saves
+    _LEAN_MIN_STEPS = 16
 
     def steps(self, n: int, h=None, t_new=None):
         """``n`` steps of ``h`` (default ``dt``); ``t_new`` the time after the last one.  Runs them
@@ -208,13 +213,17 @@ class NetworkStepper(Integrator):
         if self.drive is None and not self.others:
             if self.mon.shape[0] < n:
                 self.mon = np.zeros((n, N_MONITOR))
-            fused_steps_lean(self.R, self._v, self._F, rowptr, ia, ib, kl, self.w, self.damp, h, self.fext,
-                             self._x_ref, self._react, self.mon, n)
+            lean = n >= self._LEAN_MIN_STEPS
+            (fused_steps_lean if lean else fused_steps)(self.R, self._v, self._F, rowptr, ia, ib, kl, self.w,
+                                                        self.damp, h, self.fext, self._x_ref, self._react, self.mon, n)
             self._sync_out()
             self.stats["n_force_evals"] += n
             t0 = self.t
             try:
-                self._bound_displacements(n, h)
+                if lean:
+                    self._bound_displacements(n, h)
+                else:
+                    self._dmax_ub = float(self.mon[n - 1, 4])
                 for i in range(n):
                     self._observe_row(i, h, self.n_taken + i + 1, t0 + (i + 1) * h if i + 1 < n else end,
                                       None, None)
@@ -277,21 +286,18 @@ class NetworkStepper(Integrator):
         check has passed, the rest of the call is not checked again, and the bound restarts from
         the exact value after the call."""
         d = self._dmax_ub
-        mon = self.mon
-        passed = False
-        for i in range(n):
-            if passed:
-                mon[i, 4] = 0.0
-                continue
-            q = mon[i, 0]
-            d = d + h * np.sqrt(q) if q >= 0.0 else float("nan")
-            mon[i, 4] = d
+        bounds = np.zeros(n)  # 0 after the check passed
+        for i, q in enumerate(self.mon[:n, 0].tolist()):
+            d = d + h * math.sqrt(q) if q >= 0.0 else float("nan")
             if not d <= self.bound:
                 _check_state(self.problem, self._flat_x(), self.v, self.x_ref, self.bound, self.n_taken + i + 1,
                              self.t + (i + 1) * h, self.dt, self.method, None, None, self.limit)
-                passed = True
-                mon[i, 4] = 0.0
-        self._dmax_ub = self._dmax_exact() if passed else d
+                self._dmax_ub = self._dmax_exact()
+                break
+            bounds[i] = d
+        else:
+            self._dmax_ub = d
+        self.mon[:n, 4] = bounds
 
     def _observe_row(self, i, h, step, t, x_prev, v_prev):
         q, pf, ku, r, dmax = self.mon[i]
