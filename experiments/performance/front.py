@@ -38,7 +38,10 @@ from experiments import script
 
 HERE = Path(__file__).resolve().parent
 REPEATS = 7  # timed runs of every (variant, level), long ones too (the median and the spread need them)
-BUDGET = 75.0  # s of CPU time after which a run is stopped (and recorded as such)
+# s of CPU time after which a run is stopped (and recorded as such).  The slowest run that converges,
+# Baudet's non-linear cantilever on level 4, takes 48-53 s on an idle core and went past 75 s in a
+# full build beside another job (a fresh install's): the budget leaves room for that
+BUDGET = 180.0
 
 LAW = {"triangle": "fem_svk", "quad": "fem_svk", "tetra": "fem_neohookean", "hexahedron": "fem_neohookean"}
 
