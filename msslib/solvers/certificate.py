@@ -26,6 +26,16 @@ CERTIFICATE_FAILURE = 1e-9
 _CERT_MAX_STEPS = 64
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _spring_delta(x, a, b):
+    """``(d0, d1, d2, l)``: the vector from the node at dofs ``a`` to the node at dofs ``b`` and its
+    length (0 for coincident nodes: the callers stop there)."""
+    d0 = x[b] - x[a]
+    d1 = x[b + 1] - x[a + 1]
+    d2 = x[b + 2] - x[a + 2]
+    return d0, d1, d2, np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
 @njit(cache=True, nogil=True)
 def _spring_prep(x, conn, k, L0, isq, coef, shift_rows):
     """Per spring at ``x``: ``coef[s] = (n, k L0/l, k (1 - L0/l))`` (its Hessian block is
@@ -35,10 +45,7 @@ def _spring_prep(x, conn, k, L0, isq, coef, shift_rows):
     for s in range(conn.shape[0]):
         a = 3 * conn[s, 0]
         b = 3 * conn[s, 1]
-        d0 = x[b] - x[a]
-        d1 = x[b + 1] - x[a + 1]
-        d2 = x[b + 2] - x[a + 2]
-        l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        d0, d1, d2, l = _spring_delta(x, a, b)
         if not l > 0.0:
             return False
         r = L0[s] / l
@@ -66,10 +73,7 @@ def _spring_abs_prep(x, conn, k, L0, isq, coef, diag):
         nb = conn[s, 1]
         a = 3 * na
         b = 3 * nb
-        d0 = x[b] - x[a]
-        d1 = x[b + 1] - x[a + 1]
-        d2 = x[b + 2] - x[a + 2]
-        l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        d0, d1, d2, l = _spring_delta(x, a, b)
         if not l > 0.0:
             return False
         r = L0[s] / l

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .certificate import _rows_by_lower_node, _spring_terms, mass_vector
+from .certificate import _rows_by_lower_node, _spring_delta, _spring_terms, mass_vector
 
 # the most passes of the directional bound (each about a third of a force evaluation)
 _DIRECTIONAL_MAX_PASSES = 24
@@ -43,10 +43,7 @@ def _directional_prep(x, conn, k, L0, rowptr, order, isq, w, S, G, g):
             s = order[j]
             a = 3 * conn[s, 0]
             b = 3 * conn[s, 1]
-            d0 = x[b] - x[a]
-            d1 = x[b + 1] - x[a + 1]
-            d2 = x[b + 2] - x[a + 2]
-            l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            d0, d1, d2, l = _spring_delta(x, a, b)
             if not l > 0.0:
                 return False
             il = 1.0 / l
