@@ -12,6 +12,8 @@ import scipy.sparse as sp
 from numba import njit
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
+from msslib.terms.bounds import spring_delta as _spring_delta
+
 
 def mass_vector(problem):
     m = np.asarray(problem.mass, dtype=float).reshape(-1)
@@ -24,16 +26,6 @@ def mass_vector(problem):
 # above the limit, and the most Lanczos steps it takes before it leaves the decision to eigsh.
 CERTIFICATE_FAILURE = 1e-9
 _CERT_MAX_STEPS = 64
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _spring_delta(x, a, b):
-    """``(d0, d1, d2, l)``: the vector from the node at dofs ``a`` to the node at dofs ``b`` and its
-    length (0 for coincident nodes: the callers stop there)."""
-    d0 = x[b] - x[a]
-    d1 = x[b + 1] - x[a + 1]
-    d2 = x[b + 2] - x[a + 2]
-    return d0, d1, d2, np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
 @njit(cache=True, nogil=True)

@@ -11,7 +11,17 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["spring3d_abs_rows", "spring3d_abs_row_terms", "csr_abs_rows"]
+__all__ = ["spring3d_abs_rows", "spring3d_abs_row_terms", "spring_delta", "csr_abs_rows"]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def spring_delta(x, a, b):
+    """``(d0, d1, d2, l)``: the vector from the node at dofs ``a`` to the node at dofs ``b`` and its
+    length (0 for coincident nodes)."""
+    d0 = x[b] - x[a]
+    d1 = x[b + 1] - x[a + 1]
+    d2 = x[b + 2] - x[a + 2]
+    return d0, d1, d2, np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -20,10 +30,7 @@ def spring3d_abs_row_terms(x, a, b, k, L0, scale, isq):
     ``(r, n0, n1, n2, t0, t1, t2)``, ``r = L0 / l`` (infinite for coincident nodes), ``n`` the
     unit vector from ``a`` to ``b``, and ``t`` such that row ``a + i`` gains ``isq[a + i] t_i``
     and row ``b + i`` gains ``isq[b + i] t_i``."""
-    d0 = x[b] - x[a]
-    d1 = x[b + 1] - x[a + 1]
-    d2 = x[b + 2] - x[a + 2]
-    l = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    d0, d1, d2, l = spring_delta(x, a, b)
     if l > 0.0:
         il = 1.0 / l
         r = L0 * il
